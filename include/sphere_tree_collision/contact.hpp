@@ -1,0 +1,24 @@
+// Contact: what the response phase gets from one intersecting sphere pair
+// (paper 3.5, Fig. 4): normal along the line of centres, point dividing it
+// in proportion to the radii.
+#pragma once
+
+#include "sphere_tree_collision/types.hpp"
+
+namespace stc {
+
+struct Contact {
+  EntityId a = kInvalidEntity;
+  EntityId b = kInvalidEntity;
+  std::uint32_t index_a = 0;  // dense body index in the World this tick
+  std::uint32_t index_b = 0;
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();  // unit, from a towards b
+  double depth = 0.0;           // sphere overlap along the normal (>= 0)
+  double gap_bound = 0.0;       // h_a + h_b of the sphere pair: the true gap is at most this
+  int level = 0;                // deepest tree level the pair reached
+  bool resolved = false;        // true: found at the leaves; false: accepted unresolved
+  double priority = 0.0;        // perceptual priority f(e, g) (0 without gaze)
+};
+
+}  // namespace stc

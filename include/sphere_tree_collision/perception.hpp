@@ -1,0 +1,64 @@
+// Perception: the paper's model of how noticeable a collision artefact is
+// (2.3, 3.4.2). A pinhole camera, a fixation point F in pixels, and
+// f(e, g) = g / exp(e / 100) with e and g in pixels.
+#pragma once
+
+#include "sphere_tree_collision/pair_test.hpp"
+#include "sphere_tree_collision/types.hpp"
+
+#include <cmath>
+#include <optional>
+
+namespace stc {
+
+using Vec2 = Eigen::Vector2d;
+
+// Pinhole camera. The camera frame is the optical frame: x right, y down,
+// z forward (REP 103 "_optical" convention). Pixel (0,0) is the top-left.
+struct Camera {
+  Pose camera_to_world;
+  int width = 1280;
+  int height = 720;
+  double fov_y_deg = 60.0;  // vertical field of view
+};
+// Throws InputError naming "width", "height", "fov_y_deg", or "camera_pose".
+void validateCamera(const Camera& camera);
+
+// Perceived inaccuracy of one gap: g / exp(e / 100).
+inline double perceivedInaccuracy(double eccentricity_px, double gap_px);
+
+struct PairPerception {
+  double eccentricity_px = 0.0;  // |proj(centre of collision) - F|
+  double gap_estimate_px = 0.0;  // |proj(cA) - proj(cB)| of the last intersecting centres
+  double gap_bound_px = 0.0;     // (h_a + h_b) projected at the centre of collision's depth
+  double priority = 0.0;         // f(e, gap_estimate_px)
+  bool visible = true;           // false: behind the camera or off screen (see rule in .cpp)
+};
+
+class Perception {
+ public:
+  void setCamera(const Camera& camera);  // validates
+  const Camera& camera() const { return camera_; }
+  // Throws InputError("fixation") for non-finite values. Off-screen fixations
+  // are rejected too (InputError "fixation"): the viewer looks at the screen.
+  void setFixation(const Vec2& pixel);
+  void clearFixation() { fixation_.reset(); }
+  bool hasFixation() const { return fixation_.has_value(); }
+  const std::optional<Vec2>& fixation() const { return fixation_; }
+
+  // Pixel of a world point; nullopt when it is behind (or on) the camera plane.
+  std::optional<Vec2> project(const Vec3& world) const;
+  // Requires hasFixation().
+  PairPerception measure(const PairTest& test) const;
+
+ private:
+  Camera camera_;
+  double focal_px_ = 0.0;
+  std::optional<Vec2> fixation_;
+};
+
+inline double perceivedInaccuracy(double eccentricity_px, double gap_px) {
+  return gap_px / std::exp(eccentricity_px / 100.0);
+}
+
+}  // namespace stc

@@ -1,0 +1,54 @@
+// Schedulers (paper 3.4.3): who gets the next step of the narrow phase until
+// every PairTest resolves or the Budget ends.
+#pragma once
+
+#include "sphere_tree_collision/budget.hpp"
+#include "sphere_tree_collision/pair_test.hpp"
+#include "sphere_tree_collision/perception.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace stc {
+
+enum class SchedulerKind : std::uint8_t {
+  RoundRobin,            // Hubbard: every pair one level, then again
+  Sequential,            // pairs resolved fully one by one, in list order
+  PerceptualSequential,  // sorted by perceptual priority, then sequential
+  PriorityQueues,        // model picks one of K queues; round-robin inside; highest first
+};
+// "round_robin" | "sequential" | "perceptual_sequential" | "priority_queues";
+// throws InputError("scheduler") otherwise.
+SchedulerKind parseScheduler(const std::string& name);
+const char* toString(SchedulerKind kind);
+
+enum class UnresolvedPolicy : std::uint8_t { Accept, Reject };
+// "accept" | "reject"; throws InputError("unresolved_policy") otherwise.
+UnresolvedPolicy parseUnresolvedPolicy(const std::string& name);
+const char* toString(UnresolvedPolicy policy);
+
+struct SchedulerOptions {
+  SchedulerKind kind = SchedulerKind::PriorityQueues;
+  int queue_count = 4;  // priority queues only; >= 1
+};
+
+struct ScheduleStats {
+  std::int64_t sphere_tests = 0;
+  bool interrupted = false;       // budget ended with unresolved pairs left
+  double overhead_seconds = 0.0;  // time spent deciding (perception, sorting, queues), not testing
+  bool used_perception = false;   // false when there is no fixation: no projection work done
+};
+
+// One call per tick. Steps tests[0..count) under the budget. Without a
+// perception (nullptr or no fixation) the perceptual schedulers fall back to
+// their non-perceptual order and say so in ScheduleStats::used_perception.
+class Scheduler {
+ public:
+  virtual ~Scheduler() = default;
+  virtual ScheduleStats run(std::vector<PairTest>& tests, std::size_t count,
+                            const Perception* perception, BudgetTracker& budget) = 0;
+};
+std::unique_ptr<Scheduler> makeScheduler(const SchedulerOptions& options);
+
+}  // namespace stc

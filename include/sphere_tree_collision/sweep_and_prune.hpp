@@ -1,0 +1,51 @@
+// SweepAndPrune: the I-COLLIDE broad phase (paper 3.2). Three sorted endpoint
+// arrays kept sorted by insertion sort each tick (temporal coherence); the
+// overlap-pair set is updated by the swaps, never rebuilt by an all-pairs pass
+// after the first sort.
+#pragma once
+
+#include "sphere_tree_collision/types.hpp"
+
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace stc {
+
+// Broad-phase pair, ids ordered first < second.
+struct BroadPair {
+  EntityId first;
+  EntityId second;
+  bool operator==(const BroadPair& o) const { return first == o.first && second == o.second; }
+};
+
+class SweepAndPrune {
+ public:
+  // Add/remove between ticks. Adding an existing id or removing an unknown one
+  // throws InputError("id").
+  void add(EntityId id, const Aabb& box);
+  void remove(EntityId id);
+  bool contains(EntityId id) const;
+  // Set the box an entity will have at the next update().
+  void setBox(EntityId id, const Aabb& box);
+  // Re-sort the endpoint arrays (insertion sort) and update the pair set.
+  void update();
+  // Current overlapping pairs (all three axes), in no particular order.
+  const std::vector<BroadPair>& pairs() const { return pairs_; }
+  std::size_t size() const;
+  // Endpoint swaps done by the last update(): the measure of coherence.
+  std::size_t lastSwapCount() const { return last_swaps_; }
+
+  SweepAndPrune();
+  ~SweepAndPrune();
+  SweepAndPrune(SweepAndPrune&&) noexcept;
+  SweepAndPrune& operator=(SweepAndPrune&&) noexcept;
+
+ private:
+  struct Impl;  // endpoint arrays and overlap bookkeeping (sweep_and_prune.cpp)
+  std::unique_ptr<Impl> impl_;
+  std::vector<BroadPair> pairs_;
+  std::size_t last_swaps_ = 0;
+};
+
+}  // namespace stc

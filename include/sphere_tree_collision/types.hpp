@@ -1,0 +1,54 @@
+// Basic value types shared by every part of the ROS-free core.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace stc {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using Quat = Eigen::Quaterniond;
+
+// Stable handle of an entity; never reused within one World.
+using EntityId = std::uint32_t;
+constexpr EntityId kInvalidEntity = std::numeric_limits<EntityId>::max();
+
+// Rigid transform from a body frame to the world frame.
+struct Pose {
+  Vec3 position = Vec3::Zero();
+  Quat orientation = Quat::Identity();
+
+  Vec3 apply(const Vec3& p) const { return orientation * p + position; }
+};
+
+struct Aabb {
+  Vec3 min = Vec3::Zero();
+  Vec3 max = Vec3::Zero();
+
+  bool overlaps(const Aabb& o) const {
+    return min.x() <= o.max.x() && o.min.x() <= max.x() && min.y() <= o.max.y() &&
+           o.min.y() <= max.y() && min.z() <= o.max.z() && o.min.z() <= max.z();
+  }
+};
+
+// Rejected input. `field()` names the offending field (e.g. "voxel_size",
+// "occupancy", "preset") so callers can report it verbatim.
+class InputError : public std::invalid_argument {
+ public:
+  InputError(std::string field, const std::string& message)
+      : std::invalid_argument(field + ": " + message), field_(std::move(field)) {}
+  const std::string& field() const { return field_; }
+
+ private:
+  std::string field_;
+};
+
+inline bool allFinite(const Vec3& v) { return v.allFinite(); }
+
+}  // namespace stc

@@ -1,0 +1,167 @@
+// World: owns shapes, trees, entities and the phases; step() runs one tick:
+//   1 integrate  2 broad phase  3 narrow phase + scheduler  4 response
+// and returns a TickReport. Each phase reads what the previous one wrote.
+#pragma once
+
+#include "sphere_tree_collision/body.hpp"
+#include "sphere_tree_collision/budget.hpp"
+#include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/pair_test.hpp"
+#include "sphere_tree_collision/perception.hpp"
+#include "sphere_tree_collision/scheduler.hpp"
+#include "sphere_tree_collision/sphere_tree.hpp"
+#include "sphere_tree_collision/sweep_and_prune.hpp"
+#include "sphere_tree_collision/voxel_shape.hpp"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace stc {
+
+using ShapeId = std::uint32_t;
+
+// How an entity's broad-phase box is made (paper 3.2).
+enum class BoxMode : std::uint8_t {
+  Auto,     // chosen from the shape: Dynamic when elongated, else FixedCube
+  FixedCube,  // cube big enough for any orientation; only moves with the centre
+  Dynamic,    // tight AABB of the rotated root-level spheres, recomputed each tick
+};
+// "auto" | "fixed" | "dynamic"; throws InputError("box_mode").
+BoxMode parseBoxMode(const std::string& name);
+
+struct ResponseOptions {
+  bool enabled = true;
+  int iterations = 10;                  // solver iterations per tick
+  double restitution_threshold = 0.2;   // m/s: slower approach is treated as resting
+  double position_correction = 0.2;     // fraction of penetration removed per tick
+  double allowed_penetration = 0.0;     // metres kept as slop (0: derive from voxel size)
+};
+
+struct WorldConfig {
+  Vec3 gravity = Vec3::Zero();
+  SchedulerOptions scheduler;
+  UnresolvedPolicy unresolved_policy = UnresolvedPolicy::Accept;
+  SphereTreeOptions tree;
+  VoxelLimits voxel_limits;
+  std::size_t max_entities = 20000;
+  ResponseOptions response;
+};
+
+struct EntitySpec {
+  std::string name;         // optional; unique when given
+  ShapeId shape = 0;
+  Pose pose;                // of the body frame (origin at the centre of mass)
+  Vec3 linear_velocity = Vec3::Zero();
+  Vec3 angular_velocity = Vec3::Zero();
+  double density = 1000.0;  // kg/m^3, > 0
+  Material material;
+  bool is_static = false;
+  BoxMode box_mode = BoxMode::Auto;
+};
+
+struct TickReport {
+  // Phase wall times, seconds.
+  double integrate_s = 0.0, broad_s = 0.0, narrow_s = 0.0, response_s = 0.0, total_s = 0.0;
+  double scheduling_overhead_s = 0.0;  // part of narrow_s spent deciding, not testing
+  std::size_t entities = 0;
+  std::size_t broad_pairs = 0;
+  std::size_t colliding = 0;            // resolved colliding at the leaves
+  std::size_t separate = 0;             // resolved separate
+  std::size_t unresolved = 0;           // left unresolved at interruption
+  std::size_t unresolved_accepted = 0;  // of those, accepted as colliding (policy accept)
+  std::int64_t sphere_tests = 0;
+  bool interrupted = false;
+  bool perception_used = false;         // false without a fixation: no projection work
+  double geometric_inaccuracy = 0.0;    // nabla: sum of 3D gap estimates of accepted unresolved pairs
+  double geometric_bound = 0.0;         // sum of rigorous bounds h_a + h_b over the same pairs
+  double perceived_inaccuracy = 0.0;    // P: sum of f(e, g) over the same pairs
+  std::size_t contacts = 0;
+};
+
+struct ShapeInfo {
+  std::string key;
+  VoxelShape voxels;
+  MassProperties unit_mass;   // density 1
+  Vec3 body_origin;           // centre of mass in the grid frame
+  SphereTree tree;
+  double bounding_radius = 0; // max distance from the body origin to the shape
+  bool elongated = false;     // Auto box mode picks Dynamic
+};
+
+class World {
+ public:
+  explicit World(const WorldConfig& config = WorldConfig{});
+  ~World();
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+
+  // Shapes are shared: the same key returns the same id (the tree is built once).
+  ShapeId addShape(const std::string& key, VoxelShape shape);
+  std::optional<ShapeId> findShape(const std::string& key) const;
+  const ShapeInfo& shape(ShapeId id) const;
+
+  // Throws InputError naming the field ("shape", "pose.position",
+  // "pose.orientation", "linear_velocity", "angular_velocity", "density",
+  // "material.restitution", "material.friction", "name", "max_entities");
+  // on throw nothing changes.
+  EntityId addEntity(const EntitySpec& spec);
+  bool removeEntity(EntityId id);
+  std::optional<EntityId> findByName(const std::string& name) const;
+  void clear();  // removes every entity, keeps shapes
+
+  TickReport step(double dt, const Budget& budget);
+
+  Perception& perception() { return perception_; }
+  const Perception& perception() const { return perception_; }
+  const WorldConfig& config() const { return config_; }
+  void setScheduler(const SchedulerOptions& options);
+  void setUnresolvedPolicy(UnresolvedPolicy policy) { config_.unresolved_policy = policy; }
+
+  // Dense views, valid until the next add/remove/step.
+  std::size_t entityCount() const { return ids_.size(); }
+  const std::vector<EntityId>& entityIds() const { return ids_; }
+  const std::vector<BodyState>& bodies() const { return bodies_; }
+  std::vector<BodyState>& bodies() { return bodies_; }
+  const std::vector<ShapeId>& bodyShapes() const { return body_shapes_; }
+  const std::vector<std::string>& bodyNames() const { return names_; }
+  std::optional<std::size_t> indexOf(EntityId id) const;
+
+  // Narrow-phase results of the last step: pairTests()[0..pairCount()).
+  const std::vector<PairTest>& pairTests() const { return pair_tests_; }
+  std::size_t pairCount() const { return pair_count_; }
+  const std::vector<Contact>& contacts() const { return contacts_; }
+
+ private:
+  // Phases, in tick order.
+  void integrate(double dt, TickReport& report);
+  void broadPhase(TickReport& report);
+  void narrowPhase(const Budget& budget, TickReport& report);
+  void response(double dt, TickReport& report);
+  Aabb boxOf(std::size_t index) const;
+
+  WorldConfig config_;
+  std::vector<ShapeInfo> shapes_;
+  std::unordered_map<std::string, ShapeId> shape_by_key_;
+
+  // Entities: flat arrays indexed densely; ids_ maps dense -> id.
+  std::vector<EntityId> ids_;
+  std::vector<BodyState> bodies_;
+  std::vector<ShapeId> body_shapes_;
+  std::vector<BoxMode> box_modes_;
+  std::vector<std::string> names_;
+  std::unordered_map<EntityId, std::size_t> index_of_;
+  std::unordered_map<std::string, EntityId> id_by_name_;
+  EntityId next_id_ = 0;
+
+  SweepAndPrune broad_phase_;
+  std::unique_ptr<Scheduler> scheduler_;
+  Perception perception_;
+  std::vector<PairTest> pair_tests_;  // pooled: capacity kept between ticks
+  std::size_t pair_count_ = 0;
+  std::vector<Contact> contacts_;
+};
+
+}  // namespace stc

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs the Debian packages the package needs, only those that are missing.
+set -euo pipefail
+packages=(
+  cmake g++ git make pkg-config
+  catkin ros-base-dev ros-message-generation ros-message-runtime
+  libroscpp-dev libtf2-ros-dev libtf2-dev libvisualization-msgs-dev libgeometry-msgs-dev libstd-msgs-dev
+  librostest-dev python3-rostest rostest python3-roslaunch roslaunch
+  libeigen3-dev libyaml-cpp-dev libfcl-dev libgtest-dev googletest
+  python3-matplotlib
+  rviz xvfb xauth imagemagick x11-utils
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_deps: all ${#packages[@]} Debian packages present"
+  exit 0
+fi
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+echo "install_deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update
+$SUDO apt-get install -y --no-install-recommends "${missing[@]}"

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Install what is missing, build, run every test (gtest + rostest) and end with
+# one line "N passed, N failed". Exit status is non-zero unless all passed.
+set -uo pipefail
+source "$(dirname "$0")/common.sh"
+"$STC_ROOT/scripts/install_deps.sh" || exit 1
+"$STC_ROOT/scripts/build.sh" --tests || { echo "0 passed, 1 failed"; exit 1; }
+rm -rf "$STC_BUILD/test_results"
+# shellcheck disable=SC1091
+source "$STC_BUILD/devel/setup.bash"
+# run_tests exits 0 even when a test fails: the result files decide.
+make -C "$STC_BUILD" run_tests -j1 2>&1 | tee "$STC_BUILD/run_tests.log" | grep -E "^\[ *(RUN|  OK|  FAILED|  PASSED) |^\[ROSTEST\]|FAILURE|Error|error:" || true
+/usr/bin/python3 "$STC_ROOT/scripts/count_results.py" "$STC_BUILD/test_results"
