@@ -4,8 +4,8 @@
 # prints a line per second with tick counts. Extra arguments go to roslaunch.
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
-"$STC_ROOT/scripts/install_deps.sh"
-"$STC_ROOT/scripts/build.sh"
+bash "$STC_ROOT/scripts/install_deps.sh"
+bash "$STC_ROOT/scripts/build.sh"
 # shellcheck disable=SC1091
 source "$STC_BUILD/devel/setup.bash"
 rviz=true

@@ -3,8 +3,8 @@
 # one line "N passed, N failed". Exit status is non-zero unless all passed.
 set -uo pipefail
 source "$(dirname "$0")/common.sh"
-"$STC_ROOT/scripts/install_deps.sh" || exit 1
-"$STC_ROOT/scripts/build.sh" --tests || { echo "0 passed, 1 failed"; exit 1; }
+bash "$STC_ROOT/scripts/install_deps.sh" || exit 1
+bash "$STC_ROOT/scripts/build.sh" --tests || { echo "0 passed, 1 failed"; exit 1; }
 rm -rf "$STC_BUILD/test_results"
 # shellcheck disable=SC1091
 source "$STC_BUILD/devel/setup.bash"
