@@ -32,8 +32,17 @@ struct PairPerception {
   double gap_estimate_px = 0.0;  // |proj(cA) - proj(cB)| of the last intersecting centres
   double gap_bound_px = 0.0;     // (h_a + h_b) projected at the centre of collision's depth
   double priority = 0.0;         // f(e, gap_estimate_px)
-  bool visible = true;           // false: behind the camera or off screen (see rule in .cpp)
+  bool visible = true;           // false: behind the camera or off screen (rule below)
 };
+
+// Rule for what the viewer cannot see:
+// - centre of collision behind (or on) the camera plane (depth <= kNearDepth):
+//   visible = false, eccentricity = +inf, gaps 0, priority 0;
+// - in front but projecting outside [0,width]x[0,height]: visible = false,
+//   e measured to the off-screen pixel and priority = f(e, g) as usual (the
+//   bodies have extent, so their gap may still show; f decays fast with e and
+//   stays continuous across the border).
+// The World still accepts or rejects unresolved pairs per its policy.
 
 class Perception {
  public:
@@ -46,14 +55,23 @@ class Perception {
   bool hasFixation() const { return fixation_.has_value(); }
   const std::optional<Vec2>& fixation() const { return fixation_; }
 
+  static constexpr double kNearDepth = 1e-6;  // metres; nearer points do not project
+
   // Pixel of a world point; nullopt when it is behind (or on) the camera plane.
   std::optional<Vec2> project(const Vec3& world) const;
-  // Requires hasFixation().
+  // Depth along the optical axis; nullopt when <= kNearDepth.
+  std::optional<double> depthOf(const Vec3& world) const;
+  // Pixels per metre at unit depth: a length d at depth z spans d * focalPx() / z pixels.
+  double focalPx() const { return focal_px_; }
+  bool onScreen(const Vec2& pixel) const;
+  // Without a fixation every pair is reported invisible with priority 0.
   PairPerception measure(const PairTest& test) const;
 
  private:
   Camera camera_;
-  double focal_px_ = 0.0;
+  Mat3 world_to_camera_rotation_ = Mat3::Identity();
+  Vec3 camera_position_ = Vec3::Zero();
+  double focal_px_ = 0.5 * 720 / 0.57735026918962573;  // default Camera: 720 px, 60 deg
   std::optional<Vec2> fixation_;
 };
 

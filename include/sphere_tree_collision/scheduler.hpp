@@ -31,7 +31,13 @@ const char* toString(UnresolvedPolicy policy);
 struct SchedulerOptions {
   SchedulerKind kind = SchedulerKind::PriorityQueues;
   int queue_count = 4;  // priority queues only; >= 1
+  // Priority queues only; > 1. Log-scale bins relative to the largest priority
+  // at the start of the run: the top queue holds f >= fmax / ratio, the next
+  // f >= fmax / ratio^2, ..., the bottom queue the rest (and f = 0).
+  double queue_ratio = 4.0;
 };
+// Throws InputError("queue_count") or InputError("queue_ratio").
+void validateSchedulerOptions(const SchedulerOptions& options);
 
 struct ScheduleStats {
   std::int64_t sphere_tests = 0;
@@ -49,6 +55,7 @@ class Scheduler {
   virtual ScheduleStats run(std::vector<PairTest>& tests, std::size_t count,
                             const Perception* perception, BudgetTracker& budget) = 0;
 };
+// Validates the options (see validateSchedulerOptions).
 std::unique_ptr<Scheduler> makeScheduler(const SchedulerOptions& options);
 
 }  // namespace stc
