@@ -67,17 +67,22 @@ class PairTest {
   // Paper's gap estimate: distance between the last intersecting centres
   // (entity origins before any sphere was tested).
   double gapEstimate() const;
-  // Rigorous bound on the true gap: h_a + h_b of lastPair() (before any test:
-  // root radii + root h, i.e. the bound of the roots).
+  // Rigorous bound on the true gap: h_a + h_b of lastPair(). Without a last
+  // pair (no test yet, or separate at the roots): |c_A - c_B| + h_A + h_B of
+  // the roots, which holds whether or not the roots touch.
   double gapBound() const;
 
   const PairBody& bodyA() const { return a_; }
   const PairBody& bodyB() const { return b_; }
 
  private:
+  void chooseBestLastPair();
+
   PairBody a_, b_;
   std::vector<SphereHit> hits_, next_hits_;
   std::vector<SpherePair> last_pairs_;
+  // Scratch of one step, kept for its capacity: leaf pairs and other intersecting pairs.
+  std::vector<SpherePair> step_leaf_pairs_, step_pairs_;
   std::size_t best_last_ = 0;
   PairStatus status_ = PairStatus::Unresolved;
   int steps_ = 0;

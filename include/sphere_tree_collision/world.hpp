@@ -13,6 +13,8 @@
 #include "sphere_tree_collision/sweep_and_prune.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
 
+#include <array>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -91,6 +93,13 @@ struct ShapeInfo {
   bool elongated = false;     // Auto box mode picks Dynamic
 };
 
+// Contact from a PairTest's deepest intersecting sphere pair (the roots when
+// it has none): normal along the line of centres from a to b (UnitZ when the
+// centres coincide), point dividing the centres in proportion to the radii,
+// depth = max(0, r_a + r_b - |c_b - c_a|), gap_bound = test.gapBound().
+Contact makeContact(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b,
+                    double priority);
+
 class World {
  public:
   explicit World(const WorldConfig& config = WorldConfig{});
@@ -120,7 +129,8 @@ class World {
   void setScheduler(const SchedulerOptions& options);
   void setUnresolvedPolicy(UnresolvedPolicy policy) { config_.unresolved_policy = policy; }
 
-  // Dense views, valid until the next add/remove/step.
+  // Dense views, valid until the next add/remove/step. Adding or removing an
+  // entity (or clear()) also empties pairTests()/contacts() of the last step.
   std::size_t entityCount() const { return ids_.size(); }
   const std::vector<EntityId>& entityIds() const { return ids_; }
   const std::vector<BodyState>& bodies() const { return bodies_; }
@@ -141,9 +151,10 @@ class World {
   void narrowPhase(const Budget& budget, TickReport& report);
   void response(double dt, TickReport& report);
   Aabb boxOf(std::size_t index) const;
+  void invalidateLastTick();
 
   WorldConfig config_;
-  std::vector<ShapeInfo> shapes_;
+  std::deque<ShapeInfo> shapes_;  // deque: trees keep their address as shapes are added
   std::unordered_map<std::string, ShapeId> shape_by_key_;
 
   // Entities: flat arrays indexed densely; ids_ maps dense -> id.
@@ -161,6 +172,8 @@ class World {
   Perception perception_;
   std::vector<PairTest> pair_tests_;  // pooled: capacity kept between ticks
   std::size_t pair_count_ = 0;
+  std::vector<std::array<std::uint32_t, 2>> pair_bodies_;  // dense indices of each pair test's bodies
+  std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
   std::vector<Contact> contacts_;
 };
 

@@ -1,0 +1,418 @@
+// World: owns shapes, trees, entities and the phases of one tick.
+#include "sphere_tree_collision/world.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace stc {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsBetween(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+// A unit quaternion may be off by this much before normalisation; more means
+// the caller passed something that is not a rotation.
+constexpr double kOrientationNormTolerance = 1e-3;
+
+// Auto box mode: a shape whose occupied extent is this much longer along its
+// longest axis than along its shortest gets a dynamic box (paper 3.2: long,
+// thin objects are bounded badly by a fixed cube). Rods and plates pass it,
+// cubes, rocks, spheres, L and ring do not.
+constexpr double kElongationRatio = 2.5;
+
+// Max distance from `origin` to a corner of an occupied voxel: the radius of
+// a ball about the centre of mass that holds the shape in any orientation.
+double boundingRadius(const VoxelShape& shape, const Vec3& origin) {
+  const double s = shape.voxelSize();
+  double max_sq = 0.0;
+  for (int k = 0; k < shape.nz(); ++k) {
+    for (int j = 0; j < shape.ny(); ++j) {
+      for (int i = 0; i < shape.nx(); ++i) {
+        if (!shape.occupied(i, j, k)) continue;
+        const Vec3 lo = Vec3(i, j, k) * s - origin;
+        const Vec3 hi = lo + Vec3::Constant(s);
+        max_sq = std::max(max_sq, lo.cwiseAbs().cwiseMax(hi.cwiseAbs()).squaredNorm());
+      }
+    }
+  }
+  return std::sqrt(max_sq);
+}
+
+// Longest over shortest extent of the occupied voxels' bounding box (the
+// grid may be padded, the occupied part is what moves).
+bool isElongated(const VoxelShape& shape) {
+  Eigen::Vector3i lo(shape.nx(), shape.ny(), shape.nz());
+  Eigen::Vector3i hi(-1, -1, -1);
+  for (int k = 0; k < shape.nz(); ++k) {
+    for (int j = 0; j < shape.ny(); ++j) {
+      for (int i = 0; i < shape.nx(); ++i) {
+        if (!shape.occupied(i, j, k)) continue;
+        lo = lo.cwiseMin(Eigen::Vector3i(i, j, k));
+        hi = hi.cwiseMax(Eigen::Vector3i(i, j, k));
+      }
+    }
+  }
+  const Eigen::Vector3i extent = hi - lo + Eigen::Vector3i::Ones();
+  return extent.maxCoeff() >= kElongationRatio * extent.minCoeff();
+}
+
+void requireFinite(const Vec3& v, const char* field) {
+  if (!allFinite(v)) throw InputError(field, "must be finite");
+}
+
+}  // namespace
+
+World::World(const WorldConfig& config)
+    : config_(config), scheduler_(makeScheduler(config.scheduler)) {}
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
+// ---------------------------------------------------------------------------------
+// Shapes
+
+ShapeId World::addShape(const std::string& key, VoxelShape voxels) {
+  if (const auto found = findShape(key)) return *found;
+  const VoxelLimits& limits = config_.voxel_limits;
+  const std::int64_t cells = static_cast<std::int64_t>(voxels.nx()) * voxels.ny() * voxels.nz();
+  if (cells > limits.max_voxels) {
+    throw InputError("max_voxels", "grid of " + std::to_string(cells) + " voxels exceeds " +
+                                       std::to_string(limits.max_voxels));
+  }
+  if (!(voxels.voxelSize() >= limits.min_voxel_size && voxels.voxelSize() <= limits.max_voxel_size)) {
+    throw InputError("voxel_size", "outside [" + std::to_string(limits.min_voxel_size) + ", " +
+                                       std::to_string(limits.max_voxel_size) + "]");
+  }
+
+  ShapeInfo info;
+  info.key = key;
+  info.unit_mass = computeMassProperties(voxels, 1.0);
+  info.body_origin = info.unit_mass.centre_of_mass;
+  info.tree = SphereTree::build(voxels, info.body_origin, config_.tree);
+  info.bounding_radius = boundingRadius(voxels, info.body_origin);
+  info.elongated = isElongated(voxels);
+  info.voxels = std::move(voxels);
+
+  const auto id = static_cast<ShapeId>(shapes_.size());
+  shapes_.push_back(std::move(info));  // deque: earlier shapes (and trees) stay put
+  shape_by_key_.emplace(key, id);
+  return id;
+}
+
+std::optional<ShapeId> World::findShape(const std::string& key) const {
+  const auto it = shape_by_key_.find(key);
+  if (it == shape_by_key_.end()) return std::nullopt;
+  return it->second;
+}
+
+const ShapeInfo& World::shape(ShapeId id) const {
+  if (id >= shapes_.size()) throw InputError("shape", "unknown shape id " + std::to_string(id));
+  return shapes_[id];
+}
+
+// ---------------------------------------------------------------------------------
+// Entities
+
+EntityId World::addEntity(const EntitySpec& spec) {
+  // Validate everything first: on throw nothing has changed.
+  if (spec.shape >= shapes_.size()) {
+    throw InputError("shape", "unknown shape id " + std::to_string(spec.shape));
+  }
+  requireFinite(spec.pose.position, "pose.position");
+  const double q_norm = spec.pose.orientation.coeffs().norm();
+  if (!spec.pose.orientation.coeffs().allFinite() ||
+      std::abs(q_norm - 1.0) > kOrientationNormTolerance) {
+    throw InputError("pose.orientation", "must be a unit quaternion (|q| = " + std::to_string(q_norm) + ")");
+  }
+  requireFinite(spec.linear_velocity, "linear_velocity");
+  requireFinite(spec.angular_velocity, "angular_velocity");
+  if (!(std::isfinite(spec.density) && spec.density > 0.0)) {
+    throw InputError("density", "must be finite and > 0");
+  }
+  if (!(spec.material.restitution >= 0.0 && spec.material.restitution <= 1.0)) {
+    throw InputError("material.restitution", "must be in [0, 1]");
+  }
+  if (!(std::isfinite(spec.material.friction) && spec.material.friction >= 0.0)) {
+    throw InputError("material.friction", "must be finite and >= 0");
+  }
+  if (!spec.name.empty() && id_by_name_.count(spec.name) != 0) {
+    throw InputError("name", "'" + spec.name + "' is already used");
+  }
+  if (ids_.size() >= config_.max_entities || next_id_ == kInvalidEntity) {
+    throw InputError("max_entities", "the world holds " + std::to_string(config_.max_entities) +
+                                         " entities at most");
+  }
+
+  const ShapeInfo& info = shapes_[spec.shape];
+  BodyState body;
+  body.pose.position = spec.pose.position;
+  body.pose.orientation = spec.pose.orientation.normalized();
+  body.material = spec.material;
+  body.is_static = spec.is_static;
+  if (!spec.is_static) {  // static bodies never move: zero velocities and inverse masses
+    body.linear_velocity = spec.linear_velocity;
+    body.angular_velocity = spec.angular_velocity;
+    body.inv_mass = 1.0 / (spec.density * info.unit_mass.mass);
+    body.inv_inertia_body = (spec.density * info.unit_mass.inertia).inverse();
+    const Mat3 r = body.pose.orientation.toRotationMatrix();
+    body.inv_inertia_world = r * body.inv_inertia_body * r.transpose();
+  }
+  BoxMode mode = spec.box_mode;
+  if (mode == BoxMode::Auto) mode = info.elongated ? BoxMode::Dynamic : BoxMode::FixedCube;
+
+  const EntityId id = next_id_;
+  const std::size_t index = ids_.size();
+  ids_.push_back(id);
+  bodies_.push_back(body);
+  body_shapes_.push_back(spec.shape);
+  box_modes_.push_back(mode);
+  names_.push_back(spec.name);
+  index_of_.emplace(id, index);
+  if (!spec.name.empty()) id_by_name_.emplace(spec.name, id);
+  broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
+  ++next_id_;
+  invalidateLastTick();
+  return id;
+}
+
+bool World::removeEntity(EntityId id) {
+  const auto it = index_of_.find(id);
+  if (it == index_of_.end()) return false;
+  const std::size_t index = it->second;
+  const std::size_t last = ids_.size() - 1;
+  broad_phase_.remove(id);
+  if (!names_[index].empty()) id_by_name_.erase(names_[index]);
+  index_of_.erase(it);
+  if (index != last) {  // swap-remove keeps the arrays dense
+    ids_[index] = ids_[last];
+    bodies_[index] = bodies_[last];
+    body_shapes_[index] = body_shapes_[last];
+    box_modes_[index] = box_modes_[last];
+    names_[index] = std::move(names_[last]);
+    index_of_[ids_[index]] = index;
+  }
+  ids_.pop_back();
+  bodies_.pop_back();
+  body_shapes_.pop_back();
+  box_modes_.pop_back();
+  names_.pop_back();
+  invalidateLastTick();
+  return true;
+}
+
+std::optional<EntityId> World::findByName(const std::string& name) const {
+  const auto it = id_by_name_.find(name);
+  if (it == id_by_name_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::optional<std::size_t> World::indexOf(EntityId id) const {
+  const auto it = index_of_.find(id);
+  if (it == index_of_.end()) return std::nullopt;
+  return it->second;
+}
+
+void World::clear() {
+  ids_.clear();
+  bodies_.clear();
+  body_shapes_.clear();
+  box_modes_.clear();
+  names_.clear();
+  index_of_.clear();
+  id_by_name_.clear();
+  broad_phase_ = SweepAndPrune();
+  invalidateLastTick();
+}
+
+void World::setScheduler(const SchedulerOptions& options) {
+  auto scheduler = makeScheduler(options);  // may throw: change nothing before it
+  scheduler_ = std::move(scheduler);
+  config_.scheduler = options;
+}
+
+// The last tick's pair tests point at bodies and its contacts name dense
+// indices: both go stale when entities are added or removed.
+void World::invalidateLastTick() {
+  pair_count_ = 0;
+  contacts_.clear();
+}
+
+// ---------------------------------------------------------------------------------
+// The tick
+
+TickReport World::step(double dt, const Budget& budget) {
+  if (!(std::isfinite(dt) && dt >= 0.0)) throw InputError("dt", "must be finite and >= 0");
+  TickReport report;
+  report.entities = ids_.size();
+  const auto t0 = Clock::now();
+  integrate(dt, report);
+  const auto t1 = Clock::now();
+  broadPhase(report);
+  const auto t2 = Clock::now();
+  narrowPhase(budget, report);
+  const auto t3 = Clock::now();
+  response(dt, report);
+  const auto t4 = Clock::now();
+  report.integrate_s = secondsBetween(t0, t1);
+  report.broad_s = secondsBetween(t1, t2);
+  report.narrow_s = secondsBetween(t2, t3);
+  report.response_s = secondsBetween(t3, t4);
+  report.total_s = secondsBetween(t0, t4);
+  report.contacts = contacts_.size();
+  return report;
+}
+
+// Kinematic: poses follow the velocities; static bodies never move.
+void World::integrate(double dt, TickReport& /*report*/) {
+  for (BodyState& body : bodies_) {
+    if (body.is_static) continue;
+    body.pose.position += body.linear_velocity * dt;
+    const double speed = body.angular_velocity.norm();
+    if (speed > 0.0) {
+      // World-frame angular velocity: rotate by |w| dt about w, pre-multiplied.
+      const Quat turn(Eigen::AngleAxisd(speed * dt, body.angular_velocity / speed));
+      body.pose.orientation = (turn * body.pose.orientation).normalized();
+    }
+    const Mat3 r = body.pose.orientation.toRotationMatrix();
+    body.inv_inertia_world = r * body.inv_inertia_body * r.transpose();
+  }
+}
+
+Aabb World::boxOf(std::size_t index) const {
+  const BodyState& body = bodies_[index];
+  const ShapeInfo& info = shapes_[body_shapes_[index]];
+  Aabb box;
+  if (box_modes_[index] != BoxMode::Dynamic) {
+    // Fixed cube: holds the shape in any orientation, only follows the centre of mass.
+    const Vec3 half = Vec3::Constant(info.bounding_radius);
+    box.min = body.pose.position - half;
+    box.max = body.pose.position + half;
+    return box;
+  }
+  // Dynamic: the level-1 spheres (the root alone for a one-level tree) cover
+  // every surface voxel, so their rotated AABB holds the shape; few spheres,
+  // and much tighter than the root sphere for long, thin shapes.
+  const SphereTree& tree = info.tree;
+  const int level = tree.levelCount() > 1 ? 1 : 0;
+  const Mat3 r = body.pose.orientation.toRotationMatrix();
+  box.min = Vec3::Constant(std::numeric_limits<double>::infinity());
+  box.max = -box.min;
+  for (std::int32_t n = tree.levelBegin(level); n < tree.levelBegin(level + 1); ++n) {
+    const SphereNode& node = tree.node(n);
+    const Vec3 c = r * node.centre + body.pose.position;
+    box.min = box.min.cwiseMin(c - Vec3::Constant(node.radius));
+    box.max = box.max.cwiseMax(c + Vec3::Constant(node.radius));
+  }
+  return box;
+}
+
+void World::broadPhase(TickReport& report) {
+  for (std::size_t i = 0; i < ids_.size(); ++i) {
+    if (!bodies_[i].is_static) broad_phase_.setBox(ids_[i], boxOf(i));
+  }
+  broad_phase_.update();
+  report.broad_pairs = broad_phase_.pairs().size();
+}
+
+void World::narrowPhase(const Budget& budget, TickReport& report) {
+  const std::vector<BroadPair>& pairs = broad_phase_.pairs();
+  if (pair_tests_.size() < pairs.size()) {  // pool grows only
+    pair_tests_.resize(pairs.size());
+    pair_bodies_.resize(pairs.size());
+    pair_priority_.resize(pairs.size());
+  }
+  pair_count_ = 0;
+  for (const BroadPair& pair : pairs) {
+    const std::size_t ia = index_of_.find(pair.first)->second;
+    const std::size_t ib = index_of_.find(pair.second)->second;
+    if (bodies_[ia].is_static && bodies_[ib].is_static) continue;  // nothing can change
+    pair_tests_[pair_count_].reset(
+        PairBody{pair.first, &shapes_[body_shapes_[ia]].tree, &bodies_[ia].pose},
+        PairBody{pair.second, &shapes_[body_shapes_[ib]].tree, &bodies_[ib].pose});
+    pair_bodies_[pair_count_] = {static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib)};
+    ++pair_count_;
+  }
+
+  const bool gaze = perception_.hasFixation();
+  BudgetTracker tracker(budget);
+  const ScheduleStats stats =
+      scheduler_->run(pair_tests_, pair_count_, gaze ? &perception_ : nullptr, tracker);
+  report.sphere_tests = stats.sphere_tests;
+  report.interrupted = stats.interrupted;
+  report.scheduling_overhead_s = stats.overhead_seconds;
+  report.perception_used = stats.used_perception;
+
+  const bool accept = config_.unresolved_policy == UnresolvedPolicy::Accept;
+  for (std::size_t i = 0; i < pair_count_; ++i) {
+    const PairTest& test = pair_tests_[i];
+    pair_priority_[i] = 0.0;
+    switch (test.status()) {
+      case PairStatus::Colliding: ++report.colliding; break;
+      case PairStatus::Separate: ++report.separate; break;
+      case PairStatus::Unresolved: ++report.unresolved; break;
+    }
+    const bool accepted_unresolved = accept && test.status() == PairStatus::Unresolved;
+    if (accepted_unresolved) {
+      ++report.unresolved_accepted;
+      report.geometric_inaccuracy += test.gapEstimate();
+      report.geometric_bound += test.gapBound();
+    }
+    // Perceptual priority of every pair that becomes a contact; P sums the
+    // accepted unresolved ones only (the artefacts a viewer could notice).
+    if (gaze && (accepted_unresolved || test.status() == PairStatus::Colliding)) {
+      pair_priority_[i] = perception_.measure(test).priority;
+      report.perception_used = true;
+      if (accepted_unresolved) report.perceived_inaccuracy += pair_priority_[i];
+    }
+  }
+}
+
+// Contacts only for now: one per colliding or accepted pair, from its deepest
+// intersecting sphere pair (paper Fig. 4). Impulses come with the dynamics.
+void World::response(double /*dt*/, TickReport& /*report*/) {
+  contacts_.clear();
+  const bool accept = config_.unresolved_policy == UnresolvedPolicy::Accept;
+  for (std::size_t i = 0; i < pair_count_; ++i) {
+    const PairTest& test = pair_tests_[i];
+    const bool colliding = test.status() == PairStatus::Colliding;
+    if (!colliding && !(accept && test.status() == PairStatus::Unresolved)) continue;
+    contacts_.push_back(makeContact(test, pair_bodies_[i][0], pair_bodies_[i][1], pair_priority_[i]));
+  }
+}
+
+Contact makeContact(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b,
+                    double priority) {
+  const PairBody& a = test.bodyA();
+  const PairBody& b = test.bodyB();
+  // The deepest intersecting sphere pair; the roots when none was tested yet.
+  const SphereNode& sa = test.hasLastPair() ? a.tree->node(test.lastPair().a) : a.tree->root();
+  const SphereNode& sb = test.hasLastPair() ? b.tree->node(test.lastPair().b) : b.tree->root();
+  const Vec3 ca = a.pose->apply(sa.centre);
+  const Vec3 cb = b.pose->apply(sb.centre);
+  const Vec3 d = cb - ca;
+  const double dist = d.norm();
+  const double reach = sa.radius + sb.radius;
+
+  Contact c;
+  c.a = a.id;
+  c.b = b.id;
+  c.index_a = index_a;
+  c.index_b = index_b;
+  // Coincident centres have no line of centres: any fixed unit axis, never NaN.
+  c.normal = dist > 0.0 ? Vec3(d / dist) : Vec3::UnitZ();
+  c.point = reach > 0.0 ? Vec3(ca + d * (sa.radius / reach)) : Vec3(0.5 * (ca + cb));
+  c.depth = std::max(0.0, reach - dist);
+  c.gap_bound = test.gapBound();
+  c.level = std::max(0, test.deepestLevel());
+  c.resolved = test.status() == PairStatus::Colliding;
+  c.priority = priority;
+  return c;
+}
+
+}  // namespace stc
