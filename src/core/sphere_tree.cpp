@@ -1,0 +1,107 @@
+// Octree sphere-tree construction (paper 3.3.1).
+//
+// The bounding cube has 2^D voxels per side (2^D >= max(nx, ny, nz)), so cells
+// of every level align with voxels; level L cells have side 2^(D-L) voxels and
+// subdivision stops at single voxels. A cell becomes a node only if it holds a
+// SURFACE voxel (occupied, with an empty or outside face neighbour). This is
+// the paper's "remove nodes occluded on all six sides" made exact: a cell whose
+// occupied voxels are all interior is enclosed by other occupied voxels, so
+// nothing can reach it without first touching a cell that does hold surface
+// voxels, and dropping it loses no coverage of the surface.
+#include "sphere_tree_collision/sphere_tree.hpp"
+
+#include "sphere_tree_collision/enclosing_sphere.hpp"
+#include "surface_pyramid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stc {
+namespace {
+
+constexpr int kMaxLevels = 8;
+
+// h is refined to within this many voxels (plus 1% of the radius, so huge
+// spheres do not cost a huge number of samples).
+double gapTolerance(double radius_vox) { return 0.05 + 0.01 * radius_vox; }
+
+// Sphere fitted to one cell, in voxel units (grid frame).
+Sphere fitCell(const detail::SurfacePyramid& pyramid, int level, const detail::CellIndex& cell,
+               SphereFit fit, std::vector<Vec3>& corners) {
+  Vec3 lo, hi;
+  pyramid.cellBox(level, cell, lo, hi);
+  // Paper: circumscribed sphere of the cell clipped to the grid's cuboid,
+  // r = sqrt(x^2 + y^2 + z^2) / 2 (= sqrt(3) a / 2 for an unclipped cube).
+  const Sphere paper{0.5 * (lo + hi), 0.5 * (hi - lo).norm()};
+  if (fit == SphereFit::Paper) return paper;
+  corners.clear();
+  pyramid.appendSurfaceCorners(level, cell, corners);
+  const Sphere tight = minimalEnclosingSphere(corners);
+  // The surface voxels lie in the clipped cell, so the paper sphere encloses
+  // them too and the minimum can only be smaller; guard against rounding.
+  return tight.radius <= paper.radius ? tight : paper;
+}
+
+}  // namespace
+
+SphereTree SphereTree::build(const VoxelShape& shape, const Vec3& body_origin,
+                             const SphereTreeOptions& options) {
+  if (options.max_levels < 1 || options.max_levels > kMaxLevels) {
+    throw InputError("max_levels", "must be in [1, " + std::to_string(kMaxLevels) + "], got " +
+                                       std::to_string(options.max_levels));
+  }
+  if (!body_origin.allFinite()) throw InputError("body_origin", "must be finite");
+  if (shape.occupiedCount() == 0) throw InputError("occupancy", "no voxel is occupied");
+
+  const detail::SurfacePyramid pyramid(shape);
+  const int levels =
+      shape.isSphere() ? 1 : std::min(options.max_levels, pyramid.depth() + 1);
+  const double a = shape.voxelSize();
+
+  SphereTree tree;
+  tree.fit_ = options.fit;
+  std::vector<detail::CellIndex> cells;  // octree cell of each node, parallel to nodes_
+  std::vector<Vec3> corners;             // scratch for the tight fit
+
+  const auto addNode = [&](int level, const detail::CellIndex& cell, std::int32_t parent) {
+    // A sphere shape's single node is its smallest enclosing sphere whatever the
+    // fit: the circumscribed cube would be sqrt(3) times too big.
+    const SphereFit fit = shape.isSphere() ? SphereFit::Tight : options.fit;
+    const Sphere s = fitCell(pyramid, level, cell, fit, corners);
+    SphereNode node;
+    node.centre = s.centre * a - body_origin;
+    node.radius = s.radius * a;
+    node.h = a * detail::sphereGapBound(pyramid, level, cell, s.centre, s.radius,
+                                        gapTolerance(s.radius));
+    node.parent = parent;
+    node.level = level;
+    tree.nodes_.push_back(node);
+    cells.push_back(cell);
+  };
+
+  tree.level_begin_.push_back(0);
+  addNode(0, {0, 0, 0}, -1);
+  for (int level = 1; level < levels; ++level) {
+    const std::int32_t begin = tree.level_begin_.back();
+    const std::int32_t end = static_cast<std::int32_t>(tree.nodes_.size());
+    tree.level_begin_.push_back(end);
+    // Breadth first: the children of each node of the previous level are
+    // appended together, so they are contiguous and levels are contiguous.
+    for (std::int32_t parent = begin; parent < end; ++parent) {
+      const detail::CellIndex pc = cells[static_cast<std::size_t>(parent)];
+      const std::int32_t first = static_cast<std::int32_t>(tree.nodes_.size());
+      for (int o = 0; o < 8; ++o) {
+        const detail::CellIndex child = {2 * pc[0] + (o & 1), 2 * pc[1] + ((o >> 1) & 1),
+                                         2 * pc[2] + ((o >> 2) & 1)};
+        if (pyramid.has(level, child)) addNode(level, child, parent);
+      }
+      SphereNode& p = tree.nodes_[static_cast<std::size_t>(parent)];
+      p.first_child = first;
+      p.child_count = static_cast<std::int32_t>(tree.nodes_.size()) - first;
+    }
+  }
+  tree.level_begin_.push_back(static_cast<std::int32_t>(tree.nodes_.size()));
+  return tree;
+}
+
+}  // namespace stc
