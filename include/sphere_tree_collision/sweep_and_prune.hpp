@@ -21,16 +21,19 @@ struct BroadPair {
 
 class SweepAndPrune {
  public:
-  // Add/remove between ticks. Adding an existing id or removing an unknown one
-  // throws InputError("id").
+  // Add/remove between ticks; pairs() reflects them after the next update().
+  // Adding an existing id or removing an unknown one throws InputError("id");
+  // a non-finite box or min > max throws InputError("box"). Ids are arbitrary.
   void add(EntityId id, const Aabb& box);
   void remove(EntityId id);
   bool contains(EntityId id) const;
-  // Set the box an entity will have at the next update().
+  // Set the box an entity will have at the next update(). Unknown id throws
+  // InputError("id"), a bad box InputError("box").
   void setBox(EntityId id, const Aabb& box);
   // Re-sort the endpoint arrays (insertion sort) and update the pair set.
   void update();
-  // Current overlapping pairs (all three axes), in no particular order.
+  // Pairs whose boxes overlap on all three axes (touching counts, as in
+  // Aabb::overlaps) as of the last update(), in no particular order.
   const std::vector<BroadPair>& pairs() const { return pairs_; }
   std::size_t size() const;
   // Endpoint swaps done by the last update(): the measure of coherence.
