@@ -14,7 +14,9 @@
 #include "surface_pyramid.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <unordered_map>
 
 namespace stc {
 namespace {
@@ -23,7 +25,31 @@ constexpr int kMaxLevels = 8;
 
 // h is refined to within this many voxels (plus 1% of the radius, so huge
 // spheres do not cost a huge number of samples).
-double gapTolerance(double radius_vox) { return 0.05 + 0.01 * radius_vox; }
+double gapTolerance(double radius_vox) { return 0.1 + 0.01 * radius_vox; }
+
+// Small cells (side <= 4 voxels) repeat the same few surface patterns all over
+// a shape; their sphere and h depend only on the pattern and the clipped cell
+// size, so they are computed once per pattern (relative to the cell's corner).
+struct PatternKey {
+  int side;
+  std::array<int, 3> clipped;
+  std::uint64_t mask;
+  bool operator==(const PatternKey& o) const {
+    return side == o.side && clipped == o.clipped && mask == o.mask;
+  }
+};
+struct PatternHash {
+  std::size_t operator()(const PatternKey& k) const {
+    std::uint64_t h = k.mask * 0x9E3779B97F4A7C15ull;
+    for (int v : {k.side, k.clipped[0], k.clipped[1], k.clipped[2]}) h = (h ^ static_cast<std::uint64_t>(v)) * 0x100000001B3ull;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+};
+struct FittedCell {
+  Vec3 centre_from_corner;  // voxel units
+  double radius;
+  double h;
+};
 
 // Sphere fitted to one cell, in voxel units (grid frame).
 Sphere fitCell(const detail::SurfacePyramid& pyramid, int level, const detail::CellIndex& cell,
@@ -63,16 +89,44 @@ SphereTree SphereTree::build(const VoxelShape& shape, const Vec3& body_origin,
   std::vector<detail::CellIndex> cells;  // octree cell of each node, parallel to nodes_
   std::vector<Vec3> corners;             // scratch for the tight fit
 
-  const auto addNode = [&](int level, const detail::CellIndex& cell, std::int32_t parent) {
+  std::unordered_map<PatternKey, FittedCell, PatternHash> patterns;
+  const auto fitWithGap = [&](int level, const detail::CellIndex& cell) {
     // A sphere shape's single node is its smallest enclosing sphere whatever the
     // fit: the circumscribed cube would be sqrt(3) times too big.
     const SphereFit fit = shape.isSphere() ? SphereFit::Tight : options.fit;
     const Sphere s = fitCell(pyramid, level, cell, fit, corners);
+    return FittedCell{s.centre, s.radius,
+                      detail::sphereGapBound(pyramid, level, cell, s.centre, s.radius,
+                                             gapTolerance(s.radius))};
+  };
+  const auto addNode = [&](int level, const detail::CellIndex& cell, std::int32_t parent) {
+    Vec3 lo, hi;
+    pyramid.cellBox(level, cell, lo, hi);
+    FittedCell f;
+    const int side = pyramid.cellSide(level);
+    if (side <= 4) {
+      PatternKey key{side, {int(hi.x() - lo.x()), int(hi.y() - lo.y()), int(hi.z() - lo.z())}, 0};
+      for (int k = 0; k < side; ++k)
+        for (int j = 0; j < side; ++j)
+          for (int i = 0; i < side; ++i) {
+            const detail::CellIndex v = {cell[0] * side + i, cell[1] * side + j, cell[2] * side + k};
+            if (pyramid.has(pyramid.depth(), v)) key.mask |= std::uint64_t{1} << (i + side * (j + side * k));
+          }
+      auto it = patterns.find(key);
+      if (it == patterns.end()) {
+        f = fitWithGap(level, cell);
+        f.centre_from_corner = f.centre_from_corner - lo;
+        it = patterns.emplace(key, f).first;
+      }
+      f = it->second;
+      f.centre_from_corner += lo;
+    } else {
+      f = fitWithGap(level, cell);
+    }
     SphereNode node;
-    node.centre = s.centre * a - body_origin;
-    node.radius = s.radius * a;
-    node.h = a * detail::sphereGapBound(pyramid, level, cell, s.centre, s.radius,
-                                        gapTolerance(s.radius));
+    node.centre = f.centre_from_corner * a - body_origin;
+    node.radius = f.radius * a;
+    node.h = f.h * a;
     node.parent = parent;
     node.level = level;
     tree.nodes_.push_back(node);
