@@ -111,14 +111,23 @@ int PairTest::step() {
   return tests;
 }
 
+// The deepest pair is the one with the smallest spheres; among equally small
+// ones, the one that overlaps most (face-on rather than across an edge), so
+// the contact normal of a face contact is the face normal.
 void PairTest::chooseBestLastPair() {
   const SphereTree& ta = *a_.tree;
   const SphereTree& tb = *b_.tree;
-  double best = std::numeric_limits<double>::infinity();
+  double best_reach = std::numeric_limits<double>::infinity();
+  double best_overlap = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < last_pairs_.size(); ++i) {
-    const double reach = ta.node(last_pairs_[i].a).radius + tb.node(last_pairs_[i].b).radius;
-    if (reach < best) {
-      best = reach;
+    const SphereNode& na = ta.node(last_pairs_[i].a);
+    const SphereNode& nb = tb.node(last_pairs_[i].b);
+    const double reach = na.radius + nb.radius;
+    if (reach > best_reach * (1.0 + 1e-12)) continue;
+    const double overlap = reach - (b_.pose->apply(nb.centre) - a_.pose->apply(na.centre)).norm();
+    if (reach < best_reach * (1.0 - 1e-12) || overlap > best_overlap) {
+      best_reach = std::min(best_reach, reach);
+      best_overlap = overlap;
       best_last_ = i;
     }
   }
