@@ -24,6 +24,11 @@ struct Camera {
 // Throws InputError naming "width", "height", "fov_y_deg", or "camera_pose".
 void validateCamera(const Camera& camera);
 
+// Optical-frame pose of a camera at `eye` looking at `target`, image "up"
+// towards `up` (world). Throws InputError("target") when target == eye; an
+// `up` parallel to the view direction is replaced by another world axis.
+Pose opticalLookAt(const Vec3& eye, const Vec3& target, const Vec3& up = Vec3::UnitZ());
+
 // Perceived inaccuracy of one gap: g / exp(e / 100).
 inline double perceivedInaccuracy(double eccentricity_px, double gap_px);
 

@@ -50,6 +50,29 @@ void validateCamera(const Camera& camera) {
   }
 }
 
+Pose opticalLookAt(const Vec3& eye, const Vec3& target, const Vec3& up) {
+  if (!eye.allFinite() || !target.allFinite() || !up.allFinite()) {
+    throw InputError("target", "eye, target and up must be finite");
+  }
+  const Vec3 forward_raw = target - eye;
+  if (!(forward_raw.norm() > 0.0)) throw InputError("target", "must differ from the eye");
+  const Vec3 z = forward_raw.normalized();
+  Vec3 x = z.cross(up);  // optical x = right = forward x up
+  if (x.norm() < 1e-9 * std::max(1.0, up.norm())) {
+    x = z.cross(std::abs(z.z()) < 0.9 ? Vec3::UnitZ() : Vec3::UnitY());
+  }
+  x.normalize();
+  const Vec3 y = z.cross(x);  // optical y = down
+  Mat3 r;
+  r.col(0) = x;
+  r.col(1) = y;
+  r.col(2) = z;
+  Pose pose;
+  pose.position = eye;
+  pose.orientation = Quat(r).normalized();
+  return pose;
+}
+
 void Perception::setCamera(const Camera& camera) {
   validateCamera(camera);
   camera_ = camera;

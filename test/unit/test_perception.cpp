@@ -1,0 +1,243 @@
+// Perception: pinhole projection, input checks, f(e, g), and the rule for
+// pairs behind the camera or off screen.
+#include "sphere_tree_collision/perception.hpp"
+#include "sphere_tree_collision/sphere_tree.hpp"
+#include "sphere_tree_collision/voxel_shape.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+
+namespace stc {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Default camera: at the origin, optical axis +z (world), 1280x720, 60 deg.
+Perception defaultPerception() {
+  Perception p;
+  p.setCamera(Camera{});
+  return p;
+}
+
+std::string fieldOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.field();
+  }
+  return "<no throw>";
+}
+
+TEST(Perception, ProjectsThroughThePinholeWithYDown) {
+  const Perception p = defaultPerception();
+  const double focal = 360.0 / std::tan(3.14159265358979323846 / 6.0);
+  EXPECT_NEAR(p.focalPx(), focal, 1e-9);
+
+  const auto centre = p.project(Vec3(0, 0, 5));
+  ASSERT_TRUE(centre);
+  EXPECT_NEAR(centre->x(), 640.0, 1e-9);
+  EXPECT_NEAR(centre->y(), 360.0, 1e-9);
+
+  const auto right_down = p.project(Vec3(1, 0.5, 5));
+  ASSERT_TRUE(right_down);
+  EXPECT_NEAR(right_down->x(), 640.0 + focal * 1.0 / 5.0, 1e-9);
+  EXPECT_NEAR(right_down->y(), 360.0 + focal * 0.5 / 5.0, 1e-9);  // +y is down the image
+}
+
+TEST(Perception, PointsOnOrBehindTheCameraPlaneDoNotProject) {
+  const Perception p = defaultPerception();
+  EXPECT_FALSE(p.project(Vec3(0, 0, -1)));
+  EXPECT_FALSE(p.project(Vec3(3, 1, 0)));
+  EXPECT_FALSE(p.project(Vec3(0, 0, 0.5 * Perception::kNearDepth)));
+  EXPECT_TRUE(p.project(Vec3(0, 0, 2.0 * Perception::kNearDepth)));
+  EXPECT_FALSE(p.depthOf(Vec3(0, 0, -2)));
+  ASSERT_TRUE(p.depthOf(Vec3(7, -3, 2)));
+  EXPECT_NEAR(*p.depthOf(Vec3(7, -3, 2)), 2.0, 1e-12);
+}
+
+TEST(Perception, LookAtPutsTheTargetAtTheImageCentreWithUpUp) {
+  Perception p;
+  Camera camera;
+  camera.camera_to_world = opticalLookAt(Vec3(-10, 2, 3), Vec3(0, 2, 3), Vec3::UnitZ());
+  p.setCamera(camera);
+  const auto target = p.project(Vec3(0, 2, 3));
+  ASSERT_TRUE(target);
+  EXPECT_NEAR(target->x(), 640.0, 1e-9);
+  EXPECT_NEAR(target->y(), 360.0, 1e-9);
+  // Looking along +x with z up: +z world is up the image (smaller v), -y world is right.
+  EXPECT_LT(p.project(Vec3(0, 2, 4))->y(), 360.0);
+  EXPECT_GT(p.project(Vec3(0, 1, 3))->x(), 640.0);
+  EXPECT_EQ(fieldOf([] { opticalLookAt(Vec3(1, 1, 1), Vec3(1, 1, 1)); }), "target");
+  // Up parallel to the view direction still gives a proper rotation.
+  const Pose down = opticalLookAt(Vec3(0, 0, 10), Vec3(0, 0, 0), Vec3::UnitZ());
+  EXPECT_NEAR(down.orientation.norm(), 1.0, 1e-12);
+  EXPECT_TRUE((down.orientation * Vec3::UnitZ() - Vec3(0, 0, -1)).norm() < 1e-12);
+}
+
+TEST(Perception, ValidateCameraNamesTheBadField) {
+  auto with = [](auto edit) {
+    Camera c;
+    edit(c);
+    return fieldOf([&] { validateCamera(c); });
+  };
+  EXPECT_EQ(with([](Camera&) {}), "<no throw>");
+  EXPECT_EQ(with([](Camera& c) { c.width = 0; }), "width");
+  EXPECT_EQ(with([](Camera& c) { c.height = -3; }), "height");
+  EXPECT_EQ(with([](Camera& c) { c.fov_y_deg = 0.0; }), "fov_y_deg");
+  EXPECT_EQ(with([](Camera& c) { c.fov_y_deg = 180.0; }), "fov_y_deg");
+  EXPECT_EQ(with([](Camera& c) { c.fov_y_deg = kNaN; }), "fov_y_deg");
+  EXPECT_EQ(with([](Camera& c) { c.camera_to_world.position.x() = kNaN; }), "camera_pose");
+  EXPECT_EQ(with([](Camera& c) { c.camera_to_world.orientation = Quat(0, 0, 0, 0); }), "camera_pose");
+  EXPECT_EQ(with([](Camera& c) { c.camera_to_world.orientation = Quat(2, 0, 0, 0); }), "camera_pose");
+}
+
+TEST(Perception, RejectedCameraChangesNothing) {
+  Perception p = defaultPerception();
+  Camera bad;
+  bad.width = 640;
+  bad.fov_y_deg = -1.0;
+  EXPECT_THROW(p.setCamera(bad), InputError);
+  EXPECT_EQ(p.camera().width, 1280);
+  EXPECT_NEAR(p.project(Vec3(0, 0, 1))->x(), 640.0, 1e-9);
+}
+
+TEST(Perception, FixationMustBeFiniteAndOnScreen) {
+  Perception p = defaultPerception();
+  EXPECT_FALSE(p.hasFixation());
+  p.setFixation(Vec2(0, 0));
+  p.setFixation(Vec2(1280, 720));  // the image edges are on screen
+  p.setFixation(Vec2(100, 200));
+  EXPECT_EQ(fieldOf([&] { p.setFixation(Vec2(kNaN, 3)); }), "fixation");
+  EXPECT_EQ(fieldOf([&] { p.setFixation(Vec2(3, std::numeric_limits<double>::infinity())); }),
+            "fixation");
+  EXPECT_EQ(fieldOf([&] { p.setFixation(Vec2(-0.5, 10)); }), "fixation");
+  EXPECT_EQ(fieldOf([&] { p.setFixation(Vec2(10, 720.5)); }), "fixation");
+  EXPECT_EQ(fieldOf([&] { p.setFixation(Vec2(1281, 10)); }), "fixation");
+  ASSERT_TRUE(p.hasFixation());  // a rejected fixation keeps the previous one
+  EXPECT_EQ(*p.fixation(), Vec2(100, 200));
+  p.clearFixation();
+  EXPECT_FALSE(p.hasFixation());
+}
+
+TEST(Perception, SmallerImageKeepsTheFixationOnIt) {
+  Perception p = defaultPerception();
+  p.setFixation(Vec2(1200, 700));
+  Camera small;
+  small.width = 640;
+  small.height = 480;
+  p.setCamera(small);
+  ASSERT_TRUE(p.hasFixation());
+  EXPECT_EQ(*p.fixation(), Vec2(640, 480));
+}
+
+TEST(Perception, PerceivedInaccuracyIsThePapersFunction) {
+  EXPECT_DOUBLE_EQ(perceivedInaccuracy(0.0, 12.0), 12.0);
+  EXPECT_NEAR(perceivedInaccuracy(100.0, 12.0), 12.0 / std::exp(1.0), 1e-12);
+  EXPECT_NEAR(perceivedInaccuracy(320.0, 30.0), 30.0 * std::exp(-3.2), 1e-12);
+  EXPECT_DOUBLE_EQ(perceivedInaccuracy(50.0, 0.0), 0.0);
+}
+
+// Two overlapping sphere-preset bodies (one-level trees), stepped once so the
+// last intersecting spheres are the roots, centred at the body origins.
+class MeasurePair : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    PresetParams params;
+    params.resolution = 8;
+    params.voxel_size = 0.05;  // 0.4 m across
+    const VoxelShape shape = makePreset("sphere", params);
+    const Vec3 origin = computeMassProperties(shape, 1.0).centre_of_mass;
+    tree_ = SphereTree::build(shape, origin);
+    ASSERT_EQ(tree_.levelCount(), 1);
+  }
+
+  // Places the pair with centres at `centre` +- half of `offset`, steps it once.
+  void place(const Vec3& centre, const Vec3& offset) {
+    pose_a_.position = centre - 0.5 * offset;
+    pose_b_.position = centre + 0.5 * offset;
+    test_.reset(PairBody{0, &tree_, &pose_a_}, PairBody{1, &tree_, &pose_b_});
+    test_.step();
+    ASSERT_EQ(test_.status(), PairStatus::Colliding);
+  }
+
+  SphereTree tree_;
+  Pose pose_a_, pose_b_;
+  PairTest test_;
+};
+
+TEST_F(MeasurePair, EccentricityGapAndPriorityOnScreen) {
+  Perception p = defaultPerception();
+  const double depth = 10.0;
+  place(Vec3(0, 0, depth), Vec3(0.3, 0, 0));
+  const double gap_px = 0.3 * p.focalPx() / depth;
+
+  p.setFixation(Vec2(640, 360));
+  PairPerception m = p.measure(test_);
+  EXPECT_TRUE(m.visible);
+  EXPECT_NEAR(m.eccentricity_px, 0.0, 1e-9);
+  EXPECT_NEAR(m.gap_estimate_px, gap_px, 1e-9);
+  EXPECT_NEAR(m.gap_bound_px, test_.gapBound() * p.focalPx() / depth, 1e-9);
+  EXPECT_NEAR(m.priority, gap_px, 1e-9);
+
+  p.setFixation(Vec2(640, 460));  // 100 px below the centre of collision
+  m = p.measure(test_);
+  EXPECT_NEAR(m.eccentricity_px, 100.0, 1e-9);
+  EXPECT_NEAR(m.priority, gap_px / std::exp(1.0), 1e-9);
+
+  // The gap is measured on screen: along the view direction it projects to (almost) nothing.
+  place(Vec3(0, 0, depth), Vec3(0, 0, 0.3));
+  m = p.measure(test_);
+  EXPECT_LT(m.gap_estimate_px, 0.01 * gap_px);
+  EXPECT_GT(m.gap_bound_px, 0.0);
+}
+
+TEST_F(MeasurePair, BehindTheCameraIsInvisibleWithPriorityZero) {
+  Perception p = defaultPerception();
+  p.setFixation(Vec2(640, 360));
+  place(Vec3(0, 0, -5), Vec3(0.3, 0, 0));
+  const PairPerception m = p.measure(test_);
+  EXPECT_FALSE(m.visible);
+  EXPECT_TRUE(std::isinf(m.eccentricity_px));
+  EXPECT_EQ(m.priority, 0.0);
+  EXPECT_EQ(m.gap_estimate_px, 0.0);
+}
+
+TEST_F(MeasurePair, OffScreenIsInvisibleButKeepsADecayingPriority) {
+  Perception p = defaultPerception();
+  p.setFixation(Vec2(1280, 360));  // right edge of the image
+  const double depth = 10.0;
+  const double metres_per_px = depth / p.focalPx();
+
+  // Just inside and just outside the right border: continuous priority.
+  place(Vec3(639.0 * metres_per_px, 0, depth), Vec3(0.3, 0, 0));
+  const PairPerception inside = p.measure(test_);
+  place(Vec3(641.0 * metres_per_px, 0, depth), Vec3(0.3, 0, 0));
+  const PairPerception outside = p.measure(test_);
+  EXPECT_TRUE(inside.visible);
+  EXPECT_FALSE(outside.visible);
+  EXPECT_NEAR(outside.eccentricity_px, 1.0, 1e-6);
+  EXPECT_GT(outside.priority, 0.9 * inside.priority);
+
+  // 300 px past the border: e is measured to the off-screen pixel, f decays as exp(-e/100).
+  place(Vec3(940.0 * metres_per_px, 0, depth), Vec3(0.3, 0, 0));
+  const PairPerception far = p.measure(test_);
+  EXPECT_FALSE(far.visible);
+  EXPECT_NEAR(far.eccentricity_px, 300.0, 1e-6);
+  EXPECT_NEAR(far.priority, far.gap_estimate_px * std::exp(-3.0), 1e-9);
+  EXPECT_LT(far.priority, 0.06 * inside.priority);
+}
+
+TEST_F(MeasurePair, WithoutFixationPriorityIsZero) {
+  Perception p = defaultPerception();
+  place(Vec3(0, 0, 10), Vec3(0.3, 0, 0));
+  const PairPerception m = p.measure(test_);
+  EXPECT_EQ(m.priority, 0.0);
+  EXPECT_FALSE(m.visible);
+}
+
+}  // namespace
+}  // namespace stc
