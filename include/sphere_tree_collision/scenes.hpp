@@ -1,0 +1,94 @@
+// Scenes as data: functions that fill a World with the benchmark scenes, each
+// with a suggested camera, and a small gaze model (where the viewer looks at
+// time t). Core only: no ROS, no FCL.
+#pragma once
+
+#include "sphere_tree_collision/perception.hpp"
+#include "sphere_tree_collision/world.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stc {
+
+enum class SceneKind : std::uint8_t {
+  PackedBox,    // the paper's case: homogeneous entities tightly packed in a closed box,
+                // random velocities, no gravity: moving and colliding all the time
+  BouncingBox,  // a spread-out box of mixed presets bouncing under gravity
+  Rockfall,     // rocks of a few seeded shapes falling down a sloped ravine onto a run-out
+  CornerDrift,  // worst case: the packed box with gravity pointing into one corner
+};
+// "packed_box" | "bouncing_box" | "rockfall" | "corner_drift"; throws InputError("scene").
+SceneKind parseScene(const std::string& name);
+const char* toString(SceneKind kind);
+
+struct SceneParams {
+  int entities = 0;            // movable entities; 0: the scene's default (500, 100, 200, 500)
+  std::uint32_t seed = 1;      // poses, velocities and rock shapes
+  double entity_size = 0.4;    // metres: largest extent of one entity
+  int resolution = 8;          // voxels along an entity's largest extent
+  double speed = 1.0;          // m/s: scale of the random initial velocities
+};
+
+struct SceneSpec {
+  SceneKind kind = SceneKind::PackedBox;
+  Vec3 gravity = Vec3::Zero();  // what sceneGravity(kind) returns
+  Camera camera;                // sees the whole scene (1280x720, 60 deg)
+  Aabb bounds;                  // where the movable entities live
+  std::vector<EntityId> movers; // movable entities, creation order
+  std::vector<EntityId> walls;  // static plates (box walls, ravine walls and floor)
+  double dt = 1.0 / 60.0;       // suggested tick
+};
+
+// The gravity a scene is made for: construct the World with it
+// (WorldConfig::gravity); populateScene checks it.
+Vec3 sceneGravity(SceneKind kind);
+
+// Adds the scene's shapes and entities to `world`. Throws InputError naming
+// the parameter ("entities", "entity_size", "resolution", "speed") or
+// "gravity" when world.config().gravity is not sceneGravity(kind). On throw
+// the world may hold the shapes already added, never a partial scene of entities.
+SceneSpec populateScene(World& world, SceneKind kind, const SceneParams& params = SceneParams{});
+
+// ---------------------------------------------------------------------------
+// Gaze
+
+enum class GazeMode : std::uint8_t {
+  Fixed,     // one pixel
+  Saccades,  // jumps to a new seeded random pixel every period (the eye's saccades)
+  Follow,    // the projection of one entity's centre
+};
+// "fixed" | "saccades" | "follow"; throws InputError("gaze_mode").
+GazeMode parseGazeMode(const std::string& name);
+const char* toString(GazeMode mode);
+
+struct GazeParams {
+  GazeMode mode = GazeMode::Fixed;
+  std::optional<Vec2> pixel;           // fixed: the pixel (default: image centre)
+  double saccade_period_s = 0.3;       // saccades: time between jumps, > 0
+  double saccade_margin = 0.1;         // saccades: keep this fraction of the image off each edge
+  std::uint32_t seed = 1;              // saccades: the sequence of targets
+  EntityId target = kInvalidEntity;    // follow: the entity
+};
+
+// The fixation at time t on the image of world.perception().camera(), always
+// on the image (ready for Perception::setFixation). Pure in t for fixed and
+// saccades (the k-th saccade target is a hash of (seed, k), so replaying a time
+// gives the same pixel). Follow: the target's projection clamped onto the
+// image; while the target is behind the camera or gone, the last pixel it gave
+// (the image centre before any).
+class GazeModel {
+ public:
+  // Throws InputError("saccade_period_s"), ("saccade_margin") or ("pixel").
+  explicit GazeModel(const GazeParams& params);
+  Vec2 fixationAt(double t, const World& world);
+  const GazeParams& params() const { return params_; }
+
+ private:
+  GazeParams params_;
+  std::optional<Vec2> last_follow_;
+};
+
+}  // namespace stc

@@ -1,0 +1,307 @@
+// The benchmark scenes as data: which shapes, where, how fast, which walls,
+// and a camera that sees them. Walls and floors are static plate tiles.
+#include "sphere_tree_collision/scenes.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+namespace stc {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kG = 9.81;
+
+const std::array<std::pair<SceneKind, const char*>, 4> kScenes{{
+    {SceneKind::PackedBox, "packed_box"},
+    {SceneKind::BouncingBox, "bouncing_box"},
+    {SceneKind::Rockfall, "rockfall"},
+    {SceneKind::CornerDrift, "corner_drift"}}};
+
+// Seeded draws that mean the same on every standard library (the
+// std:: distributions do not promise that).
+class Draw {
+ public:
+  explicit Draw(std::uint32_t seed) : rng_(seed) {}
+  double unit() { return static_cast<double>(rng_()) / 4294967296.0; }  // [0, 1)
+  double range(double lo, double hi) { return lo + (hi - lo) * unit(); }
+  Vec3 direction() {  // uniform on the sphere
+    const double z = range(-1.0, 1.0);
+    const double phi = range(0.0, 2.0 * kPi);
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    return Vec3(r * std::cos(phi), r * std::sin(phi), z);
+  }
+  Quat rotation() {  // uniform on SO(3) (Shoemake)
+    const double u1 = unit(), u2 = range(0.0, 2.0 * kPi), u3 = range(0.0, 2.0 * kPi);
+    const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
+    return Quat(b * std::cos(u3), a * std::sin(u2), a * std::cos(u2), b * std::sin(u3)).normalized();
+  }
+
+ private:
+  std::mt19937 rng_;
+};
+
+std::string keyOf(const char* preset, int resolution, double voxel, std::uint32_t seed) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "scene_%s_r%d_v%.6g_s%u", preset, resolution, voxel, seed);
+  return buf;
+}
+
+// Collects the entities a scene adds so that a failure removes them all.
+class SceneBuilder {
+ public:
+  SceneBuilder(World& world, SceneSpec& spec) : world_(world), spec_(spec) {}
+  ~SceneBuilder() {
+    if (committed_) return;
+    for (EntityId id : spec_.movers) world_.removeEntity(id);
+    for (EntityId id : spec_.walls) world_.removeEntity(id);
+    spec_.movers.clear();
+    spec_.walls.clear();
+  }
+  void commit() { committed_ = true; }
+
+  ShapeId preset(const char* name, int resolution, double size, std::uint32_t seed) {
+    PresetParams p;
+    p.resolution = resolution;
+    p.voxel_size = size / resolution;
+    p.seed = seed;
+    const std::string key = keyOf(name, resolution, p.voxel_size, seed);
+    if (const auto found = world_.findShape(key)) return *found;
+    return world_.addShape(key, makePreset(name, p, world_.config().voxel_limits));
+  }
+
+  void mover(ShapeId shape, const Pose& pose, const Vec3& v, const Vec3& w, const Material& m) {
+    EntitySpec e;
+    e.shape = shape;
+    e.pose = pose;
+    e.linear_velocity = v;
+    e.angular_velocity = w;
+    e.material = m;
+    spec_.movers.push_back(world_.addEntity(e));
+  }
+
+  // Static plate tiles covering the rectangle centre + [-hu,hu] u + [-hv,hv] v,
+  // inner face on that plane, slab behind it (away from `inward`). u, v, inward
+  // orthonormal. Square tiles of about `tile` metres, spread to overlap evenly.
+  void wall(const Vec3& centre, const Vec3& u, const Vec3& v, double hu, double hv, double tile,
+            const Material& m) {
+    const int nu = std::max(1, static_cast<int>(std::ceil(2.0 * hu / tile - 1e-9)));
+    const int nv = std::max(1, static_cast<int>(std::ceil(2.0 * hv / tile - 1e-9)));
+    const double side = std::max(2.0 * hu / nu, 2.0 * hv / nv);
+    constexpr int kPlateResolution = 8;  // 8 x 8 x 1 voxels
+    const ShapeId plate = preset("plate", kPlateResolution, side, 0);
+    const double thickness = world_.shape(plate).voxels.extent().z();
+    Vec3 inward = u.cross(v).normalized();
+    Mat3 r;  // grid x -> u, grid y -> v, grid z -> the wall normal
+    r.col(0) = u;
+    r.col(1) = v;
+    r.col(2) = inward;
+    const Quat q(r);
+    auto at = [side](int i, int n, double half) {
+      return n == 1 ? 0.0 : -half + 0.5 * side + i * (2.0 * half - side) / (n - 1);
+    };
+    for (int i = 0; i < nu; ++i) {
+      for (int j = 0; j < nv; ++j) {
+        EntitySpec e;
+        e.shape = plate;
+        e.pose.position = centre + at(i, nu, hu) * u + at(j, nv, hv) * v - 0.5 * thickness * inward;
+        e.pose.orientation = q;
+        e.is_static = true;
+        e.material = m;
+        spec_.walls.push_back(world_.addEntity(e));
+      }
+    }
+  }
+
+  // Six walls, inner faces on the box [c - h, c + h].
+  void closedBox(const Vec3& c, const Vec3& h, double tile, const Material& m) {
+    const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
+    wall(c - h.z() * z, x, y, h.x(), h.y(), tile, m);   // floor, normal +z
+    wall(c + h.z() * z, y, x, h.y(), h.x(), tile, m);   // ceiling, normal -z
+    wall(c - h.x() * x, y, z, h.y(), h.z(), tile, m);   // normal +x
+    wall(c + h.x() * x, z, y, h.z(), h.y(), tile, m);   // normal -x
+    wall(c - h.y() * y, z, x, h.z(), h.x(), tile, m);   // normal +y
+    wall(c + h.y() * y, x, z, h.x(), h.z(), tile, m);   // normal -y
+  }
+
+ private:
+  World& world_;
+  SceneSpec& spec_;
+  bool committed_ = false;
+};
+
+// A camera at `direction` from the centre, far enough for a ball of `radius` to fit the view.
+Camera cameraOn(const Vec3& centre, double radius, const Vec3& direction) {
+  Camera c;
+  const double distance = radius / std::sin(0.5 * c.fov_y_deg * kPi / 180.0);
+  c.camera_to_world = opticalLookAt(centre + distance * direction.normalized(), centre);
+  return c;
+}
+
+int defaultCount(SceneKind kind) {
+  switch (kind) {
+    case SceneKind::PackedBox: return 500;
+    case SceneKind::BouncingBox: return 100;
+    case SceneKind::Rockfall: return 200;
+    case SceneKind::CornerDrift: return 500;
+  }
+  return 100;
+}
+
+// Lattice of `count` cells, `per_side` along x and y, filled x, then y, then z.
+Vec3 latticeCell(int index, int per_side, double spacing) {
+  const int i = index % per_side, j = (index / per_side) % per_side, k = index / (per_side * per_side);
+  return Vec3(i + 0.5, j + 0.5, k + 0.5) * spacing;
+}
+
+// PackedBox / CornerDrift / BouncingBox: entities on a cubic lattice in a closed box.
+void boxScene(SceneBuilder& b, SceneSpec& spec, const SceneParams& p, int count, Draw& draw) {
+  struct Style {
+    double spacing;      // lattice spacing / entity size
+    double speed;        // initial speed / params.speed
+    double spin;         // rad/s, max initial angular speed
+    Material material;
+  };
+  Style s{1.1, 1.0, 2.0, Material{0.9, 0.1}};                            // packed: always colliding
+  if (spec.kind == SceneKind::BouncingBox) s = Style{2.5, 2.0, 3.0, Material{0.7, 0.3}};
+  if (spec.kind == SceneKind::CornerDrift) s = Style{1.6, 0.3, 1.0, Material{0.3, 0.5}};
+
+  const int per_side = static_cast<int>(std::ceil(std::cbrt(static_cast<double>(count)) - 1e-9));
+  const double spacing = s.spacing * p.entity_size;
+  const double half = 0.5 * per_side * spacing;
+  const Vec3 centre = Vec3::Constant(half);  // box [0, 2 half]^3
+  b.closedBox(centre, Vec3::Constant(half), std::max(p.entity_size * 2.5, 2.0 * half / 4.0),
+              s.material);
+
+  // Homogeneous for the paper's scenes; a cycle of presets for the bouncing box.
+  static const char* kMixed[] = {"cube", "rock", "rod", "L", "ring", "sphere"};
+  for (int i = 0; i < count; ++i) {
+    const char* name = spec.kind == SceneKind::BouncingBox ? kMixed[i % 6] : "rock";
+    const ShapeId shape = b.preset(name, p.resolution, p.entity_size, p.seed);
+    Pose pose;
+    pose.position = latticeCell(i, per_side, spacing);
+    pose.orientation = draw.rotation();
+    const Vec3 v = draw.direction() * (p.speed * s.speed * draw.range(0.5, 1.0));
+    const Vec3 w = draw.direction() * draw.range(0.0, s.spin);
+    b.mover(shape, pose, v, w, s.material);
+  }
+  spec.bounds.min = Vec3::Zero();
+  spec.bounds.max = Vec3::Constant(2.0 * half);
+  spec.camera = cameraOn(centre, std::sqrt(3.0) * half * 0.85, Vec3(0.55, -1.0, 0.45));
+}
+
+// Rockfall: a straight ravine (floor, two side walls, a back wall) sloping down
+// along +x onto a flat run-out; rocks of four seeded shapes start stacked
+// above its upper half and fall, tumble and bounce off each other.
+void rockfall(SceneBuilder& b, SceneSpec& spec, const SceneParams& p, int count, Draw& draw) {
+  const double size = p.entity_size;
+  const double length = 30.0 * size, width = 6.0 * size, height = 10.0 * size;
+  const double slope = 25.0 * kPi / 180.0;
+  const Material rock{0.3, 0.6};
+  // Ravine frame: x downhill along the floor, y across, z up from the floor.
+  const Quat tilt(Eigen::AngleAxisd(slope, Vec3::UnitY()));
+  const Vec3 top(0.0, 0.0, length * std::sin(slope));
+  const Vec3 ex = tilt * Vec3::UnitX(), ey = tilt * Vec3::UnitY(), ez = tilt * Vec3::UnitZ();
+  const double tile = 2.5 * size;
+  const Vec3 mid = top + 0.5 * length * ex;
+  b.wall(mid, ex, ey, 0.5 * length, 0.5 * width, tile, rock);                                     // floor
+  b.wall(mid - 0.5 * width * ey + 0.5 * height * ez, ez, ex, 0.5 * height, 0.5 * length, tile, rock);  // +y facing
+  b.wall(mid + 0.5 * width * ey + 0.5 * height * ez, ex, ez, 0.5 * length, 0.5 * height, tile, rock);  // -y facing
+  b.wall(top + 0.5 * height * ez, ey, ez, 0.5 * width, 0.5 * height, tile, rock);               // back, facing +x
+  // Run-out: flat, wider than the ravine, from the ravine's foot onward.
+  const Vec3 foot = top + length * ex;
+  const double runout = 16.0 * size;
+  b.wall(foot + Vec3(0.5 * runout, 0, 0), Vec3::UnitX(), Vec3::UnitY(), 0.5 * runout, 1.5 * width,
+         tile, rock);
+
+  // Rocks: a lattice in the ravine frame over the upper half, layered upward.
+  const double spacing = 1.3 * size;
+  const int along = std::max(1, static_cast<int>(0.5 * length / spacing));
+  const int across = std::max(1, static_cast<int>((width - 0.5 * size) / spacing));
+  std::array<ShapeId, 4> shapes{};
+  for (std::uint32_t k = 0; k < shapes.size(); ++k) {
+    shapes[k] = b.preset("rock", p.resolution, size, p.seed * 4 + k);
+  }
+  for (int i = 0; i < count; ++i) {
+    const int a = i % along, c = (i / along) % across, layer = i / (along * across);
+    const Vec3 local(size + (a + 0.5) * spacing, -0.5 * (across - 1) * spacing + c * spacing,
+                     size + (layer + 0.5) * spacing);
+    Pose pose;
+    pose.position = top + local.x() * ex + local.y() * ey + local.z() * ez;
+    pose.orientation = draw.rotation();
+    const Vec3 v = p.speed * (0.5 * ex + 0.2 * draw.direction());
+    const Vec3 w = draw.direction() * draw.range(0.0, 2.0);
+    b.mover(shapes[static_cast<std::size_t>(i) % shapes.size()], pose, v, w, rock);
+  }
+  spec.bounds.min = Vec3(-size, -1.5 * width, -size);
+  spec.bounds.max = Vec3(foot.x() + runout, 1.5 * width, top.z() + height + 4.0 * size);
+  const Vec3 look = top + 0.6 * length * ex + 0.3 * height * ez;
+  spec.camera = cameraOn(look, 0.45 * length, Vec3(0.35, -1.0, 0.55));
+  spec.dt = 1.0 / 60.0;
+}
+
+}  // namespace
+
+SceneKind parseScene(const std::string& name) {
+  std::string allowed;
+  for (const auto& [kind, text] : kScenes) {
+    if (name == text) return kind;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(text);
+  }
+  throw InputError("scene", "unknown value '" + name + "' (expected one of: " + allowed + ")");
+}
+
+const char* toString(SceneKind kind) {
+  for (const auto& [k, text] : kScenes) {
+    if (k == kind) return text;
+  }
+  return "?";
+}
+
+Vec3 sceneGravity(SceneKind kind) {
+  switch (kind) {
+    case SceneKind::PackedBox: return Vec3::Zero();
+    case SceneKind::BouncingBox:
+    case SceneKind::Rockfall: return Vec3(0.0, 0.0, -kG);
+    case SceneKind::CornerDrift: return -kG * Vec3::Ones().normalized();  // into the box's (0,0,0) corner
+  }
+  return Vec3::Zero();
+}
+
+SceneSpec populateScene(World& world, SceneKind kind, const SceneParams& params) {
+  const int count = params.entities > 0 ? params.entities : defaultCount(kind);
+  if (params.entities < 0) throw InputError("entities", "must be >= 0 (0: the scene's default)");
+  if (!std::isfinite(params.entity_size) || params.entity_size <= 0.0) {
+    throw InputError("entity_size", "must be finite and > 0");
+  }
+  if (params.resolution < 2 || params.resolution > 64) {
+    throw InputError("resolution", "must be in [2, 64]");
+  }
+  if (!std::isfinite(params.speed) || params.speed < 0.0) {
+    throw InputError("speed", "must be finite and >= 0");
+  }
+  if ((world.config().gravity - sceneGravity(kind)).norm() > 1e-9) {
+    throw InputError("gravity", std::string("the world's gravity must be sceneGravity(") +
+                                    toString(kind) + ")");
+  }
+  if (world.entityCount() + static_cast<std::size_t>(count) > world.config().max_entities) {
+    throw InputError("entities", "the scene would exceed the world's max_entities");
+  }
+
+  SceneSpec spec;
+  spec.kind = kind;
+  spec.gravity = sceneGravity(kind);
+  SceneBuilder builder(world, spec);
+  Draw draw(params.seed);
+  if (kind == SceneKind::Rockfall) {
+    rockfall(builder, spec, params, count, draw);
+  } else {
+    boxScene(builder, spec, params, count, draw);
+  }
+  builder.commit();
+  return spec;
+}
+
+}  // namespace stc

@@ -1,0 +1,246 @@
+// Scenes as data and the gaze model: what each scene puts in a World, input
+// checks, determinism, and where the gaze lands over time.
+#include "sphere_tree_collision/scenes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+
+namespace stc {
+namespace {
+
+std::string fieldOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.field();
+  }
+  return "<no throw>";
+}
+
+WorldConfig configFor(SceneKind kind) {
+  WorldConfig c;
+  c.gravity = sceneGravity(kind);
+  return c;
+}
+
+constexpr SceneKind kAllScenes[] = {SceneKind::PackedBox, SceneKind::BouncingBox,
+                                    SceneKind::Rockfall, SceneKind::CornerDrift};
+
+TEST(Scenes, NamesRoundTrip) {
+  for (SceneKind kind : kAllScenes) EXPECT_EQ(parseScene(toString(kind)), kind);
+  EXPECT_EQ(fieldOf([] { parseScene("ravine"); }), "scene");
+  for (GazeMode mode : {GazeMode::Fixed, GazeMode::Saccades, GazeMode::Follow}) {
+    EXPECT_EQ(parseGazeMode(toString(mode)), mode);
+  }
+  EXPECT_EQ(fieldOf([] { parseGazeMode("stare"); }), "gaze_mode");
+}
+
+TEST(Scenes, EachSceneHasMoversInsideItsBoundsStaticWallsAndACameraOnThem) {
+  for (SceneKind kind : kAllScenes) {
+    SCOPED_TRACE(toString(kind));
+    World world(configFor(kind));
+    SceneParams params;
+    params.entities = 60;  // small: the layout logic is the same at 500
+    const SceneSpec spec = populateScene(world, kind, params);
+    EXPECT_EQ(spec.kind, kind);
+    EXPECT_EQ(spec.movers.size(), 60u);
+    EXPECT_GE(spec.walls.size(), 5u);
+    EXPECT_EQ(world.entityCount(), spec.movers.size() + spec.walls.size());
+    world.perception().setCamera(spec.camera);
+    std::size_t on_screen = 0;
+    for (EntityId id : spec.movers) {
+      const BodyState& body = world.bodies()[*world.indexOf(id)];
+      EXPECT_FALSE(body.is_static);
+      const Vec3& p = body.pose.position;
+      EXPECT_TRUE((p.array() >= spec.bounds.min.array()).all() &&
+                  (p.array() <= spec.bounds.max.array()).all());
+      const auto pixel = world.perception().project(p);
+      if (pixel && world.perception().onScreen(*pixel)) ++on_screen;
+    }
+    EXPECT_EQ(on_screen, spec.movers.size());
+    for (EntityId id : spec.walls) EXPECT_TRUE(world.bodies()[*world.indexOf(id)].is_static);
+  }
+}
+
+TEST(Scenes, PackedBoxIsTightlyPackedAndMoving) {
+  World world(configFor(SceneKind::PackedBox));
+  const SceneSpec spec = populateScene(world, SceneKind::PackedBox);
+  EXPECT_EQ(spec.movers.size(), 500u);
+  // Homogeneous: one shape for every mover.
+  const ShapeId shape = world.bodyShapes()[*world.indexOf(spec.movers.front())];
+  double min_speed = 1e9;
+  for (EntityId id : spec.movers) {
+    const std::size_t i = *world.indexOf(id);
+    EXPECT_EQ(world.bodyShapes()[i], shape);
+    min_speed = std::min(min_speed, world.bodies()[i].linear_velocity.norm());
+  }
+  EXPECT_GT(min_speed, 0.4);
+  // Tightly packed: on average every mover's box overlaps several others.
+  const TickReport report = world.step(0.0, Budget::unlimited());
+  EXPECT_GT(report.broad_pairs, 3 * spec.movers.size());
+  EXPECT_GT(report.colliding, 0u);
+}
+
+TEST(Scenes, CornerDriftGravityPointsIntoABoxCorner) {
+  World world(configFor(SceneKind::CornerDrift));
+  const SceneSpec spec = populateScene(world, SceneKind::CornerDrift);
+  const Vec3 g = spec.gravity.normalized();
+  EXPECT_NEAR(spec.gravity.norm(), 9.81, 1e-9);
+  const Vec3 to_corner = (spec.bounds.min - 0.5 * (spec.bounds.min + spec.bounds.max)).normalized();
+  EXPECT_NEAR(g.dot(to_corner), 1.0, 1e-9);
+}
+
+TEST(Scenes, RockfallUsesSeveralRockShapesAboveTheRavineFloor) {
+  World world(configFor(SceneKind::Rockfall));
+  const SceneSpec spec = populateScene(world, SceneKind::Rockfall);
+  EXPECT_EQ(spec.movers.size(), 200u);
+  EXPECT_LT(spec.gravity.z(), 0.0);
+  std::vector<ShapeId> shapes;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (EntityId id : spec.movers) {
+    const std::size_t i = *world.indexOf(id);
+    shapes.push_back(world.bodyShapes()[i]);
+    lowest = std::min(lowest, world.bodies()[i].pose.position.z());
+  }
+  std::sort(shapes.begin(), shapes.end());
+  EXPECT_EQ(std::unique(shapes.begin(), shapes.end()) - shapes.begin(), 4);
+  EXPECT_GT(lowest, 0.0);  // every rock starts above the run-out floor (z = 0)
+  // Nothing starts in contact, rock on rock or rock on wall (full depth).
+  const TickReport report = world.step(0.0, Budget::unlimited());
+  EXPECT_GT(report.broad_pairs, 0u);
+  EXPECT_EQ(report.colliding, 0u);
+}
+
+TEST(Scenes, SameSeedSamePosesOtherSeedOtherPoses) {
+  auto positions = [](std::uint32_t seed) {
+    World world(configFor(SceneKind::BouncingBox));
+    SceneParams p;
+    p.seed = seed;
+    p.entities = 20;
+    const SceneSpec spec = populateScene(world, SceneKind::BouncingBox, p);
+    std::vector<double> out;
+    for (EntityId id : spec.movers) {
+      const BodyState& b = world.bodies()[*world.indexOf(id)];
+      out.push_back(b.pose.orientation.w());
+      out.push_back(b.linear_velocity.x());
+    }
+    return out;
+  };
+  EXPECT_EQ(positions(7), positions(7));
+  EXPECT_NE(positions(7), positions(8));
+}
+
+TEST(Scenes, BadParamsNameTheFieldAndAddNoEntity) {
+  auto field = [](SceneKind kind, const WorldConfig& config, auto edit) {
+    World world(config);
+    SceneParams p;
+    edit(p);
+    const std::string f = fieldOf([&] { populateScene(world, kind, p); });
+    EXPECT_EQ(world.entityCount(), 0u) << f;
+    return f;
+  };
+  const WorldConfig packed = configFor(SceneKind::PackedBox);
+  EXPECT_EQ(field(SceneKind::PackedBox, packed, [](SceneParams& p) { p.entities = -2; }), "entities");
+  EXPECT_EQ(field(SceneKind::PackedBox, packed, [](SceneParams& p) { p.entity_size = 0.0; }),
+            "entity_size");
+  EXPECT_EQ(field(SceneKind::PackedBox, packed, [](SceneParams& p) { p.resolution = 1; }),
+            "resolution");
+  EXPECT_EQ(field(SceneKind::PackedBox, packed, [](SceneParams& p) { p.speed = std::nan(""); }),
+            "speed");
+  EXPECT_EQ(field(SceneKind::Rockfall, packed, [](SceneParams&) {}), "gravity");
+  WorldConfig small = packed;
+  small.max_entities = 100;
+  EXPECT_EQ(field(SceneKind::PackedBox, small, [](SceneParams&) {}), "entities");
+}
+
+// ---------------------------------------------------------------------------
+// Gaze
+
+class Gaze : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    Camera c;  // at the origin looking along +z, 1280x720
+    world_.perception().setCamera(c);
+    PresetParams p;
+    p.resolution = 4;
+    p.voxel_size = 0.05;
+    shape_ = world_.addShape("cube", makePreset("cube", p));
+  }
+  EntityId add(const Vec3& at) {
+    EntitySpec e;
+    e.shape = shape_;
+    e.pose.position = at;
+    return world_.addEntity(e);
+  }
+  World world_;
+  ShapeId shape_ = 0;
+};
+
+TEST_F(Gaze, FixedIsThePixelOrTheImageCentre) {
+  GazeModel centre(GazeParams{});
+  EXPECT_EQ(centre.fixationAt(3.0, world_), Vec2(640, 360));
+  GazeParams p;
+  p.pixel = Vec2(100, 50);
+  GazeModel fixed(p);
+  EXPECT_EQ(fixed.fixationAt(0.0, world_), Vec2(100, 50));
+  EXPECT_EQ(fixed.fixationAt(99.0, world_), Vec2(100, 50));
+}
+
+TEST_F(Gaze, SaccadesHoldForAPeriodThenJumpReproducibly) {
+  GazeParams p;
+  p.mode = GazeMode::Saccades;
+  p.saccade_period_s = 0.3;
+  p.seed = 5;
+  GazeModel a(p), b(p);
+  EXPECT_EQ(a.fixationAt(0.01, world_), a.fixationAt(0.29, world_));
+  int jumps = 0;
+  for (int k = 0; k < 50; ++k) {
+    const Vec2 now = a.fixationAt(0.3 * k + 0.15, world_);
+    const Vec2 next = a.fixationAt(0.3 * (k + 1) + 0.15, world_);
+    if ((now - next).norm() > 1.0) ++jumps;
+    EXPECT_EQ(now, b.fixationAt(0.3 * k + 0.15, world_));  // same seed, same path
+    EXPECT_GE(now.x(), 0.1 * 1280 - 1e-9);
+    EXPECT_LE(now.x(), 0.9 * 1280 + 1e-9);
+    EXPECT_GE(now.y(), 0.1 * 720 - 1e-9);
+    EXPECT_LE(now.y(), 0.9 * 720 + 1e-9);
+  }
+  EXPECT_GE(jumps, 48);
+  p.seed = 6;
+  GazeModel other(p);
+  EXPECT_NE(other.fixationAt(0.15, world_), a.fixationAt(0.15, world_));
+}
+
+TEST_F(Gaze, FollowTracksTheEntityAndHoldsWhenItIsBehind) {
+  const EntityId id = add(Vec3(1.0, -0.5, 5.0));
+  GazeParams p;
+  p.mode = GazeMode::Follow;
+  p.target = id;
+  GazeModel follow(p);
+  const Vec2 seen = follow.fixationAt(0.0, world_);
+  EXPECT_TRUE((seen - *world_.perception().project(Vec3(1.0, -0.5, 5.0))).norm() < 1e-9);
+  world_.bodies()[*world_.indexOf(id)].pose.position = Vec3(0, 0, -3);  // behind the camera
+  EXPECT_EQ(follow.fixationAt(0.1, world_), seen);
+  world_.bodies()[*world_.indexOf(id)].pose.position = Vec3(100, 0, 1);  // far right: clamped
+  EXPECT_EQ(follow.fixationAt(0.2, world_).x(), 1280.0);
+  world_.removeEntity(id);
+  EXPECT_EQ(follow.fixationAt(0.3, world_).x(), 1280.0);  // gone: holds the last
+}
+
+TEST_F(Gaze, BadParamsNameTheField) {
+  GazeParams p;
+  p.saccade_period_s = 0.0;
+  EXPECT_EQ(fieldOf([&] { GazeModel g(p); }), "saccade_period_s");
+  p = GazeParams{};
+  p.saccade_margin = 0.5;
+  EXPECT_EQ(fieldOf([&] { GazeModel g(p); }), "saccade_margin");
+  p = GazeParams{};
+  p.pixel = Vec2(std::nan(""), 1);
+  EXPECT_EQ(fieldOf([&] { GazeModel g(p); }), "pixel");
+}
+
+}  // namespace
+}  // namespace stc
