@@ -11,7 +11,10 @@ namespace stc {
 
 enum class SphereFit : std::uint8_t {
   Paper,  // circumscribed sphere of the octree cell (r = sqrt(3) a / 2)
-  Tight,  // smallest sphere around the surface voxels the cell covers
+  // Of the smallest sphere around the cell's surface voxels, the smallest around
+  // its occupied voxels, and the paper sphere: the one with the smallest h.
+  // Never larger (radius) nor looser (h) than Paper on the same cell.
+  Tight,
 };
 // "paper" | "tight"; throws InputError("sphere_fit") otherwise.
 SphereFit parseSphereFit(const std::string& name);
@@ -25,8 +28,10 @@ struct SphereTreeOptions {
 struct SphereNode {
   Vec3 centre = Vec3::Zero();  // body frame
   double radius = 0.0;
-  // Max distance from a point of this sphere to the shape part it covers:
-  // if spheres a and b touch, the true gap between the shapes is <= h_a + h_b.
+  // Max distance from a point of this sphere (its surface) to the shape part it
+  // covers (the occupied voxels of its octree cell); a rigorous upper bound,
+  // within 0.1 voxel + 1% of the radius of the true value. If spheres a and b
+  // touch, the true gap between the shapes is <= h_a + h_b.
   double h = 0.0;
   std::int32_t first_child = -1;  // index of the first child; children contiguous
   std::int32_t child_count = 0;

@@ -1,9 +1,12 @@
 // The gap bound h of a sphere-tree node: max over points p of the node's sphere
-// surface of f(p) = dist(p, K), K = the surface voxels the node covers.
+// surface of f(p) = dist(p, K), K = the occupied voxels of the node's octree
+// cell (the solid part of the shape the node stands for).
 //
-// Why the surface: if spheres a and b touch (or their surfaces cross), some
-// point p lies on both surfaces, and the true gap between the shapes is at most
-// dist(p, K_a) + dist(p, K_b) <= h_a + h_b.
+// Why it bounds the gap: if spheres a and b touch (or their surfaces cross),
+// some point p lies on both surfaces, and since K_a and K_b are parts of the
+// two shapes the true gap is at most dist(p, K_a) + dist(p, K_b) <= h_a + h_b.
+// Measuring to the cell's solid rather than to its surface voxels only makes h
+// smaller where the sphere dips into the body, where no gap can be.
 //
 // Why the result is a rigorous upper bound: f is 1-Lipschitz. The sphere is
 // covered by the radial images of squares on the faces of the cube [-1,1]^3.
@@ -15,7 +18,7 @@
 // sphere by patches, split the patch with the largest f(s) + rho until that
 // largest bound is within `tolerance` of the best f(s) seen. The answer, the
 // largest f(s) + rho over a cover, is >= the true max and <= true max + tol.
-#include "surface_pyramid.hpp"
+#include "voxel_pyramid.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -46,7 +49,7 @@ Vec3 samplePoint(const Vec3& centre, double radius, int face, double u, double v
 
 }  // namespace
 
-double sphereGapBound(const SurfacePyramid& pyramid, int level, const CellIndex& cell,
+double sphereGapBound(const VoxelPyramid& pyramid, int level, const CellIndex& cell,
                       const Vec3& centre, double radius, double tolerance) {
   const auto rhoOf = [&](double width) { return radius * width / std::sqrt(2.0); };
   const auto less = [](const Patch& a, const Patch& b) { return a.upper < b.upper; };
@@ -58,7 +61,7 @@ double sphereGapBound(const SurfacePyramid& pyramid, int level, const CellIndex&
     for (double u : {-0.5, 0.5})
       for (double v : {-0.5, 0.5}) {
         Patch p{face, u, v, 1.0, 0.0, 0.0, samplePoint(centre, radius, face, u, v)};
-        p.f = pyramid.distanceToSurface(p.sample, level, cell, inf);
+        p.f = pyramid.distanceToSet(p.sample, level, cell, inf);
         p.upper = p.f + rhoOf(p.width);
         best = std::max(best, p.f);
         open.push(p);
@@ -76,7 +79,7 @@ double sphereGapBound(const SurfacePyramid& pyramid, int level, const CellIndex&
         // Lipschitz seed from the parent prunes the nearest-voxel search; the
         // small slack keeps it an upper bound despite rounding.
         const double seed = top.f + (p.sample - top.sample).norm() + 1e-9 * (1.0 + radius);
-        p.f = pyramid.distanceToSurface(p.sample, level, cell, seed);
+        p.f = pyramid.distanceToSet(p.sample, level, cell, seed);
         p.upper = p.f + rhoOf(p.width);
         best = std::max(best, p.f);
         open.push(p);

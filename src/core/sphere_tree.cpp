@@ -11,7 +11,7 @@
 #include "sphere_tree_collision/sphere_tree.hpp"
 
 #include "sphere_tree_collision/enclosing_sphere.hpp"
-#include "surface_pyramid.hpp"
+#include "voxel_pyramid.hpp"
 
 #include <algorithm>
 #include <array>
@@ -27,20 +27,23 @@ constexpr int kMaxLevels = 8;
 // spheres do not cost a huge number of samples).
 double gapTolerance(double radius_vox) { return 0.1 + 0.01 * radius_vox; }
 
-// Small cells (side <= 4 voxels) repeat the same few surface patterns all over
-// a shape; their sphere and h depend only on the pattern and the clipped cell
-// size, so they are computed once per pattern (relative to the cell's corner).
+// Small cells (side <= 4 voxels) repeat the same few patterns all over a
+// shape; their sphere and h depend only on which voxels are surface and which
+// occupied, and on the clipped cell size, so they are computed once per pattern
+// (relative to the cell's corner).
 struct PatternKey {
   int side;
   std::array<int, 3> clipped;
-  std::uint64_t mask;
+  std::uint64_t surface_mask;
+  std::uint64_t occupied_mask;
   bool operator==(const PatternKey& o) const {
-    return side == o.side && clipped == o.clipped && mask == o.mask;
+    return side == o.side && clipped == o.clipped && surface_mask == o.surface_mask &&
+           occupied_mask == o.occupied_mask;
   }
 };
 struct PatternHash {
   std::size_t operator()(const PatternKey& k) const {
-    std::uint64_t h = k.mask * 0x9E3779B97F4A7C15ull;
+    std::uint64_t h = (k.surface_mask * 0x9E3779B97F4A7C15ull) ^ (k.occupied_mask + 0x632BE59BD9B4E019ull);
     for (int v : {k.side, k.clipped[0], k.clipped[1], k.clipped[2]}) h = (h ^ static_cast<std::uint64_t>(v)) * 0x100000001B3ull;
     return static_cast<std::size_t>(h ^ (h >> 29));
   }
@@ -51,21 +54,71 @@ struct FittedCell {
   double h;
 };
 
-// Sphere fitted to one cell, in voxel units (grid frame).
-Sphere fitCell(const detail::SurfacePyramid& pyramid, int level, const detail::CellIndex& cell,
-               SphereFit fit, std::vector<Vec3>& corners) {
+// Corners of the occupied voxels of the cell that can lie on its convex hull:
+// per (i, j) column only the lowest and highest occupied voxels matter (the
+// others sit on the segment between them).
+void appendOccupiedColumnCorners(const VoxelShape& shape, const Vec3& lo, const Vec3& hi,
+                                 std::vector<Vec3>& out) {
+  const int i0 = int(lo.x()), j0 = int(lo.y()), k0 = int(lo.z());
+  const int i1 = int(hi.x()), j1 = int(hi.y()), k1 = int(hi.z());
+  for (int j = j0; j < j1; ++j)
+    for (int i = i0; i < i1; ++i) {
+      int kmin = k1, kmax = k0 - 1;
+      for (int k = k0; k < k1; ++k)
+        if (shape.occupied(i, j, k)) {
+          kmin = std::min(kmin, k);
+          kmax = k;
+        }
+      if (kmax < kmin) continue;
+      for (int o = 0; o < 4; ++o) {
+        out.emplace_back(i + (o & 1), j + (o >> 1), kmin);
+        out.emplace_back(i + (o & 1), j + (o >> 1), kmax + 1);
+      }
+    }
+}
+
+// Sphere and gap bound of one cell, in voxel units (grid frame).
+//   Paper: circumscribed sphere of the cell clipped to the grid's cuboid,
+//          r = sqrt(x^2 + y^2 + z^2) / 2 (= sqrt(3) a / 2 for a whole cube).
+//   Tight: of three valid covers -- the smallest sphere around the cell's
+//          surface voxels, the smallest around its occupied voxels, and the
+//          paper sphere -- the one with the smallest h (then radius). The
+//          surface-only sphere alone is not enough: on a solid face it centres
+//          on the one-voxel shell and bulges out further than the paper sphere,
+//          so it would be a worse fit (larger gap) despite its smaller radius.
+//          All three enclose the surface voxels and none is larger than the
+//          paper sphere (they enclose subsets of the clipped cell), so tight
+//          is never looser than paper, by radius or by h.
+FittedCell fitCell(const VoxelShape& shape, const detail::VoxelPyramid& surface,
+                   const detail::VoxelPyramid& solid, int level, const detail::CellIndex& cell, SphereFit fit,
+                   std::vector<Vec3>& corners) {
   Vec3 lo, hi;
-  pyramid.cellBox(level, cell, lo, hi);
-  // Paper: circumscribed sphere of the cell clipped to the grid's cuboid,
-  // r = sqrt(x^2 + y^2 + z^2) / 2 (= sqrt(3) a / 2 for an unclipped cube).
+  surface.cellBox(level, cell, lo, hi);
+  const auto withGap = [&](const Sphere& s) {
+    return FittedCell{s.centre, s.radius,
+                      detail::sphereGapBound(solid, level, cell, s.centre, s.radius, gapTolerance(s.radius))};
+  };
   const Sphere paper{0.5 * (lo + hi), 0.5 * (hi - lo).norm()};
-  if (fit == SphereFit::Paper) return paper;
+  if (fit == SphereFit::Paper) return withGap(paper);
+
+  FittedCell best = withGap(paper);
+  const auto consider = [&](const Sphere& s) {
+    if (s.radius > paper.radius) return;  // cannot happen but for rounding
+    const FittedCell c = withGap(s);
+    if (c.h < best.h || (c.h == best.h && c.radius < best.radius)) best = c;
+  };
   corners.clear();
-  pyramid.appendSurfaceCorners(level, cell, corners);
-  const Sphere tight = minimalEnclosingSphere(corners);
-  // The surface voxels lie in the clipped cell, so the paper sphere encloses
-  // them too and the minimum can only be smaller; guard against rounding.
-  return tight.radius <= paper.radius ? tight : paper;
+  surface.appendCorners(level, cell, corners);
+  const Sphere around_surface = minimalEnclosingSphere(corners);
+  consider(around_surface);
+  corners.clear();
+  appendOccupiedColumnCorners(shape, lo, hi, corners);
+  const Sphere around_occupied = minimalEnclosingSphere(corners);
+  if ((around_occupied.centre - around_surface.centre).norm() > 1e-9 ||
+      around_occupied.radius != around_surface.radius) {
+    consider(around_occupied);
+  }
+  return best;
 }
 
 }  // namespace
@@ -79,7 +132,8 @@ SphereTree SphereTree::build(const VoxelShape& shape, const Vec3& body_origin,
   if (!body_origin.allFinite()) throw InputError("body_origin", "must be finite");
   if (shape.occupiedCount() == 0) throw InputError("occupancy", "no voxel is occupied");
 
-  const detail::SurfacePyramid pyramid(shape);
+  const detail::VoxelPyramid pyramid(shape, detail::VoxelSet::Surface);  // which cells are nodes
+  const detail::VoxelPyramid solid(shape, detail::VoxelSet::Occupied);    // what h measures to
   const int levels =
       shape.isSphere() ? 1 : std::min(options.max_levels, pyramid.depth() + 1);
   const double a = shape.voxelSize();
@@ -90,14 +144,11 @@ SphereTree SphereTree::build(const VoxelShape& shape, const Vec3& body_origin,
   std::vector<Vec3> corners;             // scratch for the tight fit
 
   std::unordered_map<PatternKey, FittedCell, PatternHash> patterns;
+  // A sphere shape's single node is its smallest enclosing sphere: the
+  // circumscribed cube would be sqrt(3) times too big.
+  const SphereFit fit = shape.isSphere() ? SphereFit::Tight : options.fit;
   const auto fitWithGap = [&](int level, const detail::CellIndex& cell) {
-    // A sphere shape's single node is its smallest enclosing sphere whatever the
-    // fit: the circumscribed cube would be sqrt(3) times too big.
-    const SphereFit fit = shape.isSphere() ? SphereFit::Tight : options.fit;
-    const Sphere s = fitCell(pyramid, level, cell, fit, corners);
-    return FittedCell{s.centre, s.radius,
-                      detail::sphereGapBound(pyramid, level, cell, s.centre, s.radius,
-                                             gapTolerance(s.radius))};
+    return fitCell(shape, pyramid, solid, level, cell, fit, corners);
   };
   const auto addNode = [&](int level, const detail::CellIndex& cell, std::int32_t parent) {
     Vec3 lo, hi;
@@ -105,12 +156,14 @@ SphereTree SphereTree::build(const VoxelShape& shape, const Vec3& body_origin,
     FittedCell f;
     const int side = pyramid.cellSide(level);
     if (side <= 4) {
-      PatternKey key{side, {int(hi.x() - lo.x()), int(hi.y() - lo.y()), int(hi.z() - lo.z())}, 0};
+      PatternKey key{side, {int(hi.x() - lo.x()), int(hi.y() - lo.y()), int(hi.z() - lo.z())}, 0, 0};
       for (int k = 0; k < side; ++k)
         for (int j = 0; j < side; ++j)
           for (int i = 0; i < side; ++i) {
             const detail::CellIndex v = {cell[0] * side + i, cell[1] * side + j, cell[2] * side + k};
-            if (pyramid.has(pyramid.depth(), v)) key.mask |= std::uint64_t{1} << (i + side * (j + side * k));
+            const std::uint64_t bit = std::uint64_t{1} << (i + side * (j + side * k));
+            if (pyramid.has(pyramid.depth(), v)) key.surface_mask |= bit;
+            if (shape.occupied(v[0], v[1], v[2])) key.occupied_mask |= bit;
           }
       auto it = patterns.find(key);
       if (it == patterns.end()) {

@@ -1,6 +1,6 @@
-// Implicit surface-voxel octree: one flag array per level, each flag the OR of
+// Implicit voxel-set octree: one flag array per level, each flag the OR of
 // its (up to) eight children, so empty regions are skipped in O(1).
-#include "surface_pyramid.hpp"
+#include "voxel_pyramid.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 namespace stc::detail {
 
-SurfacePyramid::SurfacePyramid(const VoxelShape& shape) {
+VoxelPyramid::VoxelPyramid(const VoxelShape& shape, VoxelSet set) {
   const int largest = std::max({shape.nx(), shape.ny(), shape.nz()});
   while ((1 << depth_) < largest) ++depth_;
   grid_max_ = Vec3(shape.nx(), shape.ny(), shape.nz());
@@ -19,11 +19,12 @@ SurfacePyramid::SurfacePyramid(const VoxelShape& shape) {
   finest.nx = shape.nx();
   finest.ny = shape.ny();
   finest.nz = shape.nz();
-  finest.has_surface.assign(shape.occupancy().size(), 0);
+  finest.has_voxel.assign(shape.occupancy().size(), 0);
   for (int k = 0; k < shape.nz(); ++k)
     for (int j = 0; j < shape.ny(); ++j)
       for (int i = 0; i < shape.nx(); ++i)
-        finest.has_surface[shape.index(i, j, k)] = shape.isSurfaceVoxel(i, j, k) ? 1 : 0;
+        finest.has_voxel[shape.index(i, j, k)] =
+            (set == VoxelSet::Surface ? shape.isSurfaceVoxel(i, j, k) : shape.occupied(i, j, k)) ? 1 : 0;
 
   for (int level = depth_ - 1; level >= 0; --level) {
     const Level& fine = levels_[static_cast<std::size_t>(level) + 1];
@@ -31,28 +32,28 @@ SurfacePyramid::SurfacePyramid(const VoxelShape& shape) {
     coarse.nx = (fine.nx + 1) / 2;
     coarse.ny = (fine.ny + 1) / 2;
     coarse.nz = (fine.nz + 1) / 2;
-    coarse.has_surface.assign(static_cast<std::size_t>(coarse.nx) * coarse.ny * coarse.nz, 0);
+    coarse.has_voxel.assign(static_cast<std::size_t>(coarse.nx) * coarse.ny * coarse.nz, 0);
     for (int k = 0; k < fine.nz; ++k)
       for (int j = 0; j < fine.ny; ++j)
         for (int i = 0; i < fine.nx; ++i) {
-          if (!fine.has_surface[static_cast<std::size_t>(i) + static_cast<std::size_t>(fine.nx) *
+          if (!fine.has_voxel[static_cast<std::size_t>(i) + static_cast<std::size_t>(fine.nx) *
                                                                   (j + static_cast<std::size_t>(fine.ny) * k)])
             continue;
-          coarse.has_surface[static_cast<std::size_t>(i / 2) +
+          coarse.has_voxel[static_cast<std::size_t>(i / 2) +
                              static_cast<std::size_t>(coarse.nx) *
                                  (j / 2 + static_cast<std::size_t>(coarse.ny) * (k / 2))] = 1;
         }
   }
 }
 
-bool SurfacePyramid::has(int level, const CellIndex& c) const {
+bool VoxelPyramid::has(int level, const CellIndex& c) const {
   const Level& l = levels_[static_cast<std::size_t>(level)];
   if (c[0] < 0 || c[1] < 0 || c[2] < 0 || c[0] >= l.nx || c[1] >= l.ny || c[2] >= l.nz) return false;
-  return l.has_surface[static_cast<std::size_t>(c[0]) +
+  return l.has_voxel[static_cast<std::size_t>(c[0]) +
                        static_cast<std::size_t>(l.nx) * (c[1] + static_cast<std::size_t>(l.ny) * c[2])] != 0;
 }
 
-void SurfacePyramid::cellBox(int level, const CellIndex& c, Vec3& lo, Vec3& hi) const {
+void VoxelPyramid::cellBox(int level, const CellIndex& c, Vec3& lo, Vec3& hi) const {
   const double side = cellSide(level);
   lo = Vec3(c[0], c[1], c[2]) * side;
   hi = (lo + Vec3::Constant(side)).cwiseMin(grid_max_);
@@ -65,7 +66,7 @@ double boxDistanceSquared(const Vec3& p, const Vec3& lo, const Vec3& hi) {
 }
 }  // namespace
 
-double SurfacePyramid::distanceToSurface(const Vec3& p, int level, const CellIndex& c,
+double VoxelPyramid::distanceToSet(const Vec3& p, int level, const CellIndex& c,
                                          double bound) const {
   struct Entry {
     int level;
@@ -83,7 +84,7 @@ double SurfacePyramid::distanceToSurface(const Vec3& p, int level, const CellInd
     const Entry e = stack[--top];
     if (e.d2 >= best2) continue;
     if (e.level == depth_) {
-      best2 = e.d2;  // a surface voxel: its box distance is the exact distance
+      best2 = e.d2;  // a voxel of the set: its box distance is the exact distance
       continue;
     }
     Entry kids[8];
@@ -105,7 +106,7 @@ double SurfacePyramid::distanceToSurface(const Vec3& p, int level, const CellInd
   return std::sqrt(best2);
 }
 
-void SurfacePyramid::appendSurfaceCorners(int level, const CellIndex& c, std::vector<Vec3>& out) const {
+void VoxelPyramid::appendCorners(int level, const CellIndex& c, std::vector<Vec3>& out) const {
   if (!has(level, c)) return;
   if (level == depth_) {
     for (int o = 0; o < 8; ++o)
@@ -113,7 +114,7 @@ void SurfacePyramid::appendSurfaceCorners(int level, const CellIndex& c, std::ve
     return;
   }
   for (int o = 0; o < 8; ++o)
-    appendSurfaceCorners(level + 1, {2 * c[0] + (o & 1), 2 * c[1] + ((o >> 1) & 1), 2 * c[2] + ((o >> 2) & 1)},
+    appendCorners(level + 1, {2 * c[0] + (o & 1), 2 * c[1] + ((o >> 1) & 1), 2 * c[2] + ((o >> 2) & 1)},
                          out);
 }
 
