@@ -6,10 +6,20 @@
 // touching boxes). Insertion sort swaps every inverted pair exactly once, and a
 // pair's overlap can only change when one of its min/max orders changes, so the
 // swaps alone keep the overlap set exact:
-//   a min moves left past a max  -> the pair may start overlapping: test 3 axes;
+//   a min moves left past a max  -> the pair may start overlapping (join);
 //   a max moves left past a min  -> the pair is now separated on this axis.
-// Entities are identified by dense slots internally; ids map to slots.
+// Most such swaps are between boxes far apart on the other axes, so two filters
+// that need no random memory access drop them during the sort:
+//   join:     each endpoint carries its box's ranges on the two other axes,
+//             quantised monotonically to 8 bits (conservative): no overlap
+//             there, no event;
+//   separate: each slot has a 64-bit Bloom mask of its current partners' slots:
+//             bit clear, the pair is not in the set, nothing to remove.
+// Surviving events are applied after the three sorts. Entities are dense slots
+// inside; ids map to slots.
 #include "sphere_tree_collision/sweep_and_prune.hpp"
+
+#include "flat_hash_map.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,119 +28,57 @@
 namespace stc {
 namespace {
 
-// Open-addressing hash map uint64 -> uint32 with linear probing and
-// backward-shift deletion: O(1) add/remove, no allocation until it grows.
-class FlatMap {
- public:
-  static constexpr std::uint32_t kMissing = 0xFFFFFFFFu;
-
-  std::uint32_t find(std::uint64_t key) const {
-    if (size_ == 0) return kMissing;
-    for (std::size_t i = home(key);; i = (i + 1) & mask_) {
-      if (keys_[i] == key) return values_[i];
-      if (keys_[i] == kEmpty) return kMissing;
-    }
-  }
-
-  // Inserts or overwrites.
-  void set(std::uint64_t key, std::uint32_t value) {
-    if ((size_ + 1) * 2 > keys_.size()) grow((size_ + 1) * 2);
-    std::size_t i = home(key);
-    while (keys_[i] != kEmpty && keys_[i] != key) i = (i + 1) & mask_;
-    if (keys_[i] == kEmpty) ++size_;
-    keys_[i] = key;
-    values_[i] = value;
-  }
-
-  bool erase(std::uint64_t key) {
-    if (size_ == 0) return false;
-    std::size_t i = home(key);
-    while (keys_[i] != key) {
-      if (keys_[i] == kEmpty) return false;
-      i = (i + 1) & mask_;
-    }
-    // Backward shift: pull later entries of the probe run into the hole.
-    std::size_t hole = i;
-    for (std::size_t j = (i + 1) & mask_; keys_[j] != kEmpty; j = (j + 1) & mask_) {
-      const std::size_t h = home(keys_[j]);
-      // Entry j may move to the hole if its home is not in (hole, j] cyclically.
-      const bool home_after_hole = ((j - h) & mask_) < ((j - hole) & mask_);
-      if (!home_after_hole) {
-        keys_[hole] = keys_[j];
-        values_[hole] = values_[j];
-        hole = j;
-      }
-    }
-    keys_[hole] = kEmpty;
-    --size_;
-    return true;
-  }
-
-  // Make room for n entries without growing.
-  void reserve(std::size_t n) {
-    if (n * 2 > keys_.size()) grow(n * 2);
-  }
-  std::size_t size() const { return size_; }
-
- private:
-  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
-
-  std::size_t home(std::uint64_t key) const {
-    // splitmix64 finaliser: pair keys are two packed slot indices.
-    key ^= key >> 30;
-    key *= 0xbf58476d1ce4e5b9ull;
-    key ^= key >> 27;
-    key *= 0x94d049bb133111ebull;
-    key ^= key >> 31;
-    return static_cast<std::size_t>(key) & mask_;
-  }
-
-  void grow(std::size_t min_capacity) {
-    std::size_t capacity = 16;
-    while (capacity < min_capacity) capacity *= 2;
-    std::vector<std::uint64_t> old_keys(capacity, kEmpty);
-    std::vector<std::uint32_t> old_values(capacity);
-    old_keys.swap(keys_);
-    old_values.swap(values_);
-    mask_ = capacity - 1;
-    size_ = 0;
-    for (std::size_t i = 0; i < old_keys.size(); ++i)
-      if (old_keys[i] != kEmpty) set(old_keys[i], old_values[i]);
-  }
-
-  std::vector<std::uint64_t> keys_;
-  std::vector<std::uint32_t> values_;
-  std::size_t mask_ = 0;
-  std::size_t size_ = 0;
-};
+using detail::FlatHashMap;
 
 struct Endpoint {
   double value;
-  std::uint32_t tag;  // slot << 1 | is_max
+  std::uint32_t tag;    // slot << 1 | is_max
+  std::uint32_t others;  // the box's quantised ranges on the other two axes
 };
 
 inline std::uint32_t slotOf(const Endpoint& e) { return e.tag >> 1; }
-inline bool isMax(const Endpoint& e) { return (e.tag & 1u) != 0; }
+inline std::uint32_t isMax(const Endpoint& e) { return e.tag & 1u; }
 
 // Strict order: value, then min before max at equal value.
 inline bool before(const Endpoint& a, const Endpoint& b) {
-  return a.value < b.value || (a.value == b.value && (a.tag & 1u) < (b.tag & 1u));
+  return a.value < b.value || (a.value == b.value && isMax(a) < isMax(b));
 }
 
-struct Box {
-  double min[3];
-  double max[3];
+// Two quantised ranges packed per word, byte by byte: lo1, hi1, lo2, hi2.
+// Both overlap (necessary for the exact ranges to overlap).
+inline std::uint32_t rangesMayOverlap(std::uint32_t a, std::uint32_t b) {
+  const auto byte = [](std::uint32_t w, int k) { return (w >> (8 * k)) & 0xFFu; };
+  return static_cast<std::uint32_t>(byte(a, 0) <= byte(b, 1)) &
+         static_cast<std::uint32_t>(byte(b, 0) <= byte(a, 1)) &
+         static_cast<std::uint32_t>(byte(a, 2) <= byte(b, 3)) &
+         static_cast<std::uint32_t>(byte(b, 2) <= byte(a, 3));
+}
+
+// A box's extent on one axis, stored per axis so that sorting one axis reads
+// one compact array. others: the quantised ranges on the other two axes.
+struct alignas(32) Span {
+  double min;
+  double max;
+  std::uint32_t others;
 };
 
-inline bool overlaps(const Box& a, const Box& b) {
-  return a.min[0] <= b.max[0] && b.min[0] <= a.max[0] && a.min[1] <= b.max[1] &&
-         b.min[1] <= a.max[1] && a.min[2] <= b.max[2] && b.min[2] <= a.max[2];
-}
+// Monotone map of a coordinate to 0..255: a <= b implies q(a) <= q(b), so
+// quantised ranges of overlapping intervals overlap.
+struct Quantiser {
+  double origin = 0.0;
+  double scale = 0.0;
+  std::uint32_t operator()(double v) const {
+    const double x = (v - origin) * scale;  // NaN only when scale is 0: maps to 0 like all
+    return x > 0.0 ? static_cast<std::uint32_t>(std::min(x, 255.0)) : 0u;
+  }
+};
 
 inline std::uint64_t pairKey(std::uint32_t a, std::uint32_t b) {
   if (a > b) std::swap(a, b);
   return (std::uint64_t{a} << 32) | b;
 }
+
+inline std::uint64_t bloomBit(std::uint32_t slot) { return std::uint64_t{1} << (slot & 63u); }
 
 enum class SlotState : std::uint8_t {
   kFree,     // reusable
@@ -139,46 +87,75 @@ enum class SlotState : std::uint8_t {
   kRemoved,  // removed since the last update(); endpoints and pairs still there
 };
 
-Box toBox(const Aabb& a) {
+void checkBox(const Aabb& a) {
   if (!a.min.allFinite() || !a.max.allFinite())
     throw InputError("box", "box corners must be finite");
   if (!(a.min.array() <= a.max.array()).all())
     throw InputError("box", "box min must be <= max on every axis");
-  return Box{{a.min.x(), a.min.y(), a.min.z()}, {a.max.x(), a.max.y(), a.max.z()}};
 }
 
 }  // namespace
 
 struct SweepAndPrune::Impl {
   std::vector<Endpoint> axis[3];
-  std::vector<Box> boxes;        // by slot: the box for the next update()
+  std::vector<Span> spans[3];    // by slot, per axis: the box for the next update()
   std::vector<EntityId> ids;     // by slot
   std::vector<SlotState> state;  // by slot
+  std::vector<std::uint64_t> partner_bloom;  // by slot, rebuilt each update()
   std::vector<std::uint32_t> free_slots;
   std::vector<std::uint32_t> added;    // slots to insert at the next update()
   std::vector<std::uint32_t> removed;  // slots to drop at the next update()
-  FlatMap slot_of_id;
+  FlatHashMap slot_of_id;
+  std::uint32_t last_set = ~0u;  // slot of the last setBox: callers often go in add order
 
   // Pair set: pairs (owned by SweepAndPrune) and pair_keys are parallel dense
   // arrays; pair_index maps a key to its index there.
   std::vector<std::uint64_t> pair_keys;
-  FlatMap pair_index;
+  FlatHashMap pair_index;
 
+  // Swaps that may change the pair set: moving slot << 32 | kind | passed slot;
+  // events[0, event_count) are this update's, the rest is room.
+  static constexpr std::uint64_t kSeparate = 1u << 31;
+  static constexpr std::size_t kLookAhead = 8;
+  std::vector<std::uint64_t> events;
+  std::size_t event_count = 0;
   std::vector<Endpoint> scratch;  // new endpoints of one axis, sorted before merging
 
   std::uint32_t slotOfId(EntityId id) const {
     const std::uint32_t slot = slot_of_id.find(id);
-    if (slot == FlatMap::kMissing) throw InputError("id", "unknown entity id " + std::to_string(id));
+    if (slot == FlatHashMap::kMissing) throw InputError("id", "unknown entity id " + std::to_string(id));
     return slot;
+  }
+
+  bool inUse(std::uint32_t slot) const {
+    return state[slot] == SlotState::kLive || state[slot] == SlotState::kAdded;
+  }
+
+  void setSpans(std::uint32_t slot, const Aabb& box) {
+    for (int a = 0; a < 3; ++a) {
+      spans[a][slot].min = box.min[a];
+      spans[a][slot].max = box.max[a];
+    }
+  }
+
+  bool overlaps(std::uint32_t s, std::uint32_t t) const {
+    for (int a = 0; a < 3; ++a) {
+      const Span& p = spans[a][s];
+      const Span& q = spans[a][t];
+      if (!(p.min <= q.max && q.min <= p.max)) return false;
+    }
+    return true;
   }
 
   void addPair(std::uint32_t a, std::uint32_t b, std::vector<BroadPair>& pairs) {
     const std::uint64_t key = pairKey(a, b);
-    if (pair_index.find(key) != FlatMap::kMissing) return;
+    if (pair_index.find(key) != FlatHashMap::kMissing) return;
     pair_index.set(key, static_cast<std::uint32_t>(pairs.size()));
     const EntityId ia = ids[a], ib = ids[b];
     pairs.push_back(ia < ib ? BroadPair{ia, ib} : BroadPair{ib, ia});
     pair_keys.push_back(key);
+    partner_bloom[a] |= bloomBit(b);
+    partner_bloom[b] |= bloomBit(a);
   }
 
   void removePairAt(std::size_t index, std::vector<BroadPair>& pairs) {
@@ -195,7 +172,7 @@ struct SweepAndPrune::Impl {
 
   void removePair(std::uint32_t a, std::uint32_t b, std::vector<BroadPair>& pairs) {
     const std::uint32_t index = pair_index.find(pairKey(a, b));
-    if (index != FlatMap::kMissing) removePairAt(index, pairs);
+    if (index != FlatHashMap::kMissing) removePairAt(index, pairs);
   }
 
   // Drop the endpoints and pairs of removed slots and free the slots.
@@ -223,43 +200,101 @@ struct SweepAndPrune::Impl {
     removed.clear();
   }
 
-  // Copy the current boxes into the endpoint values.
-  void refreshValues() {
-    for (int a = 0; a < 3; ++a) {
-      for (Endpoint& e : axis[a]) {
-        const Box& b = boxes[slotOf(e)];
-        e.value = isMax(e) ? b.max[a] : b.min[a];
-      }
+  // Bloom masks of the current pair set (removals leave stale bits: rebuild).
+  void rebuildBlooms() {
+    std::fill(partner_bloom.begin(), partner_bloom.end(), 0);
+    for (const std::uint64_t key : pair_keys) {
+      const auto a = static_cast<std::uint32_t>(key >> 32);
+      const auto b = static_cast<std::uint32_t>(key & 0xFFFFFFFFu);
+      partner_bloom[a] |= bloomBit(b);
+      partner_bloom[b] |= bloomBit(a);
     }
   }
 
-  // Insertion sort of one axis; each swap of a min with a max updates the pair
-  // set. Returns the number of swaps.
-  std::size_t sortAxis(int a, std::vector<BroadPair>& pairs) {
+  // Quantise every box over the bounds of all boxes into the others field of
+  // its spans (the endpoints copy it in sortAxis).
+  void quantiseRanges() {
+    const std::size_t slots = state.size();
+    Quantiser q[3];
+    for (int a = 0; a < 3; ++a) {
+      double lo = INFINITY, hi = -INFINITY;
+      for (std::size_t s = 0; s < slots; ++s) {
+        if (!inUse(static_cast<std::uint32_t>(s))) continue;
+        lo = std::min(lo, spans[a][s].min);
+        hi = std::max(hi, spans[a][s].max);
+      }
+      q[a].origin = lo <= hi ? lo : 0.0;
+      const double extent = hi - lo;
+      // Zero or overflowing extent: scale 0 maps all to 0, still conservative.
+      q[a].scale = extent > 0.0 && std::isfinite(extent) ? 255.0 / extent : 0.0;
+    }
+    for (std::size_t s = 0; s < slots; ++s) {
+      std::uint32_t range[3];
+      for (int a = 0; a < 3; ++a) range[a] = q[a](spans[a][s].min) | (q[a](spans[a][s].max) << 8);
+      for (int a = 0; a < 3; ++a) spans[a][s].others = range[(a + 1) % 3] | (range[(a + 2) % 3] << 16);
+    }
+  }
+
+  // Refresh and insertion-sort one axis, recording the min/max swaps that
+  // pass the filters as events. The inner loop is branch-free but for its exit: an
+  // event is always written, the cursor advanced only when it counts.
+  // Returns the number of swaps.
+  std::size_t sortAxis(int a) {
     Endpoint* e = axis[a].data();
     const std::size_t n = axis[a].size();
+    const std::uint64_t* bloom = partner_bloom.data();
+    const Span* span = spans[a].data();
     std::size_t swaps = 0;
-    for (std::size_t i = 1; i < n; ++i) {
+    for (std::size_t i = 0; i < n; ++i) {
+      // Copy the new box into e[i] (untouched so far: the sort has only
+      // shifted e[0, i)), fetching the span needed a few steps ahead.
+      if (i + kLookAhead < n) __builtin_prefetch(&span[slotOf(e[i + kLookAhead])]);
+      const Span& sp = span[slotOf(e[i])];
+      e[i].value = isMax(e[i]) ? sp.max : sp.min;
+      e[i].others = sp.others;
       const Endpoint moving = e[i];
-      if (!before(moving, e[i - 1])) continue;
+      if (i == 0 || !before(moving, e[i - 1])) continue;
+      // Room for one event per swap this endpoint can make.
+      if (events.size() - event_count < i) events.resize(2 * events.size() + i);
+      std::uint64_t* out = events.data() + event_count;
+      const std::uint32_t moving_max = isMax(moving);
+      const std::uint64_t head = (std::uint64_t{slotOf(moving)} << 32) | (moving_max ? kSeparate : 0);
+      // A min passing a max may start an overlap: filter on the other axes.
+      // A max passing a min ends one if there was one: filter on the Bloom mask.
+      const std::uint64_t partners = bloom[slotOf(moving)];
+      const std::uint32_t join = moving_max ^ 1u;
       std::size_t j = i;
       do {
-        const Endpoint& passed = e[j - 1];
-        if (!isMax(moving) && isMax(passed)) {
-          // moving.min now precedes passed.max: overlap possible.
-          const std::uint32_t s = slotOf(moving), t = slotOf(passed);
-          if (overlaps(boxes[s], boxes[t])) addPair(s, t, pairs);
-        } else if (isMax(moving) && !isMax(passed)) {
-          // passed.min now follows moving.max: separated on this axis.
-          removePair(slotOf(moving), slotOf(passed), pairs);
-        }
+        const Endpoint passed = e[j - 1];
+        const std::uint32_t t = slotOf(passed);
+        *out = head | t;
+        const std::uint32_t partner = static_cast<std::uint32_t>(partners >> (t & 63u)) & 1u;
+        const std::uint32_t near = rangesMayOverlap(moving.others, passed.others);
+        out += (moving_max ^ isMax(passed)) & ((join & near) | (moving_max & partner));
         e[j] = passed;
         --j;
-        ++swaps;
       } while (j > 0 && before(moving, e[j - 1]));
+      event_count = static_cast<std::size_t>(out - events.data());
+      swaps += i - j;
       e[j] = moving;
     }
     return swaps;
+  }
+
+  // Apply the events of all three axes. Order does not matter: a join adds a
+  // pair only if the boxes overlap on every axis now, and a pair with a
+  // separate event does not.
+  void applyEvents(std::vector<BroadPair>& pairs) {
+    for (std::size_t k = 0; k < event_count; ++k) {
+      const std::uint64_t ev = events[k];
+      const auto s = static_cast<std::uint32_t>(ev >> 32);
+      const auto t = static_cast<std::uint32_t>(ev & ~kSeparate & 0xFFFFFFFFu);
+      if (ev & kSeparate)
+        removePair(s, t, pairs);
+      else if (overlaps(s, t))
+        addPair(s, t, pairs);
+    }
+    event_count = 0;
   }
 
   // Merge the endpoints of newly added slots into the sorted arrays, then find
@@ -271,10 +306,11 @@ struct SweepAndPrune::Impl {
                 added.end());
     if (added.empty()) return;
     for (int a = 0; a < 3; ++a) {
+      const std::vector<Span>& span = spans[a];
       scratch.clear();
       for (std::uint32_t s : added) {
-        scratch.push_back({boxes[s].min[a], s << 1});
-        scratch.push_back({boxes[s].max[a], (s << 1) | 1u});
+        scratch.push_back({span[s].min, s << 1, span[s].others});
+        scratch.push_back({span[s].max, (s << 1) | 1u, span[s].others});
       }
       std::sort(scratch.begin(), scratch.end(), before);
       std::vector<Endpoint>& endpoints = axis[a];
@@ -291,19 +327,23 @@ struct SweepAndPrune::Impl {
 
     // Every box overlapping box s on x has its min in [s.min - width, s.max],
     // width = the largest x extent of any box (with a margin for rounding).
+    const std::vector<Span>& xspan = spans[0];
     double width = 0.0;
     for (std::size_t s = 0; s < state.size(); ++s)
-      if (state[s] == SlotState::kLive) width = std::max(width, boxes[s].max[0] - boxes[s].min[0]);
+      if (state[s] == SlotState::kLive) width = std::max(width, xspan[s].max - xspan[s].min);
     const std::vector<Endpoint>& xs = axis[0];
+    // In x order, consecutive windows overlap and stay in cache.
+    std::sort(added.begin(), added.end(),
+              [&](std::uint32_t s, std::uint32_t t) { return xspan[s].min < xspan[t].min; });
     for (std::uint32_t s : added) {
-      const Box& box = boxes[s];
-      const double from = box.min[0] - width - 1e-9 * (std::abs(box.min[0]) + width);
+      const Span& x = xspan[s];
+      const double from = x.min - width - 1e-9 * (std::abs(x.min) + width);
       auto it = std::lower_bound(xs.begin(), xs.end(), from,
                                  [](const Endpoint& e, double v) { return e.value < v; });
-      for (; it != xs.end() && it->value <= box.max[0]; ++it) {
+      for (; it != xs.end() && it->value <= x.max; ++it) {
+        if (isMax(*it) || !rangesMayOverlap(x.others, it->others)) continue;
         const std::uint32_t t = slotOf(*it);
-        if (isMax(*it) || t == s) continue;
-        if (overlaps(box, boxes[t])) addPair(s, t, pairs);
+        if (t != s && overlaps(s, t)) addPair(s, t, pairs);
       }
     }
     added.clear();
@@ -317,9 +357,9 @@ SweepAndPrune& SweepAndPrune::operator=(SweepAndPrune&&) noexcept = default;
 
 void SweepAndPrune::add(EntityId id, const Aabb& box) {
   Impl& m = *impl_;
-  if (m.slot_of_id.find(id) != FlatMap::kMissing)
+  if (m.slot_of_id.find(id) != FlatHashMap::kMissing)
     throw InputError("id", "entity id " + std::to_string(id) + " already added");
-  const Box b = toBox(box);
+  checkBox(box);
   std::uint32_t slot;
   if (!m.free_slots.empty()) {
     slot = m.free_slots.back();
@@ -327,11 +367,12 @@ void SweepAndPrune::add(EntityId id, const Aabb& box) {
   } else {
     if (m.state.size() >= (std::size_t{1} << 31)) throw InputError("id", "too many entities");
     slot = static_cast<std::uint32_t>(m.state.size());
-    m.boxes.emplace_back();
+    for (auto& span : m.spans) span.emplace_back();
     m.ids.emplace_back();
     m.state.emplace_back();
+    m.partner_bloom.emplace_back();
   }
-  m.boxes[slot] = b;
+  m.setSpans(slot, box);
   m.ids[slot] = id;
   m.state[slot] = SlotState::kAdded;
   m.slot_of_id.set(id, slot);
@@ -347,29 +388,35 @@ void SweepAndPrune::remove(EntityId id) {
 }
 
 bool SweepAndPrune::contains(EntityId id) const {
-  return impl_->slot_of_id.find(id) != FlatMap::kMissing;
+  return impl_->slot_of_id.find(id) != FlatHashMap::kMissing;
 }
 
 void SweepAndPrune::setBox(EntityId id, const Aabb& box) {
   Impl& m = *impl_;
-  const std::uint32_t slot = m.slotOfId(id);
-  m.boxes[slot] = toBox(box);
+  // Fast path without the hash lookup: the slot after the last one set.
+  std::uint32_t slot = m.last_set + 1;
+  if (slot >= m.ids.size() || m.ids[slot] != id || !m.inUse(slot)) slot = m.slotOfId(id);
+  checkBox(box);
+  m.setSpans(slot, box);
+  m.last_set = slot;
 }
 
 void SweepAndPrune::update() {
   Impl& m = *impl_;
   if (!m.removed.empty()) m.dropRemoved(pairs_);
-  m.refreshValues();
+  m.rebuildBlooms();
+  m.quantiseRanges();
   last_swaps_ = 0;
-  for (int a = 0; a < 3; ++a) last_swaps_ += m.sortAxis(a, pairs_);
+  for (int a = 0; a < 3; ++a) last_swaps_ += m.sortAxis(a);
+  m.applyEvents(pairs_);
   if (!m.added.empty()) {
     const std::size_t entities = m.slot_of_id.size();
-    // Room for a typical pair count, so steady-state ticks do not allocate.
+    // Room for a typical pair count, so steady-state ticks rarely grow them.
+    // The hash index is left to grow with the pairs: small, it stays in cache.
     if (pairs_.capacity() < 2 * entities) {
       pairs_.reserve(2 * entities);
       m.pair_keys.reserve(2 * entities);
     }
-    m.pair_index.reserve(2 * entities);
     m.insertAdded(pairs_);
   }
 }
