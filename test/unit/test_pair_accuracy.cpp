@@ -29,10 +29,11 @@ namespace {
 constexpr int kPoses = 10000;
 constexpr int kMaxSteps = 16;     // a 4+4-level pair resolves in at most 7 steps
 constexpr double kTol = 1e-9;     // metres; FCL and sphere arithmetic round-off
-// Bisection steps on a bracket of at most ~1.1 m: tangent poses to ~1e-7 m,
-// near-miss poses to ~2e-5 m (they then move on by up to 2 voxels anyway).
-constexpr int kTangentBisections = 24;
-constexpr int kNearMissBisections = 16;
+// Bisection steps on a bracket of at most ~0.3 m: tangent poses to ~1e-7 m,
+// near-miss poses to ~1e-4 m (they then move on by up to 2 voxels anyway,
+// and are classified by the measured gap).
+constexpr int kTangentBisections = 22;
+constexpr int kNearMissBisections = 12;
 
 // Extents from 0.2 m to 1 m, so pairs meet at up to 5:1 scale. Leaf cells
 // are 1 voxel (resolution 8), 2 voxels (5, 10, 12, 16) or 4 voxels (20);
@@ -173,16 +174,18 @@ class PairAccuracy : public ::testing::Test {
       if (c.kind == kRandom || c.kind == kDeep) {
         placeB(randomUniform(rng, 0.0, c.kind == kDeep ? 0.4 * far : far));
       } else {
-        double lo = -1.0;
-        for (double f : {0.0, 0.5, 0.25, 0.75}) {
+        // Scan inwards: the outermost colliding point and the scan point
+        // beyond it bracket a contact.
+        double lo = -1.0, hi = far;
+        for (double f : {0.75, 0.5, 0.25, 0.0}) {
           placeB(f * far);
           if (collideAt(a, c.pa, b, c.pb)) {
             lo = f * far;
             break;
           }
+          hi = f * far;
         }
         if (lo < 0.0) continue;  // e.g. B threads A's hole along this ray: draw again
-        double hi = far;
         const int bisections = c.kind == kTangent ? kTangentBisections : kNearMissBisections;
         for (int i = 0; i < bisections; ++i) {
           const double mid = 0.5 * (lo + hi);
