@@ -77,6 +77,7 @@ struct Case {
   bool collide = false;   // FCL
   bool nested = false;    // no surface contact, one body inside the other
   double distance = 0.0;  // FCL surface distance, 0 when colliding
+  double voxel = 0.0;     // the coarser voxel size of the pair
 };
 
 // What a PairTest interrupted after some number of steps says.
@@ -92,6 +93,7 @@ struct StepStats {
   long missed = 0;          // FCL collides, the PairTest says separate
   long false_positive = 0;  // FCL separate (not nested), accepted (colliding or unresolved)
   double gap_sum = 0.0, gap_max = 0.0;
+  double gap_voxels_sum = 0.0, gap_voxels_max = 0.0;  // in voxels of the coarser body
   long estimate_below = 0;    // false positives whose paper estimate < true gap
   long bound_violations = 0;  // accepted, true gap > gapBound() + kTol
   double worst_gap_over_bound = 0.0;
@@ -200,6 +202,7 @@ class PairAccuracy : public ::testing::Test {
         }
       }
 
+      c.voxel = std::max(a.shape.voxelSize(), b.shape.voxelSize());
       c.collide = collideAt(a, c.pa, b, c.pb);
       if (!c.collide) {
         c.distance = exactDistance(*a.mesh, c.pa, *b.mesh, c.pb);
@@ -269,6 +272,8 @@ class PairAccuracy : public ::testing::Test {
     ++st.false_positive;
     st.gap_sum += c.distance;
     st.gap_max = std::max(st.gap_max, c.distance);
+    st.gap_voxels_sum += c.distance / c.voxel;
+    st.gap_voxels_max = std::max(st.gap_voxels_max, c.distance / c.voxel);
     if (v.estimate < c.distance) ++st.estimate_below;
     if (c.distance > v.bound + kTol) ++st.bound_violations;
     st.worst_gap_over_bound = std::max(st.worst_gap_over_bound, c.distance / v.bound);
@@ -379,16 +384,18 @@ TEST_F(PairAccuracy, ReportPerDepth) {
                 "%ld nested (excluded)\n\n",
                 toString(kFits[f]), kPoses, separated, s.nested);
     std::printf("| steps | mean deepest level | unresolved | false positives | FP rate | max true gap (m) "
-                "| mean true gap (m) | max gap / bound | estimate < true gap |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|\n");
+                "| mean true gap (m) | max gap (voxels) | mean gap (voxels) | max gap / bound "
+                "| estimate < true gap |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int k = 1; k <= s.max_steps_used; ++k) {
       const StepStats& st = s.step[static_cast<std::size_t>(k)];
       const long n = kPoses - s.nested;
       const double fp = static_cast<double>(st.false_positive);
-      std::printf("| %d | %.2f | %.1f%% | %ld | %.1f%% | %.4f | %.4f | %.3f | %.1f%% |\n", k,
+      std::printf("| %d | %.2f | %.1f%% | %ld | %.1f%% | %.4f | %.4f | %.2f | %.2f | %.3f | %.1f%% |\n", k,
                   st.deepest_sum / n, 100.0 * st.unresolved / n, st.false_positive,
                   100.0 * fp / separated, st.gap_max, fp > 0 ? st.gap_sum / fp : 0.0,
-                  st.worst_gap_over_bound, fp > 0 ? 100.0 * st.estimate_below / fp : 0.0);
+                  st.gap_voxels_max, fp > 0 ? st.gap_voxels_sum / fp : 0.0, st.worst_gap_over_bound,
+                  fp > 0 ? 100.0 * st.estimate_below / fp : 0.0);
     }
     std::printf("\nfull depth: missed %ld, false positives %ld of %ld separated (%.1f%%), true gap max %.4f m "
                 "mean %.4f m, largest leaf bound h_a + h_b %.4f m, worst gap / bound %.3f, over bound %ld\n",
