@@ -1,5 +1,8 @@
 #include "sphere_tree_collision/ros/conversions.hpp"
 
+#include <climits>
+#include <map>
+
 namespace stc_ros {
 
 geometry_msgs::Point toPointMsg(const stc::Vec3& v) {
@@ -32,6 +35,63 @@ geometry_msgs::Pose toPoseMsg(const stc::Pose& pose) {
   m.position = toPointMsg(pose.position);
   m.orientation = toQuaternionMsg(pose.orientation);
   return m;
+}
+
+std::string reasonOf(const stc::InputError& error) {
+  const std::string what = error.what();
+  const std::string prefix = error.field() + ": ";
+  return what.compare(0, prefix.size(), prefix) == 0 ? what.substr(prefix.size()) : what;
+}
+
+EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg,
+                              std::uint32_t default_resolution) {
+  EntityRequest r;
+  r.spec.name = msg.name;
+  const bool has_grid = msg.dims[0] != 0 || msg.dims[1] != 0 || msg.dims[2] != 0 || !msg.occupancy.empty();
+  if (!msg.preset.empty()) {
+    if (has_grid) throw stc::InputError("preset", "give either a preset or dims + occupancy, not both");
+    r.preset = msg.preset;
+    const std::uint32_t resolution = msg.resolution == 0 ? default_resolution : msg.resolution;
+    if (resolution > 4096) throw stc::InputError("resolution", "must be <= 4096");
+    r.preset_params.resolution = static_cast<int>(resolution);
+    r.preset_params.voxel_size = msg.voxel_size;
+    r.preset_params.seed = msg.seed;
+  } else {
+    if (!has_grid) throw stc::InputError("preset", "empty: give a preset or dims + occupancy");
+    for (std::uint32_t d : msg.dims) {
+      if (d == 0 || d > static_cast<std::uint32_t>(INT_MAX)) {
+        throw stc::InputError("dims", "each of nx, ny, nz must be in [1, " + std::to_string(INT_MAX) + "]");
+      }
+    }
+    ExplicitGrid grid;
+    grid.nx = static_cast<int>(msg.dims[0]);
+    grid.ny = static_cast<int>(msg.dims[1]);
+    grid.nz = static_cast<int>(msg.dims[2]);
+    grid.voxel_size = msg.voxel_size;
+    grid.occupancy = msg.occupancy;
+    r.grid = std::move(grid);
+  }
+  r.spec.pose.position = toEigen(msg.pose.position);
+  r.spec.pose.orientation = toEigen(msg.pose.orientation);
+  r.spec.linear_velocity = toEigen(msg.twist.linear);
+  r.spec.angular_velocity = toEigen(msg.twist.angular);
+  r.spec.density = msg.density;
+  r.spec.material.restitution = msg.restitution;
+  r.spec.material.friction = msg.friction;
+  r.spec.is_static = msg.is_static;
+  const auto& c = msg.color;
+  if (c.r != 0.0f || c.g != 0.0f || c.b != 0.0f || c.a != 0.0f) r.color = Rgba{c.r, c.g, c.b, c.a};
+  return r;
+}
+
+std::string spawnFieldOf(const std::string& core_field, bool is_preset) {
+  static const std::map<std::string, std::string> kFields{
+      {"linear_velocity", "twist.linear"}, {"angular_velocity", "twist.angular"},
+      {"material.restitution", "restitution"}, {"material.friction", "friction"},
+      {"max_voxels", "dims"}};
+  if (is_preset && (core_field == "dims" || core_field == "max_voxels")) return "resolution";
+  const auto it = kFields.find(core_field);
+  return it == kFields.end() ? core_field : it->second;
 }
 
 }  // namespace stc_ros

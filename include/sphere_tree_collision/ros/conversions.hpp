@@ -1,12 +1,17 @@
 // Conversions between ROS messages and core types. ROS side only.
 #pragma once
 
+#include "sphere_tree_collision/ros/entity_request.hpp"
 #include "sphere_tree_collision/types.hpp"
+
+#include <sphere_tree_collision/SpawnEntity.h>
 
 #include <geometry_msgs/Point.h>
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Vector3.h>
+
+#include <string>
 
 namespace stc_ros {
 
@@ -19,5 +24,20 @@ geometry_msgs::Point toPointMsg(const stc::Vec3& v);
 geometry_msgs::Vector3 toVector3Msg(const stc::Vec3& v);
 geometry_msgs::Quaternion toQuaternionMsg(const stc::Quat& q);
 geometry_msgs::Pose toPoseMsg(const stc::Pose& pose);
+
+// The message of an InputError without its "field: " prefix, for re-raising
+// the error under another field name.
+std::string reasonOf(const stc::InputError& error);
+
+// A SpawnEntity message as an EntityRequest. Checks what only the message can
+// get wrong (preset and grid both or neither, dims beyond int) and throws
+// InputError named after the message field; the rest is checked by addRequest.
+// resolution 0 takes `default_resolution`; an all-zero colour means "none".
+EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg,
+                              std::uint32_t default_resolution);
+
+// addRequest names fields after the core (EntitySpec, VoxelShape); this gives
+// the SpawnEntity field a user wrote (e.g. "linear_velocity" -> "twist.linear").
+std::string spawnFieldOf(const std::string& core_field, bool is_preset);
 
 }  // namespace stc_ros

@@ -1,0 +1,50 @@
+// EntityRequest: one entity to add to the World, as a scene file or a spawn
+// message describes it (shape preset or explicit grid, body state, colour).
+// One path for both, so scenes and spawns validate and share shapes alike.
+#pragma once
+
+#include "sphere_tree_collision/world.hpp"
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stc_ros {
+
+using Rgba = std::array<float, 4>;
+
+struct ExplicitGrid {
+  int nx = 0, ny = 0, nz = 0;
+  double voxel_size = 0.0;
+  std::vector<std::uint8_t> occupancy;  // x fastest, non-zero = solid
+};
+
+struct EntityRequest {
+  std::string preset;                  // empty: `grid` gives the shape
+  stc::PresetParams preset_params;
+  std::optional<ExplicitGrid> grid;
+  stc::EntitySpec spec;                // spec.shape is filled in by addRequest
+  std::optional<Rgba> color;           // unset: a palette colour by id
+};
+
+// Shape cache key of a preset: equal keys share one shape and one tree.
+std::string presetShapeKey(const std::string& preset, const stc::PresetParams& params);
+
+// Names become tf frames: letters, digits and '_' only, at most 64 characters,
+// and not of the form "entity_<digits>" (the frames of unnamed entities).
+// Throws InputError("name").
+void validateEntityName(const std::string& name);
+
+// Frame of an entity: its name when it has one, else "entity_<id>".
+std::string entityFrame(stc::EntityId id, const std::string& name);
+
+// Builds (or reuses) the shape and adds the entity. Throws stc::InputError
+// naming the field; the entity set is unchanged on throw (a valid shape may
+// stay cached for reuse).
+stc::EntityId addRequest(stc::World& world, EntityRequest request);
+
+// Distinct colours for entities without one (golden-ratio hue steps).
+Rgba paletteColor(stc::EntityId id);
+
+}  // namespace stc_ros

@@ -1,0 +1,51 @@
+// The collision_world_node's parameters, read and validated in one place.
+// Every parameter is documented (name, default, meaning) in docs/ros_interface.md.
+#pragma once
+
+#include "sphere_tree_collision/world.hpp"
+
+#include <ros/node_handle.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stc_ros {
+
+struct CameraParams {
+  std::string frame;                                // tf frame (optical: z forward, x right, y down); "" = use pose below
+  stc::Vec3 position = stc::Vec3(0.0, -2.6, 1.55);   // world frame, used without a frame or while tf has none
+  stc::Vec3 look_at = stc::Vec3(0.0, 0.0, 0.5);
+  int width = 1280;
+  int height = 720;
+  double fov_y_deg = 60.0;
+};
+
+struct NodeParams {
+  std::string scene;                 // YAML file; "" = embedded default
+  std::string world_frame = "world";
+  double rate = 60.0;                // Hz, ticks
+  double marker_rate = 10.0;         // Hz
+  std::vector<int> marker_levels{1, 2};
+  bool show_voxels = true;
+  bool publish_tf = true;
+  int max_contact_markers = 2000;
+  double contact_marker_size = 0.04;  // m
+  double detection_budget_ms = 8.0;  // < 0: none
+  std::int64_t sphere_test_budget = -1;  // < 0: none
+  double gaze_timeout = 0.5;         // s
+  std::uint32_t default_resolution = 8;  // spawn messages with resolution 0
+  std::optional<stc::Vec3> gravity;  // overrides the scene's
+  stc::WorldConfig world;            // scheduler, policy, tree, limits, response
+  CameraParams camera;
+
+  stc::Budget budget() const;
+};
+
+// Throws stc::InputError whose field is the parameter name (e.g. "rate").
+NodeParams readNodeParams(const ros::NodeHandle& private_nh);
+
+// Private parameters the node does not know (likely typos), for a warning.
+std::vector<std::string> unknownParams(const ros::NodeHandle& private_nh);
+
+}  // namespace stc_ros

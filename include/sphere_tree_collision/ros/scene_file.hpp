@@ -1,0 +1,53 @@
+// Scene files (YAML): gravity and a list of entities, each a preset shape with
+// its pose, velocities and material. The node's default scene is one of these,
+// embedded. Schema (every key optional except preset; unknown keys rejected):
+//
+//   gravity: [0, 0, -9.81]
+//   entities:
+//     - name: rock_1             # letters, digits, '_'; becomes the tf frame
+//       preset: rock             # cube sphere rock rod plate L ring
+//       resolution: 8            # voxels along the largest extent
+//       voxel_size: 0.05         # metres
+//       seed: 1                  # rock only
+//       position: [0, 0, 1]      # of the centre of mass, world frame
+//       orientation: {rpy: [0, 0, 0]}   # or {quat: [x, y, z, w]}
+//       velocity: [0, 0, 0]
+//       angular_velocity: [0, 0, 0]
+//       density: 1000
+//       restitution: 0.3
+//       friction: 0.5
+//       color: [0.8, 0.5, 0.2, 1.0]
+//       static: false
+//       box_mode: auto           # auto | fixed | dynamic
+//       repeat: {count: [3, 1, 1], spacing: [0.5, 0, 0]}   # copies on a grid, names get _i
+#pragma once
+
+#include "sphere_tree_collision/ros/entity_request.hpp"
+
+#include <string>
+#include <vector>
+
+namespace stc_ros {
+
+struct SceneEntry {
+  std::string path;  // "entities[3]" or "entities[3].repeat[5]", for error messages
+  EntityRequest request;
+};
+
+struct Scene {
+  stc::Vec3 gravity = stc::Vec3::Zero();
+  std::vector<SceneEntry> entities;  // repeats already expanded
+};
+
+// Throws stc::InputError naming the field, e.g. "entities[2].position".
+Scene parseScene(const std::string& yaml_text);
+Scene loadSceneFile(const std::string& path);
+
+// The embedded default: a handful of presets spread out on a static floor.
+const std::string& defaultSceneYaml();
+
+// Adds every entity, returns their ids in scene order. Throws
+// InputError("entities[i].<field>") on the first bad one.
+std::vector<stc::EntityId> addScene(stc::World& world, const Scene& scene);
+
+}  // namespace stc_ros

@@ -1,0 +1,98 @@
+// WorldNode: the ROS face of one stc::World. Loads the scene, ticks the World
+// on a steady timer, turns input messages into World calls (rejecting bad ones
+// by field name, counted in tick_stats) and World state into messages. Every
+// algorithm lives in the core; this class is glue only. Single-threaded: all
+// callbacks run from one spinner, so no locking.
+#pragma once
+
+#include "sphere_tree_collision/ros/marker_builder.hpp"
+#include "sphere_tree_collision/ros/node_params.hpp"
+#include "sphere_tree_collision/world.hpp"
+
+#include <geometry_msgs/PointStamped.h>
+#include <ros/ros.h>
+#include <sphere_tree_collision/ContactArray.h>
+#include <sphere_tree_collision/Despawn.h>
+#include <sphere_tree_collision/GazePoint.h>
+#include <sphere_tree_collision/SpawnEntity.h>
+#include <sphere_tree_collision/TickStats.h>
+#include <std_msgs/Empty.h>
+#include <tf2_msgs/TFMessage.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_map>
+
+namespace stc_ros {
+
+class WorldNode {
+ public:
+  // Throws stc::InputError naming the parameter or scene field: the caller
+  // reports it and exits non-zero rather than run on a guess.
+  WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+  // One tick: camera, gaze expiry, World::step, tick_stats / contacts / tf.
+  void tick();
+  void publishMarkers();
+
+  const stc::World& world() const { return world_; }
+  std::uint64_t tickCount() const { return tick_; }
+
+ private:
+  enum class Input { Spawn, Despawn, Gaze, ClickedPoint };
+  void onSpawn(const sphere_tree_collision::SpawnEntity& msg);
+  void onDespawn(const sphere_tree_collision::Despawn& msg);
+  void onClear(const std_msgs::Empty& msg);
+  void onGaze(const sphere_tree_collision::GazePoint& msg);
+  void onClickedPoint(const geometry_msgs::PointStamped& msg);
+  void reject(Input input, const std::string& field, const std::string& reason);
+
+  // Sets the fixation from a pixel stamped `stamp` (zero: now), or throws InputError.
+  void setFixation(double x, double y, const ros::Time& stamp, const char* x_field, const char* y_field);
+  void updateCameraFromTf();
+  void expireGaze(const ros::Time& now);
+  std::optional<GazeRay> gazeRay() const;
+  void remember(stc::EntityId id, const EntityRequest& request);
+
+  void publishStats(const stc::TickReport& report, const ros::Time& stamp);
+  void publishContacts(const ros::Time& stamp);
+  void publishTf(const ros::Time& stamp);
+
+  ros::NodeHandle nh_, pnh_;
+  NodeParams params_;
+  stc::World world_;
+  stc::Budget budget_;
+  double dt_ = 0.0;
+  std::uint64_t tick_ = 0;
+
+  // Per entity, by id: what the World does not keep.
+  std::unordered_map<stc::EntityId, Rgba> colors_;
+  std::unordered_map<stc::EntityId, std::string> frames_;
+
+  // Gaze: valid until gaze_expiry_ (stamp of the last fixation + gaze_timeout).
+  ros::Time gaze_expiry_;
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;  // only with ~camera_frame
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  bool camera_from_tf_ = false;
+
+  // Rejected inputs, total and per topic.
+  std::uint64_t rejected_[4] = {0, 0, 0, 0};
+  std::string last_rejection_;
+
+  MarkerBuilder marker_builder_;
+  MarkerOptions marker_options_;
+  // Reused message buffers: no allocation per tick once warm.
+  visualization_msgs::MarkerArray markers_msg_;
+  sphere_tree_collision::ContactArray contacts_msg_;
+  tf2_msgs::TFMessage tf_msg_;
+
+  ros::Publisher markers_pub_, contacts_pub_, stats_pub_, tf_pub_;
+  ros::Subscriber spawn_sub_, despawn_sub_, clear_sub_, gaze_sub_, clicked_sub_;
+  ros::SteadyTimer tick_timer_, marker_timer_;
+};
+
+}  // namespace stc_ros

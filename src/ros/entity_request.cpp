@@ -1,0 +1,134 @@
+#include "sphere_tree_collision/ros/entity_request.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace stc_ros {
+
+std::string presetShapeKey(const std::string& preset, const stc::PresetParams& params) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "/r%d/v%.9g", params.resolution, params.voxel_size);
+  std::string key = preset + buf;
+  if (preset == "rock") key += "/s" + std::to_string(params.seed);
+  return key;
+}
+
+void validateEntityName(const std::string& name) {
+  if (name.size() > 64) throw stc::InputError("name", "longer than 64 characters");
+  for (char c : name) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+    if (!ok) throw stc::InputError("name", "'" + name + "' may hold only letters, digits and '_'");
+  }
+  const std::string reserved = "entity_";
+  if (name.size() > reserved.size() && name.compare(0, reserved.size(), reserved) == 0 &&
+      name.find_first_not_of("0123456789", reserved.size()) == std::string::npos) {
+    throw stc::InputError("name", "'" + name + "' is reserved for the frame of an unnamed entity");
+  }
+}
+
+std::string entityFrame(stc::EntityId id, const std::string& name) {
+  return name.empty() ? "entity_" + std::to_string(id) : name;
+}
+
+namespace {
+
+// Explicit grids are keyed by their content; a key clash with a different grid
+// gets a suffix, so equal grids share a shape and different ones never do.
+stc::ShapeId gridShape(stc::World& world, ExplicitGrid grid) {
+  std::uint64_t hash = 1469598103934665603ull;  // FNV-1a over the occupancy bits
+  for (std::uint8_t v : grid.occupancy) hash = (hash ^ (v != 0 ? 1u : 0u)) * 1099511628211ull;
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "grid/%dx%dx%d/v%.9g/%016llx", grid.nx, grid.ny, grid.nz,
+                grid.voxel_size, static_cast<unsigned long long>(hash));
+  stc::VoxelShape shape = stc::VoxelShape::create(grid.nx, grid.ny, grid.nz, grid.voxel_size,
+                                                  std::move(grid.occupancy),
+                                                  world.config().voxel_limits);
+  for (int suffix = 0;; ++suffix) {
+    const std::string key = suffix == 0 ? std::string(buf) : std::string(buf) + "#" + std::to_string(suffix);
+    const auto found = world.findShape(key);
+    if (!found) return world.addShape(key, std::move(shape));
+    const stc::VoxelShape& other = world.shape(*found).voxels;
+    if (other.nx() == shape.nx() && other.ny() == shape.ny() && other.nz() == shape.nz() &&
+        other.voxelSize() == shape.voxelSize() && other.occupancy() == shape.occupancy()) {
+      return *found;
+    }
+  }
+}
+
+void checkFinite(const stc::Vec3& v, const char* field) {
+  if (!v.allFinite()) throw stc::InputError(field, "not finite");
+}
+
+}  // namespace
+
+stc::EntityId addRequest(stc::World& world, EntityRequest request) {
+  if (!request.spec.name.empty()) validateEntityName(request.spec.name);
+  if (request.spec.name.empty() == false && world.findByName(request.spec.name)) {
+    throw stc::InputError("name", "'" + request.spec.name + "' is already taken");
+  }
+  // Cheap state checks before any shape work: bad input builds nothing.
+  checkFinite(request.spec.pose.position, "pose.position");
+  checkFinite(request.spec.linear_velocity, "linear_velocity");
+  checkFinite(request.spec.angular_velocity, "angular_velocity");
+  const stc::Quat& q = request.spec.pose.orientation;
+  if (!q.coeffs().allFinite()) throw stc::InputError("pose.orientation", "not finite");
+  if (std::abs(q.norm() - 1.0) > 1e-3) {
+    throw stc::InputError("pose.orientation", "quaternion norm " + std::to_string(q.norm()) +
+                                                  " is not 1 (tolerance 1e-3)");
+  }
+  request.spec.pose.orientation.normalize();
+  if (!(request.spec.density > 0.0) || !std::isfinite(request.spec.density)) {
+    throw stc::InputError("density", "must be finite and > 0");
+  }
+  const stc::Material& m = request.spec.material;
+  if (!(m.restitution >= 0.0 && m.restitution <= 1.0)) {
+    throw stc::InputError("material.restitution", "must be in [0, 1]");
+  }
+  if (!(m.friction >= 0.0) || !std::isfinite(m.friction)) {
+    throw stc::InputError("material.friction", "must be finite and >= 0");
+  }
+  if (request.color) {
+    for (float c : *request.color) {
+      if (!(c >= 0.0f && c <= 1.0f)) throw stc::InputError("color", "components must be in [0, 1]");
+    }
+  }
+  if (world.entityCount() >= world.config().max_entities) {
+    throw stc::InputError("max_entities", "the world already holds " +
+                                              std::to_string(world.entityCount()) + " entities");
+  }
+
+  if (!request.preset.empty()) {
+    if (request.grid) throw stc::InputError("preset", "give either a preset or an explicit grid, not both");
+    const std::string key = presetShapeKey(request.preset, request.preset_params);
+    const auto found = world.findShape(key);
+    request.spec.shape = found ? *found
+                               : world.addShape(key, stc::makePreset(request.preset, request.preset_params,
+                                                                     world.config().voxel_limits));
+  } else if (request.grid) {
+    request.spec.shape = gridShape(world, std::move(*request.grid));
+  } else {
+    throw stc::InputError("preset", "no preset and no explicit grid");
+  }
+  return world.addEntity(request.spec);
+}
+
+Rgba paletteColor(stc::EntityId id) {
+  // HSV with golden-ratio hue steps, saturation 0.6, value 0.9.
+  const double h = std::fmod(0.12 + 0.618033988749895 * id, 1.0) * 6.0;
+  const double s = 0.6, v = 0.9;
+  const int sector = static_cast<int>(h) % 6;
+  const double f = h - std::floor(h);
+  const double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+  double r = v, g = t, b = p;
+  switch (sector) {
+    case 0: r = v; g = t; b = p; break;
+    case 1: r = q; g = v; b = p; break;
+    case 2: r = p; g = v; b = t; break;
+    case 3: r = p; g = q; b = v; break;
+    case 4: r = t; g = p; b = v; break;
+    default: r = v; g = p; b = q; break;
+  }
+  return {static_cast<float>(r), static_cast<float>(g), static_cast<float>(b), 1.0f};
+}
+
+}  // namespace stc_ros

@@ -1,0 +1,146 @@
+#include "sphere_tree_collision/ros/node_params.hpp"
+
+#include "sphere_tree_collision/ros/conversions.hpp"
+
+#include <cmath>
+#include <set>
+
+namespace stc_ros {
+namespace {
+
+using stc::InputError;
+
+// Every private parameter the node reads; others are reported as unknown.
+const std::set<std::string>& knownParams() {
+  static const std::set<std::string> kNames{
+      "scene", "world_frame", "rate", "marker_rate", "marker_levels", "show_voxels", "publish_tf",
+      "max_contact_markers", "contact_marker_size", "detection_budget", "sphere_test_budget", "scheduler", "queue_count",
+      "unresolved_policy", "max_entities", "max_voxels", "tree_levels", "sphere_fit", "gravity",
+      "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame",
+      "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y"};
+  return kNames;
+}
+
+// Reads `name` when set; a value of the wrong type is an error, not a default.
+template <typename T>
+bool read(const ros::NodeHandle& nh, const std::string& name, T& out) {
+  if (!nh.hasParam(name)) return false;
+  if (!nh.getParam(name, out)) throw InputError(name, "has the wrong type");
+  return true;
+}
+
+double readPositive(const ros::NodeHandle& nh, const std::string& name, double value) {
+  read(nh, name, value);
+  if (!(value > 0.0) || !std::isfinite(value)) throw InputError(name, "must be finite and > 0");
+  return value;
+}
+
+int readIntIn(const ros::NodeHandle& nh, const std::string& name, int value, int lo, int hi) {
+  read(nh, name, value);
+  if (value < lo || value > hi) {
+    throw InputError(name, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  return value;
+}
+
+std::optional<stc::Vec3> readVec3(const ros::NodeHandle& nh, const std::string& name) {
+  std::vector<double> v;
+  if (!read(nh, name, v)) return std::nullopt;
+  if (v.size() != 3) throw InputError(name, "expected a list of 3 numbers");
+  const stc::Vec3 out(v[0], v[1], v[2]);
+  if (!out.allFinite()) throw InputError(name, "not finite");
+  return out;
+}
+
+// Re-raises a core parse error under the parameter's own name.
+template <typename F>
+auto parsed(const std::string& name, F&& parse) {
+  try {
+    return parse();
+  } catch (const InputError& e) {
+    throw InputError(name, reasonOf(e));
+  }
+}
+
+}  // namespace
+
+stc::Budget NodeParams::budget() const {
+  stc::Budget b;
+  if (detection_budget_ms >= 0.0) b.seconds = detection_budget_ms * 1e-3;
+  if (sphere_test_budget >= 0) b.sphere_tests = sphere_test_budget;
+  return b;
+}
+
+NodeParams readNodeParams(const ros::NodeHandle& nh) {
+  NodeParams p;
+  read(nh, "scene", p.scene);
+  read(nh, "world_frame", p.world_frame);
+  if (p.world_frame.empty()) throw InputError("world_frame", "must not be empty");
+  p.rate = readPositive(nh, "rate", p.rate);
+  if (p.rate > 10000.0) throw InputError("rate", "must be <= 10000 Hz");
+  p.marker_rate = readPositive(nh, "marker_rate", p.marker_rate);
+  if (read(nh, "marker_levels", p.marker_levels)) {
+    for (int level : p.marker_levels) {
+      if (level < 0 || level > 7) throw InputError("marker_levels", "levels must be in [0, 7]");
+    }
+  }
+  read(nh, "show_voxels", p.show_voxels);
+  read(nh, "publish_tf", p.publish_tf);
+  p.max_contact_markers = readIntIn(nh, "max_contact_markers", p.max_contact_markers, 0, 1000000);
+  p.contact_marker_size = readPositive(nh, "contact_marker_size", p.contact_marker_size);
+
+  read(nh, "detection_budget", p.detection_budget_ms);
+  if (std::isnan(p.detection_budget_ms)) throw InputError("detection_budget", "is NaN");
+  int sphere_tests = -1;
+  if (read(nh, "sphere_test_budget", sphere_tests)) p.sphere_test_budget = sphere_tests;
+  if (p.sphere_test_budget < -1) throw InputError("sphere_test_budget", "must be >= 0, or -1 for none");
+
+  std::string name = "priority_queues";
+  read(nh, "scheduler", name);
+  p.world.scheduler.kind = parsed("scheduler", [&] { return stc::parseScheduler(name); });
+  p.world.scheduler.queue_count = readIntIn(nh, "queue_count", p.world.scheduler.queue_count, 1, 64);
+  name = "accept";
+  read(nh, "unresolved_policy", name);
+  p.world.unresolved_policy = parsed("unresolved_policy", [&] { return stc::parseUnresolvedPolicy(name); });
+  name = "tight";
+  read(nh, "sphere_fit", name);
+  p.world.tree.fit = parsed("sphere_fit", [&] { return stc::parseSphereFit(name); });
+  p.world.tree.max_levels = readIntIn(nh, "tree_levels", p.world.tree.max_levels, 1, 8);
+
+  p.world.max_entities = static_cast<std::size_t>(
+      readIntIn(nh, "max_entities", static_cast<int>(p.world.max_entities), 1, 10000000));
+  int max_voxels = static_cast<int>(p.world.voxel_limits.max_voxels);
+  p.world.voxel_limits.max_voxels = readIntIn(nh, "max_voxels", max_voxels, 1, 1 << 30);
+  p.gravity = readVec3(nh, "gravity");
+  read(nh, "response", p.world.response.enabled);
+  p.world.response.iterations = readIntIn(nh, "solver_iterations", p.world.response.iterations, 1, 1000);
+
+  p.gaze_timeout = readPositive(nh, "gaze_timeout", p.gaze_timeout);
+  int resolution = static_cast<int>(p.default_resolution);
+  p.default_resolution = static_cast<std::uint32_t>(readIntIn(nh, "default_resolution", resolution, 1, 4096));
+
+  read(nh, "camera_frame", p.camera.frame);
+  if (auto v = readVec3(nh, "camera_position")) p.camera.position = *v;
+  if (auto v = readVec3(nh, "camera_look_at")) p.camera.look_at = *v;
+  p.camera.width = readIntIn(nh, "camera_width", p.camera.width, 1, 100000);
+  p.camera.height = readIntIn(nh, "camera_height", p.camera.height, 1, 100000);
+  p.camera.fov_y_deg = readPositive(nh, "camera_fov_y", p.camera.fov_y_deg);
+  if (p.camera.fov_y_deg >= 180.0) throw InputError("camera_fov_y", "must be < 180 degrees");
+  parsed("camera_look_at", [&] { return stc::opticalLookAt(p.camera.position, p.camera.look_at); });
+  return p;
+}
+
+std::vector<std::string> unknownParams(const ros::NodeHandle& nh) {
+  std::vector<std::string> all, unknown;
+  nh.getParamNames(all);
+  const std::string prefix = nh.getNamespace() + "/";
+  for (const std::string& full : all) {
+    if (full.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string rest = full.substr(prefix.size());
+    const std::string top = rest.substr(0, rest.find('/'));
+    if (knownParams().count(top) == 0) unknown.push_back(top);
+  }
+  return unknown;
+}
+
+}  // namespace stc_ros

@@ -1,0 +1,251 @@
+#include "sphere_tree_collision/ros/scene_file.hpp"
+
+#include "sphere_tree_collision/ros/conversions.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace stc_ros {
+namespace {
+
+using stc::InputError;
+
+void checkKeys(const YAML::Node& node, const std::string& path, const std::set<std::string>& allowed) {
+  for (const auto& kv : node) {
+    const std::string key = kv.first.as<std::string>();
+    if (allowed.count(key) == 0) throw InputError(path + key, "unknown key");
+  }
+}
+
+double readDouble(const YAML::Node& node, const std::string& field) {
+  if (!node.IsScalar()) throw InputError(field, "expected a number");
+  try {
+    return node.as<double>();
+  } catch (const YAML::Exception&) {
+    throw InputError(field, "expected a number, got '" + node.Scalar() + "'");
+  }
+}
+
+std::int64_t readInt(const YAML::Node& node, const std::string& field, std::int64_t lo, std::int64_t hi) {
+  if (!node.IsScalar()) throw InputError(field, "expected an integer");
+  std::int64_t v = 0;
+  try {
+    v = node.as<std::int64_t>();
+  } catch (const YAML::Exception&) {
+    throw InputError(field, "expected an integer, got '" + node.Scalar() + "'");
+  }
+  if (v < lo || v > hi) {
+    throw InputError(field, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  return v;
+}
+
+bool readBool(const YAML::Node& node, const std::string& field) {
+  try {
+    return node.as<bool>();
+  } catch (const YAML::Exception&) {
+    throw InputError(field, "expected true or false");
+  }
+}
+
+std::string readString(const YAML::Node& node, const std::string& field) {
+  if (!node.IsScalar()) throw InputError(field, "expected a string");
+  return node.Scalar();
+}
+
+std::vector<double> readNumbers(const YAML::Node& node, const std::string& field, std::size_t n) {
+  if (!node.IsSequence() || node.size() != n) {
+    throw InputError(field, "expected a list of " + std::to_string(n) + " numbers");
+  }
+  std::vector<double> out;
+  for (std::size_t i = 0; i < n; ++i) out.push_back(readDouble(node[i], field));
+  return out;
+}
+
+stc::Vec3 readVec3(const YAML::Node& node, const std::string& field) {
+  const auto v = readNumbers(node, field, 3);
+  return {v[0], v[1], v[2]};
+}
+
+stc::Quat fromRpy(double roll, double pitch, double yaw) {
+  return stc::Quat(Eigen::AngleAxisd(yaw, stc::Vec3::UnitZ()) *
+                   Eigen::AngleAxisd(pitch, stc::Vec3::UnitY()) *
+                   Eigen::AngleAxisd(roll, stc::Vec3::UnitX()));
+}
+
+// {rpy: [r, p, y]} (radians, fixed axes X then Y then Z) or {quat: [x, y, z, w]}.
+stc::Quat readOrientation(const YAML::Node& node, const std::string& field) {
+  if (!node.IsMap() || node.size() != 1) {
+    throw InputError(field, "expected {rpy: [roll, pitch, yaw]} or {quat: [x, y, z, w]}");
+  }
+  if (node["rpy"]) {
+    const auto v = readNumbers(node["rpy"], field + ".rpy", 3);
+    return fromRpy(v[0], v[1], v[2]);
+  }
+  if (node["quat"]) {
+    const auto v = readNumbers(node["quat"], field + ".quat", 4);
+    return stc::Quat(v[3], v[0], v[1], v[2]);  // validated (unit norm) by addRequest
+  }
+  throw InputError(field, "expected {rpy: [roll, pitch, yaw]} or {quat: [x, y, z, w]}");
+}
+
+Rgba readColor(const YAML::Node& node, const std::string& field) {
+  if (!node.IsSequence() || (node.size() != 3 && node.size() != 4)) {
+    throw InputError(field, "expected [r, g, b] or [r, g, b, a] in [0, 1]");
+  }
+  Rgba c{1.0f, 1.0f, 1.0f, 1.0f};
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const double v = readDouble(node[i], field);
+    if (!(v >= 0.0 && v <= 1.0)) throw InputError(field, "components must be in [0, 1]");
+    c[i] = static_cast<float>(v);
+  }
+  return c;
+}
+
+void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) {
+  if (!node.IsMap()) throw InputError(path, "expected a map");
+  const std::string p = path + ".";
+  checkKeys(node, p,
+            {"name", "preset", "resolution", "voxel_size", "seed", "position", "orientation", "velocity",
+             "angular_velocity", "density", "restitution", "friction", "color", "static", "box_mode",
+             "repeat"});
+  EntityRequest r;
+  if (!node["preset"]) throw InputError(p + "preset", "missing");
+  r.preset = readString(node["preset"], p + "preset");
+  if (node["name"]) r.spec.name = readString(node["name"], p + "name");
+  if (node["resolution"]) r.preset_params.resolution = static_cast<int>(readInt(node["resolution"], p + "resolution", 1, 4096));
+  if (node["voxel_size"]) r.preset_params.voxel_size = readDouble(node["voxel_size"], p + "voxel_size");
+  if (node["seed"]) r.preset_params.seed = static_cast<std::uint32_t>(readInt(node["seed"], p + "seed", 0, 0xffffffffll));
+  if (node["position"]) r.spec.pose.position = readVec3(node["position"], p + "position");
+  if (node["orientation"]) r.spec.pose.orientation = readOrientation(node["orientation"], p + "orientation");
+  if (node["velocity"]) r.spec.linear_velocity = readVec3(node["velocity"], p + "velocity");
+  if (node["angular_velocity"]) r.spec.angular_velocity = readVec3(node["angular_velocity"], p + "angular_velocity");
+  if (node["density"]) r.spec.density = readDouble(node["density"], p + "density");
+  if (node["restitution"]) r.spec.material.restitution = readDouble(node["restitution"], p + "restitution");
+  if (node["friction"]) r.spec.material.friction = readDouble(node["friction"], p + "friction");
+  if (node["color"]) r.color = readColor(node["color"], p + "color");
+  if (node["static"]) r.spec.is_static = readBool(node["static"], p + "static");
+  if (node["box_mode"]) {
+    try {
+      r.spec.box_mode = stc::parseBoxMode(readString(node["box_mode"], p + "box_mode"));
+    } catch (const InputError& e) {
+      throw InputError(p + "box_mode", reasonOf(e));
+    }
+  }
+
+  if (!node["repeat"]) {
+    scene.entities.push_back({path, std::move(r)});
+    return;
+  }
+  const YAML::Node rep = node["repeat"];
+  if (!rep.IsMap()) throw InputError(p + "repeat", "expected {count: [nx, ny, nz], spacing: [dx, dy, dz]}");
+  checkKeys(rep, p + "repeat.", {"count", "spacing", "seed_step"});
+  if (!rep["count"] || !rep["spacing"]) throw InputError(p + "repeat", "needs count and spacing");
+  const auto count = readNumbers(rep["count"], p + "repeat.count", 3);
+  const stc::Vec3 spacing = readVec3(rep["spacing"], p + "repeat.spacing");
+  const std::int64_t seed_step = rep["seed_step"] ? readInt(rep["seed_step"], p + "repeat.seed_step", 0, 1 << 20) : 0;
+  std::int64_t total = 1;
+  for (double c : count) {
+    if (!(c >= 1 && c <= 100000) || c != std::floor(c)) {
+      throw InputError(p + "repeat.count", "expected three integers >= 1");
+    }
+    total *= static_cast<std::int64_t>(c);
+  }
+  if (total > 1000000) throw InputError(p + "repeat.count", "more than 1000000 copies");
+  int index = 0;
+  for (int k = 0; k < static_cast<int>(count[2]); ++k) {
+    for (int j = 0; j < static_cast<int>(count[1]); ++j) {
+      for (int i = 0; i < static_cast<int>(count[0]); ++i, ++index) {
+        EntityRequest copy = r;
+        copy.spec.pose.position += stc::Vec3(i * spacing.x(), j * spacing.y(), k * spacing.z());
+        copy.preset_params.seed = r.preset_params.seed + static_cast<std::uint32_t>(seed_step * index);
+        if (!r.spec.name.empty()) copy.spec.name = r.spec.name + "_" + std::to_string(index);
+        scene.entities.push_back({path + ".repeat[" + std::to_string(index) + "]", std::move(copy)});
+      }
+    }
+  }
+}
+
+// addRequest names fields after EntitySpec; a scene file spells them as its keys.
+std::string sceneKeyOf(const std::string& field) {
+  static const std::map<std::string, std::string> kKeys{
+      {"pose.position", "position"},        {"pose.orientation", "orientation"},
+      {"linear_velocity", "velocity"},      {"material.restitution", "restitution"},
+      {"material.friction", "friction"},    {"dims", "resolution"}};
+  const auto it = kKeys.find(field);
+  return it == kKeys.end() ? field : it->second;
+}
+
+}  // namespace
+
+Scene parseScene(const std::string& yaml_text) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw InputError("scene", std::string("not valid YAML: ") + e.what());
+  }
+  if (!root.IsMap()) throw InputError("scene", "expected a map with keys gravity and entities");
+  checkKeys(root, "", {"gravity", "entities"});
+  Scene scene;
+  if (root["gravity"]) scene.gravity = readVec3(root["gravity"], "gravity");
+  if (!scene.gravity.allFinite()) throw InputError("gravity", "not finite");
+  if (root["entities"]) {
+    const YAML::Node list = root["entities"];
+    if (!list.IsSequence()) throw InputError("entities", "expected a list");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      parseEntity(list[i], "entities[" + std::to_string(i) + "]", scene);
+    }
+  }
+  return scene;
+}
+
+Scene loadSceneFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("scene", "cannot read file '" + path + "'");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseScene(text.str());
+}
+
+std::vector<stc::EntityId> addScene(stc::World& world, const Scene& scene) {
+  std::vector<stc::EntityId> ids;
+  ids.reserve(scene.entities.size());
+  for (const SceneEntry& entry : scene.entities) {
+    try {
+      ids.push_back(addRequest(world, entry.request));
+    } catch (const InputError& e) {
+      throw InputError(entry.path + "." + sceneKeyOf(e.field()), reasonOf(e));
+    }
+  }
+  return ids;
+}
+
+const std::string& defaultSceneYaml() {
+  // Six presets in two rows, spinning slowly without gravity, far enough
+  // apart that each sphere-tree level reads clearly in rviz.
+  static const std::string kYaml = R"(
+gravity: [0, 0, 0]
+entities:
+  - {name: cube,   preset: cube,   resolution: 8,  voxel_size: 0.05, position: [-1.2, -0.6, 0.5],
+     angular_velocity: [0, 0, 0.3], color: [0.90, 0.45, 0.20, 1.0]}
+  - {name: rock,   preset: rock,   resolution: 10, voxel_size: 0.05, seed: 3, position: [0.0, -0.6, 0.5],
+     angular_velocity: [0.2, 0, 0.2], color: [0.62, 0.50, 0.38, 1.0]}
+  - {name: L,      preset: L,      resolution: 10, voxel_size: 0.05, position: [1.2, -0.6, 0.5],
+     orientation: {rpy: [1.2, 0, 0]}, angular_velocity: [0, 0, -0.3], color: [0.25, 0.60, 0.90, 1.0]}
+  - {name: ring,   preset: ring,   resolution: 12, voxel_size: 0.05, position: [-1.2, 0.6, 0.5],
+     orientation: {rpy: [1.2, 0, 0]}, angular_velocity: [0, 0, 0.3], color: [0.85, 0.75, 0.20, 1.0]}
+  - {name: rod,    preset: rod,    resolution: 16, voxel_size: 0.05, position: [0.0, 0.6, 0.5],
+     orientation: {rpy: [0, 0.3, 0.6]}, angular_velocity: [0, 0, 0.4], color: [0.50, 0.80, 0.40, 1.0]}
+  - {name: sphere, preset: sphere, resolution: 10, voxel_size: 0.05, position: [1.2, 0.6, 0.5],
+     color: [0.80, 0.35, 0.60, 1.0]}
+)";
+  return kYaml;
+}
+
+}  // namespace stc_ros

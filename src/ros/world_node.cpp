@@ -1,0 +1,342 @@
+#include "sphere_tree_collision/ros/world_node.hpp"
+
+#include "sphere_tree_collision/ros/conversions.hpp"
+#include "sphere_tree_collision/ros/scene_file.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace stc_ros {
+namespace {
+
+const char* const kInputTopics[] = {"spawn", "despawn", "gaze", "clicked_point"};
+
+stc::Camera cameraAt(const CameraParams& params, const stc::Pose& pose) {
+  stc::Camera camera;
+  camera.camera_to_world = pose;
+  camera.width = params.width;
+  camera.height = params.height;
+  camera.fov_y_deg = params.fov_y_deg;
+  return camera;
+}
+
+// First hit of the ray with an entity's bounding ball, else with the ground
+// plane z = 0, else a point 5 m out: where the gaze marker is drawn.
+stc::Vec3 gazeTarget(const stc::World& world, const stc::Vec3& origin, const stc::Vec3& dir) {
+  double best = std::numeric_limits<double>::infinity();
+  const auto& bodies = world.bodies();
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const double r = world.shape(world.bodyShapes()[i]).bounding_radius;
+    const stc::Vec3 oc = bodies[i].pose.position - origin;
+    const double t_mid = oc.dot(dir);
+    const double d2 = oc.squaredNorm() - t_mid * t_mid;
+    if (d2 > r * r) continue;
+    const double t = t_mid - std::sqrt(r * r - d2);
+    if (t > 0.0 && t < best) best = t;
+  }
+  if (std::isfinite(best)) return origin + best * dir;
+  if (dir.z() < -1e-6 && origin.z() > 0.0) return origin + (-origin.z() / dir.z()) * dir;
+  return origin + 5.0 * dir;
+}
+
+}  // namespace
+
+WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : nh_(nh), pnh_(private_nh), params_(readNodeParams(private_nh)) {
+  for (const std::string& name : unknownParams(pnh_)) {
+    ROS_WARN("unknown parameter ~%s is ignored", name.c_str());
+  }
+  Scene scene;
+  try {
+    scene = params_.scene.empty() ? parseScene(defaultSceneYaml()) : loadSceneFile(params_.scene);
+  } catch (const stc::InputError& e) {
+    throw stc::InputError(e.field() == "scene" ? "scene" : "scene " + e.field(), reasonOf(e));
+  }
+  stc::WorldConfig config = params_.world;
+  config.gravity = params_.gravity ? *params_.gravity : scene.gravity;
+  world_ = stc::World(config);
+  std::vector<stc::EntityId> ids;
+  try {
+    ids = addScene(world_, scene);
+  } catch (const stc::InputError& e) {
+    throw stc::InputError("scene " + e.field(), reasonOf(e));
+  }
+  for (std::size_t i = 0; i < ids.size(); ++i) remember(ids[i], scene.entities[i].request);
+
+  const stc::Pose camera_pose = stc::opticalLookAt(params_.camera.position, params_.camera.look_at);
+  world_.perception().setCamera(cameraAt(params_.camera, camera_pose));
+  if (!params_.camera.frame.empty()) {
+    tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
+    tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
+  }
+  budget_ = params_.budget();
+  dt_ = 1.0 / params_.rate;
+  marker_options_.frame = params_.world_frame;
+  marker_options_.levels = params_.marker_levels;
+  marker_options_.voxels = params_.show_voxels;
+  marker_options_.max_contacts = static_cast<std::size_t>(params_.max_contact_markers);
+
+  markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
+  contacts_pub_ = nh_.advertise<sphere_tree_collision::ContactArray>("contacts", 10);
+  stats_pub_ = nh_.advertise<sphere_tree_collision::TickStats>("tick_stats", 10);
+  if (params_.publish_tf) tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
+  spawn_sub_ = nh_.subscribe("spawn", 1000, &WorldNode::onSpawn, this);
+  despawn_sub_ = nh_.subscribe("despawn", 1000, &WorldNode::onDespawn, this);
+  clear_sub_ = nh_.subscribe("clear", 10, &WorldNode::onClear, this);
+  gaze_sub_ = nh_.subscribe("gaze", 10, &WorldNode::onGaze, this);
+  clicked_sub_ = nh_.subscribe("/clicked_point", 10, &WorldNode::onClickedPoint, this);
+
+  tick_timer_ = nh_.createSteadyTimer(ros::WallDuration(dt_), [this](const ros::SteadyTimerEvent&) { tick(); });
+  marker_timer_ = nh_.createSteadyTimer(ros::WallDuration(1.0 / params_.marker_rate),
+                                        [this](const ros::SteadyTimerEvent&) { publishMarkers(); });
+  ROS_INFO("collision_world_node: %zu entities from %s, %.1f Hz, scheduler %s, budget %s ms / %s sphere tests",
+           world_.entityCount(), params_.scene.empty() ? "the default scene" : params_.scene.c_str(),
+           params_.rate, stc::toString(params_.world.scheduler.kind),
+           params_.detection_budget_ms < 0 ? "none" : std::to_string(params_.detection_budget_ms).c_str(),
+           params_.sphere_test_budget < 0 ? "no limit" : std::to_string(params_.sphere_test_budget).c_str());
+}
+
+void WorldNode::remember(stc::EntityId id, const EntityRequest& request) {
+  colors_[id] = request.color ? *request.color : paletteColor(id);
+  frames_[id] = entityFrame(id, request.spec.name);
+}
+
+// ---------------------------------------------------------------------------------
+// Tick
+
+void WorldNode::tick() {
+  const ros::Time now = ros::Time::now();
+  if (camera_from_tf_ || tf_buffer_) updateCameraFromTf();
+  expireGaze(now);
+  const stc::TickReport report = world_.step(dt_, budget_);
+  ++tick_;
+  publishStats(report, now);
+  publishContacts(now);
+  publishTf(now);
+  ROS_INFO_THROTTLE(1.0,
+                    "tick %llu: %zu entities, %zu broad pairs, %zu colliding, %zu unresolved (%zu accepted), "
+                    "%lld sphere tests, %zu contacts, %.2f ms, gaze %s, %llu rejected inputs",
+                    static_cast<unsigned long long>(tick_), report.entities, report.broad_pairs, report.colliding,
+                    report.unresolved, report.unresolved_accepted, static_cast<long long>(report.sphere_tests),
+                    report.contacts, report.total_s * 1e3, world_.perception().hasFixation() ? "on" : "off",
+                    static_cast<unsigned long long>(rejected_[0] + rejected_[1] + rejected_[2] + rejected_[3]));
+}
+
+void WorldNode::updateCameraFromTf() {
+  try {
+    const auto t = tf_buffer_->lookupTransform(params_.world_frame, params_.camera.frame, ros::Time(0));
+    stc::Pose pose;
+    pose.position = toEigen(t.transform.translation);
+    pose.orientation = toEigen(t.transform.rotation).normalized();
+    world_.perception().setCamera(cameraAt(params_.camera, pose));
+    if (!camera_from_tf_) ROS_INFO("camera pose now from tf frame '%s'", params_.camera.frame.c_str());
+    camera_from_tf_ = true;
+  } catch (const tf2::TransformException& e) {
+    ROS_WARN_THROTTLE(5.0, "camera frame '%s' not in tf (%s): using %s", params_.camera.frame.c_str(), e.what(),
+                      camera_from_tf_ ? "its last pose" : "~camera_position / ~camera_look_at");
+  } catch (const stc::InputError& e) {
+    ROS_WARN_THROTTLE(5.0, "camera frame '%s' rejected: %s", params_.camera.frame.c_str(), e.what());
+  }
+}
+
+void WorldNode::expireGaze(const ros::Time& now) {
+  if (world_.perception().hasFixation() && now > gaze_expiry_) world_.perception().clearFixation();
+}
+
+void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
+  if (stats_pub_.getNumSubscribers() == 0) return;
+  sphere_tree_collision::TickStats s;
+  s.header.stamp = stamp;
+  s.header.frame_id = params_.world_frame;
+  s.tick = tick_;
+  s.integrate_ms = r.integrate_s * 1e3;
+  s.broad_ms = r.broad_s * 1e3;
+  s.narrow_ms = r.narrow_s * 1e3;
+  s.response_ms = r.response_s * 1e3;
+  s.total_ms = r.total_s * 1e3;
+  s.scheduling_overhead_ms = r.scheduling_overhead_s * 1e3;
+  s.budget_ms = std::isfinite(budget_.seconds) ? budget_.seconds * 1e3 : std::numeric_limits<double>::infinity();
+  s.budget_sphere_tests = params_.sphere_test_budget;
+  s.scheduler = stc::toString(params_.world.scheduler.kind);
+  s.perception_used = r.perception_used;
+  s.entities = static_cast<std::uint32_t>(r.entities);
+  s.broad_pairs = static_cast<std::uint32_t>(r.broad_pairs);
+  s.colliding = static_cast<std::uint32_t>(r.colliding);
+  s.separate = static_cast<std::uint32_t>(r.separate);
+  s.unresolved = static_cast<std::uint32_t>(r.unresolved);
+  s.unresolved_accepted = static_cast<std::uint32_t>(r.unresolved_accepted);
+  s.sphere_tests = r.sphere_tests;
+  s.interrupted = r.interrupted;
+  s.geometric_inaccuracy = r.geometric_inaccuracy;
+  s.geometric_bound = r.geometric_bound;
+  s.perceived_inaccuracy = r.perceived_inaccuracy;
+  s.contacts = static_cast<std::uint32_t>(r.contacts);
+  s.rejected_spawn = rejected_[0];
+  s.rejected_despawn = rejected_[1];
+  s.rejected_gaze = rejected_[2];
+  s.rejected_clicked_point = rejected_[3];
+  s.rejected_inputs = rejected_[0] + rejected_[1] + rejected_[2] + rejected_[3];
+  s.last_rejection = last_rejection_;
+  s.gaze_active = world_.perception().hasFixation();
+  stats_pub_.publish(s);
+}
+
+void WorldNode::publishContacts(const ros::Time& stamp) {
+  if (contacts_pub_.getNumSubscribers() == 0) return;
+  const auto& contacts = world_.contacts();
+  contacts_msg_.header.stamp = stamp;
+  contacts_msg_.header.frame_id = params_.world_frame;
+  contacts_msg_.contacts.resize(contacts.size());
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    const stc::Contact& c = contacts[i];
+    auto& m = contacts_msg_.contacts[i];
+    m.entity_a = c.a;
+    m.entity_b = c.b;
+    m.point = toPointMsg(c.point);
+    m.normal = toVector3Msg(c.normal);
+    m.depth = c.depth;
+    m.gap_bound = c.gap_bound;
+    m.level = c.level;
+    m.resolved = c.resolved;
+    m.priority = c.priority;
+  }
+  contacts_pub_.publish(contacts_msg_);
+}
+
+void WorldNode::publishTf(const ros::Time& stamp) {
+  if (!params_.publish_tf || tf_pub_.getNumSubscribers() == 0) return;
+  const auto& ids = world_.entityIds();
+  const auto& bodies = world_.bodies();
+  tf_msg_.transforms.resize(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    auto& t = tf_msg_.transforms[i];
+    t.header.stamp = stamp;
+    t.header.frame_id = params_.world_frame;
+    t.child_frame_id = frames_[ids[i]];
+    t.transform.translation = toVector3Msg(bodies[i].pose.position);
+    t.transform.rotation = toQuaternionMsg(bodies[i].pose.orientation);
+  }
+  if (!ids.empty()) tf_pub_.publish(tf_msg_);
+}
+
+void WorldNode::publishMarkers() {
+  if (markers_pub_.getNumSubscribers() == 0) return;
+  marker_options_.contact_size = params_.contact_marker_size;
+  marker_builder_.build(world_, colors_, marker_options_, gazeRay(), ros::Time::now(), markers_msg_);
+  markers_pub_.publish(markers_msg_);
+}
+
+std::optional<GazeRay> WorldNode::gazeRay() const {
+  const stc::Perception& p = world_.perception();
+  if (!p.hasFixation()) return std::nullopt;
+  const stc::Camera& camera = p.camera();
+  const stc::Vec2& f = *p.fixation();
+  const stc::Vec3 dir_camera((f.x() - 0.5 * camera.width) / p.focalPx(), (f.y() - 0.5 * camera.height) / p.focalPx(), 1.0);
+  const stc::Vec3 dir = (camera.camera_to_world.orientation * dir_camera).normalized();
+  const stc::Vec3 origin = camera.camera_to_world.position;
+  return GazeRay{origin, gazeTarget(world_, origin, dir)};
+}
+
+// ---------------------------------------------------------------------------------
+// Inputs
+
+void WorldNode::reject(Input input, const std::string& field, const std::string& reason) {
+  const auto k = static_cast<std::size_t>(input);
+  ++rejected_[k];
+  last_rejection_ = std::string(kInputTopics[k]) + ": " + field + ": " + reason;
+  ROS_ERROR("rejected %s message: %s: %s", kInputTopics[k], field.c_str(), reason.c_str());
+}
+
+void WorldNode::onSpawn(const sphere_tree_collision::SpawnEntity& msg) {
+  const bool is_preset = !msg.preset.empty();
+  try {
+    EntityRequest request = toEntityRequest(msg, params_.default_resolution);
+    const EntityRequest kept_for_style{std::string(), {}, std::nullopt, request.spec, request.color};
+    const stc::EntityId id = addRequest(world_, std::move(request));
+    remember(id, kept_for_style);
+    ROS_DEBUG("spawned entity %u (%s)", id, frames_[id].c_str());
+  } catch (const stc::InputError& e) {
+    reject(Input::Spawn, spawnFieldOf(e.field(), is_preset), reasonOf(e));
+  }
+}
+
+void WorldNode::onDespawn(const sphere_tree_collision::Despawn& msg) {
+  std::optional<stc::EntityId> id;
+  if (!msg.name.empty()) {
+    id = world_.findByName(msg.name);
+    if (!id) return reject(Input::Despawn, "name", "no entity named '" + msg.name + "'");
+  } else {
+    id = msg.id;
+  }
+  if (!world_.removeEntity(*id)) return reject(Input::Despawn, "id", "no entity with id " + std::to_string(msg.id));
+  colors_.erase(*id);
+  frames_.erase(*id);
+}
+
+void WorldNode::onClear(const std_msgs::Empty&) {
+  ROS_INFO("clear: removing %zu entities", world_.entityCount());
+  world_.clear();
+  colors_.clear();
+  frames_.clear();
+}
+
+void WorldNode::setFixation(double x, double y, const ros::Time& stamp, const char* x_field, const char* y_field) {
+  const stc::Camera& camera = world_.perception().camera();
+  if (!std::isfinite(x)) throw stc::InputError(x_field, "not finite");
+  if (!std::isfinite(y)) throw stc::InputError(y_field, "not finite");
+  if (x < 0.0 || x > camera.width) {
+    throw stc::InputError(x_field, "off screen: " + std::to_string(x) + " outside [0, " + std::to_string(camera.width) + "]");
+  }
+  if (y < 0.0 || y > camera.height) {
+    throw stc::InputError(y_field, "off screen: " + std::to_string(y) + " outside [0, " + std::to_string(camera.height) + "]");
+  }
+  const ros::Time now = ros::Time::now();
+  const ros::Time when = stamp.isZero() ? now : stamp;
+  const double age = (now - when).toSec();
+  if (age > params_.gaze_timeout) {
+    throw stc::InputError("header.stamp", "stale: " + std::to_string(age) + " s old (~gaze_timeout " +
+                                              std::to_string(params_.gaze_timeout) + " s)");
+  }
+  if (-age > params_.gaze_timeout) {
+    throw stc::InputError("header.stamp", "in the future by " + std::to_string(-age) + " s");
+  }
+  world_.perception().setFixation(stc::Vec2(x, y));
+  gaze_expiry_ = when + ros::Duration(params_.gaze_timeout);
+}
+
+void WorldNode::onGaze(const sphere_tree_collision::GazePoint& msg) {
+  try {
+    setFixation(msg.x, msg.y, msg.header.stamp, "x", "y");
+  } catch (const stc::InputError& e) {
+    reject(Input::Gaze, e.field(), reasonOf(e));
+  }
+}
+
+void WorldNode::onClickedPoint(const geometry_msgs::PointStamped& msg) {
+  try {
+    stc::Vec3 point = toEigen(msg.point);
+    if (!point.allFinite()) throw stc::InputError("point", "not finite");
+    if (!msg.header.frame_id.empty() && msg.header.frame_id != params_.world_frame) {
+      if (!tf_buffer_) {
+        throw stc::InputError("header.frame_id", "'" + msg.header.frame_id + "' is not ~world_frame '" +
+                                                     params_.world_frame + "' (no tf listener without ~camera_frame)");
+      }
+      try {
+        const auto t = tf_buffer_->lookupTransform(params_.world_frame, msg.header.frame_id, ros::Time(0));
+        stc::Pose pose;
+        pose.position = toEigen(t.transform.translation);
+        pose.orientation = toEigen(t.transform.rotation).normalized();
+        point = pose.apply(point);
+      } catch (const tf2::TransformException& e) {
+        throw stc::InputError("header.frame_id", e.what());
+      }
+    }
+    const auto pixel = world_.perception().project(point);
+    if (!pixel) throw stc::InputError("point", "behind the camera");
+    setFixation(pixel->x(), pixel->y(), ros::Time(0), "point", "point");
+  } catch (const stc::InputError& e) {
+    reject(Input::ClickedPoint, e.field(), reasonOf(e));
+  }
+}
+
+}  // namespace stc_ros
