@@ -27,6 +27,36 @@ struct SpherePair {
   std::int32_t b = 0;
 };
 
+// Read-only view of a run of sphere pairs (what lastPairs() returns).
+class SpherePairSpan {
+ public:
+  SpherePairSpan() = default;
+  SpherePairSpan(const SpherePair* data, std::size_t size) : data_(data), size_(size) {}
+  const SpherePair* begin() const { return data_; }
+  const SpherePair* end() const { return data_ + size_; }
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  const SpherePair& operator[](std::size_t i) const { return data_[i]; }
+
+ private:
+  const SpherePair* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+// Storage of the hits and pairs of many PairTests during one tick. Steps
+// only append; clear() once per tick, before the tests are reset. Shared by
+// all pair tests of a World, its capacity settles at the largest tick's
+// total, so steady-state ticks do not allocate (per-test vectors would each
+// have to grow to their own worst frontier, one at a time). The vectors are
+// only ever grown: `*_used` says how much of them holds data.
+struct PairArena {
+  std::vector<SphereHit> hits;
+  std::vector<SpherePair> pairs;
+  std::size_t hits_used = 0;
+  std::size_t pairs_used = 0;
+  void clear() { hits_used = pairs_used = 0; }
+};
+
 // Inputs a PairTest reads; owned by the World, stable during a tick.
 struct PairBody {
   EntityId id = kInvalidEntity;
@@ -36,8 +66,10 @@ struct PairBody {
 
 class PairTest {
  public:
-  // Start a fresh test at the roots. Keeps vector capacity (no allocation once warm).
-  void reset(const PairBody& a, const PairBody& b);
+  // Start a fresh test at the roots. With an arena, hits and pairs go there
+  // (the caller clears it between ticks, and the pairs stay valid until
+  // then); without one, the test uses and clears its own. No allocation once warm.
+  void reset(const PairBody& a, const PairBody& b, PairArena* arena = nullptr);
 
   // Descend one level: test every sphere hit's target against its test list.
   // Outcomes (paper 3.4.1): a leaf-leaf intersection -> Colliding; no
@@ -47,6 +79,13 @@ class PairTest {
   // Returns the number of sphere-sphere tests done. No-op when resolved.
   int step();
 
+  // Yes/no mode (like FCL's collide with one contact): the step that finds a
+  // leaf pair stops at the end of that sphere hit, so lastPairs() holds the
+  // leaf pairs of the hits done, not of the whole level. Off by default: the
+  // response wants every leaf pair. Kept across reset().
+  void setFirstContactOnly(bool on) { first_contact_only_ = on; }
+  bool firstContactOnly() const { return first_contact_only_; }
+
   PairStatus status() const { return status_; }
   bool resolved() const { return status_ != PairStatus::Unresolved; }
   int stepsDone() const { return steps_; }
@@ -55,10 +94,13 @@ class PairTest {
 
   // Intersecting sphere pairs found by the last step that found any: leaf
   // pairs when Colliding, the current frontier when Unresolved.
-  const std::vector<SpherePair>& lastPairs() const { return last_pairs_; }
-  // Deepest (smallest combined radius) of lastPairs(); valid when hasLastPair().
-  bool hasLastPair() const { return !last_pairs_.empty(); }
-  SpherePair lastPair() const { return last_pairs_[best_last_]; }
+  SpherePairSpan lastPairs() const {
+    return SpherePairSpan(arena().pairs.data() + last_begin_, last_count_);
+  }
+  // Deepest of lastPairs(): smallest combined radius, then largest overlap.
+  // Valid when hasLastPair().
+  bool hasLastPair() const { return last_count_ != 0; }
+  SpherePair lastPair() const;
   // World centres of the spheres of lastPair() (entity origins if none).
   Vec3 lastCentreA() const;
   Vec3 lastCentreB() const;
@@ -76,15 +118,19 @@ class PairTest {
   const PairBody& bodyB() const { return b_; }
 
  private:
-  void chooseBestLastPair();
+  const PairArena& arena() const { return shared_arena_ ? *shared_arena_ : own_arena_; }
+  PairArena& arena() { return shared_arena_ ? *shared_arena_ : own_arena_; }
 
   PairBody a_, b_;
-  std::vector<SphereHit> hits_, next_hits_;
-  std::vector<SpherePair> last_pairs_;
-  // Scratch of one step, kept for its capacity: leaf pairs and other intersecting pairs.
-  std::vector<SpherePair> step_leaf_pairs_, step_pairs_;
-  std::size_t best_last_ = 0;
+  PairArena* shared_arena_ = nullptr;  // not owned
+  PairArena own_arena_;                // used when reset() got no arena
+  // The frontier (what the next step tests) and the last pairs are runs of the arena.
+  std::size_t hits_begin_ = 0, hits_count_ = 0;
+  std::size_t last_begin_ = 0, last_count_ = 0;
+  mutable std::size_t best_last_ = 0;  // index in lastPairs(), chosen lazily
+  mutable bool best_valid_ = false;
   PairStatus status_ = PairStatus::Unresolved;
+  bool first_contact_only_ = false;
   int steps_ = 0;
   int deepest_level_ = -1;
   std::int64_t sphere_tests_ = 0;

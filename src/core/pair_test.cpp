@@ -9,36 +9,49 @@
 namespace stc {
 namespace {
 
-// Room for a typical frontier, so a pooled PairTest stops growing early.
-constexpr std::size_t kInitialCapacity = 32;
+inline bool isLeaf(const SphereNode& n) { return n.child_count == 0; }
 
-void reserveAtLeast(std::vector<SphereHit>& v) {
-  if (v.capacity() < kInitialCapacity) v.reserve(kInitialCapacity);
-}
-void reserveAtLeast(std::vector<SpherePair>& v) {
-  if (v.capacity() < kInitialCapacity) v.reserve(kInitialCapacity);
-}
+// The deepest of a step's pairs: the smallest spheres; among equally small
+// ones, the one that overlaps most (face-on rather than across an edge), so
+// the contact normal of a face contact is the face normal.
+struct DeepestPair {
+  double reach = std::numeric_limits<double>::infinity();
+  double overlap = -std::numeric_limits<double>::infinity();
+  std::size_t index = 0;
 
-// World centre of a body-frame point, with the rotation as a matrix: one
-// matrix per step is cheaper than a quaternion rotation per sphere.
-inline Vec3 toWorld(const Mat3& r, const Vec3& p, const Vec3& body) { return r * body + p; }
+  void offer(double pair_reach, double distance_sq, std::size_t pair_index) {
+    if (pair_reach > reach * (1.0 + 1e-12)) return;
+    const double pair_overlap = pair_reach - std::sqrt(distance_sq);
+    if (pair_reach < reach * (1.0 - 1e-12) || pair_overlap > overlap) {
+      reach = std::min(reach, pair_reach);
+      overlap = pair_overlap;
+      index = pair_index;
+    }
+  }
+};
+
+// Make room for `extra` more elements after `used` (grows only, geometrically).
+template <typename T>
+T* roomFor(std::vector<T>& v, std::size_t used, std::size_t extra) {
+  if (v.size() < used + extra) v.resize(std::max(used + extra, 2 * v.size()));
+  return v.data() + used;
+}
 
 }  // namespace
 
-void PairTest::reset(const PairBody& a, const PairBody& b) {
+void PairTest::reset(const PairBody& a, const PairBody& b, PairArena* arena) {
   a_ = a;
   b_ = b;
-  reserveAtLeast(hits_);
-  reserveAtLeast(next_hits_);
-  reserveAtLeast(last_pairs_);
-  reserveAtLeast(step_leaf_pairs_);
-  reserveAtLeast(step_pairs_);
-  hits_.clear();
-  next_hits_.clear();
-  last_pairs_.clear();
+  shared_arena_ = arena;
+  if (!arena) own_arena_.clear();
+  PairArena& store = this->arena();
   // Paper: the root of tree A is the target, the root of tree B the test list.
-  hits_.push_back(SphereHit{0, 0, 1, 0});
-  best_last_ = 0;
+  hits_begin_ = store.hits_used;
+  hits_count_ = 1;
+  *roomFor(store.hits, store.hits_used, 1) = SphereHit{0, 0, 1, 0};
+  ++store.hits_used;
+  last_begin_ = last_count_ = best_last_ = 0;
+  best_valid_ = false;
   status_ = PairStatus::Unresolved;
   steps_ = 0;
   deepest_level_ = -1;
@@ -48,89 +61,109 @@ void PairTest::reset(const PairBody& a, const PairBody& b) {
 int PairTest::step() {
   if (resolved()) return 0;
 
+  // Distances do not change under a rigid motion, so each target centre is
+  // taken into the body frame of the tree it is tested against, once per hit;
+  // the members are then used as stored, with no transform per sphere test.
+  // to_other[s] maps body frame s to body frame 1 - s.
   const SphereNode* nodes[2] = {a_.tree->nodes().data(), b_.tree->nodes().data()};
-  const Mat3 rotation[2] = {a_.pose->orientation.toRotationMatrix(),
-                            b_.pose->orientation.toRotationMatrix()};
-  const Vec3 position[2] = {a_.pose->position, b_.pose->position};
+  const Mat3 ra = a_.pose->orientation.toRotationMatrix();
+  const Mat3 rb = b_.pose->orientation.toRotationMatrix();
+  const Vec3 pa_in_b = rb.transpose() * (a_.pose->position - b_.pose->position);
+  const Mat3 rot_to_other[2] = {rb.transpose() * ra, ra.transpose() * rb};
+  const Vec3 pos_to_other[2] = {pa_in_b, -(rot_to_other[1] * pa_in_b)};
 
-  next_hits_.clear();
-  step_leaf_pairs_.clear();
-  step_pairs_.clear();
+  // New hits and this step's intersecting pairs are appended to the arena.
+  // Room for the worst case (every test intersects) is made first, and the
+  // loop writes every candidate and advances the write index only when it
+  // intersects: no unpredictable branch per sphere test.
+  PairArena& store = arena();
+  std::size_t most = 0;  // tests if every hit is done
+  for (std::size_t h = hits_begin_; h < hits_begin_ + hits_count_; ++h) most += store.hits[h].test_count;
+  const std::size_t new_hits_begin = store.hits_used;
+  const std::size_t pairs_begin = store.pairs_used;
+  SphereHit* hit_out = roomFor(store.hits, new_hits_begin, most);
+  SpherePair* pair_out = roomFor(store.pairs, pairs_begin, most);
+  const SphereHit* hits = store.hits.data();  // after the growth above
+  std::size_t hit_count = 0, pair_count = 0, leaf_pairs = 0;
   int tests = 0;
 
-  for (const SphereHit& hit : hits_) {
-    const int ts = hit.target_side;
-    const int ms = 1 - ts;
-    const SphereNode& target = nodes[ts][hit.target];
-    const Vec3 target_centre = toWorld(rotation[ts], position[ts], target.centre);
-    const bool target_leaf = target.child_count == 0;
+  for (std::size_t h = hits_begin_; h < hits_begin_ + hits_count_; ++h) {
+    if (first_contact_only_ && leaf_pairs > 0) break;  // the answer is known
+    const SphereHit hit = hits[h];
     tests += hit.test_count;
-    deepest_level_ = std::max({deepest_level_, target.level, nodes[ms][hit.test_first].level});
+    const int ts = hit.target_side;
+    const auto ms = static_cast<std::uint8_t>(1 - ts);
+    const SphereNode& target = nodes[ts][hit.target];
+    const Vec3 target_centre = rot_to_other[ts] * target.centre + pos_to_other[ts];
+    const SphereNode* members = nodes[ms];
+    const std::int32_t end = hit.test_first + hit.test_count;
+    deepest_level_ = std::max({deepest_level_, target.level, members[hit.test_first].level});
 
-    for (std::int32_t m = hit.test_first; m < hit.test_first + hit.test_count; ++m) {
-      const SphereNode& member = nodes[ms][m];
+    for (std::int32_t m = hit.test_first; m < end; ++m) {
+      const SphereNode& member = members[m];
       const double reach = target.radius + member.radius;
-      const Vec3 member_centre = toWorld(rotation[ms], position[ms], member.centre);
-      if ((member_centre - target_centre).squaredNorm() > reach * reach) continue;
-
+      const bool touching = (member.centre - target_centre).squaredNorm() <= reach * reach;
       // Keep a on tree A and b on tree B whichever tree holds the target.
-      const SpherePair pair = ts == 0 ? SpherePair{hit.target, m} : SpherePair{m, hit.target};
-      const bool member_leaf = member.child_count == 0;
-      if (target_leaf && member_leaf) {
-        step_leaf_pairs_.push_back(pair);
-      } else if (!target_leaf) {
+      pair_out[pair_count] = ts == 0 ? SpherePair{hit.target, m} : SpherePair{m, hit.target};
+      pair_count += touching;
+      if (!isLeaf(target)) {
         // Crossover: the member becomes the target, the target's children the test list.
-        step_pairs_.push_back(pair);
-        next_hits_.push_back(SphereHit{m, target.first_child, target.child_count,
-                                       static_cast<std::uint8_t>(ms)});
+        hit_out[hit_count] = SphereHit{m, target.first_child, target.child_count, ms};
+        hit_count += touching;
       } else {
-        // Unequal heights: a leaf target stays, the member's children become the test list.
-        step_pairs_.push_back(pair);
-        next_hits_.push_back(SphereHit{hit.target, member.first_child, member.child_count,
-                                       static_cast<std::uint8_t>(ts)});
+        // Unequal heights: a leaf target stays, the member's children become
+        // the test list; a leaf member makes a leaf pair instead.
+        const bool member_leaf = isLeaf(member);
+        hit_out[hit_count] = SphereHit{hit.target, member.first_child, member.child_count, hit.target_side};
+        hit_count += touching && !member_leaf;
+        leaf_pairs += touching && member_leaf;
       }
     }
   }
 
   ++steps_;
   sphere_tests_ += tests;
-  if (!step_leaf_pairs_.empty()) {
+  best_valid_ = false;
+  if (leaf_pairs > 0) {
+    // Colliding: the last pairs are the leaf pairs only; drop the rest of the step.
     status_ = PairStatus::Colliding;
-    last_pairs_.swap(step_leaf_pairs_);
-    hits_.clear();
-  } else if (!step_pairs_.empty()) {
-    last_pairs_.swap(step_pairs_);
-    hits_.swap(next_hits_);
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < pair_count; ++i) {
+      if (isLeaf(nodes[0][pair_out[i].a]) && isLeaf(nodes[1][pair_out[i].b])) pair_out[kept++] = pair_out[i];
+    }
+    pair_count = kept;
+    hits_count_ = 0;
+  } else if (pair_count > 0) {
+    store.hits_used = new_hits_begin + hit_count;
+    hits_begin_ = new_hits_begin;
+    hits_count_ = hit_count;
   } else {
     // Nothing intersects: lastPairs() keeps the deepest pairs found before.
     status_ = PairStatus::Separate;
-    hits_.clear();
+    hits_count_ = 0;
     return tests;
   }
-  chooseBestLastPair();
+  store.pairs_used = pairs_begin + pair_count;
+  last_begin_ = pairs_begin;
+  last_count_ = pair_count;
   return tests;
 }
 
-// The deepest pair is the one with the smallest spheres; among equally small
-// ones, the one that overlaps most (face-on rather than across an edge), so
-// the contact normal of a face contact is the face normal.
-void PairTest::chooseBestLastPair() {
-  const SphereTree& ta = *a_.tree;
-  const SphereTree& tb = *b_.tree;
-  double best_reach = std::numeric_limits<double>::infinity();
-  double best_overlap = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < last_pairs_.size(); ++i) {
-    const SphereNode& na = ta.node(last_pairs_[i].a);
-    const SphereNode& nb = tb.node(last_pairs_[i].b);
-    const double reach = na.radius + nb.radius;
-    if (reach > best_reach * (1.0 + 1e-12)) continue;
-    const double overlap = reach - (b_.pose->apply(nb.centre) - a_.pose->apply(na.centre)).norm();
-    if (reach < best_reach * (1.0 - 1e-12) || overlap > best_overlap) {
-      best_reach = std::min(best_reach, reach);
-      best_overlap = overlap;
-      best_last_ = i;
+// Chosen on first use after a step (most pair tests are never asked).
+SpherePair PairTest::lastPair() const {
+  const SpherePairSpan last = lastPairs();
+  if (!best_valid_) {
+    DeepestPair deepest;
+    for (std::size_t i = 0; i < last.size(); ++i) {
+      const SphereNode& na = a_.tree->node(last[i].a);
+      const SphereNode& nb = b_.tree->node(last[i].b);
+      const double distance_sq = (b_.pose->apply(nb.centre) - a_.pose->apply(na.centre)).squaredNorm();
+      deepest.offer(na.radius + nb.radius, distance_sq, i);
     }
+    best_last_ = deepest.index;
+    best_valid_ = true;
   }
+  return last[best_last_];
 }
 
 Vec3 PairTest::lastCentreA() const {
