@@ -171,6 +171,9 @@ class World {
   std::unique_ptr<Scheduler> scheduler_;
   Perception perception_;
   std::vector<PairTest> pair_tests_;  // pooled: capacity kept between ticks
+  // Hits and pairs of all pair tests of a tick; on the heap so that it keeps
+  // its address when the World is moved (the pair tests point at it).
+  std::unique_ptr<PairArena> pair_arena_ = std::make_unique<PairArena>();
   std::size_t pair_count_ = 0;
   std::vector<std::array<std::uint32_t, 2>> pair_bodies_;  // dense indices of each pair test's bodies
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)

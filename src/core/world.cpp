@@ -328,13 +328,15 @@ void World::narrowPhase(const Budget& budget, TickReport& report) {
     pair_priority_.resize(pairs.size());
   }
   pair_count_ = 0;
+  pair_arena_->clear();
   for (const BroadPair& pair : pairs) {
     const std::size_t ia = index_of_.find(pair.first)->second;
     const std::size_t ib = index_of_.find(pair.second)->second;
     if (bodies_[ia].is_static && bodies_[ib].is_static) continue;  // nothing can change
     pair_tests_[pair_count_].reset(
         PairBody{pair.first, &shapes_[body_shapes_[ia]].tree, &bodies_[ia].pose},
-        PairBody{pair.second, &shapes_[body_shapes_[ib]].tree, &bodies_[ib].pose});
+        PairBody{pair.second, &shapes_[body_shapes_[ib]].tree, &bodies_[ib].pose},
+        pair_arena_.get());
     pair_bodies_[pair_count_] = {static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib)};
     ++pair_count_;
   }
