@@ -1,0 +1,71 @@
+// Helpers shared by the rostest gtest nodes: record a topic, spin until a
+// condition holds, measure a message rate.
+#pragma once
+
+#include <ros/ros.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace stc_test {
+
+// Spins the default callback queue until `done()` or `timeout_s` of wall time.
+inline bool spinUntil(const std::function<bool()>& done, double timeout_s) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    ros::spinOnce();
+    if (done()) return true;
+    ros::WallDuration(0.002).sleep();
+  }
+  ros::spinOnce();
+  return done();
+}
+
+inline void spinFor(double seconds) {
+  spinUntil([] { return false; }, seconds);
+}
+
+// Keeps the arrival times of every message and a copy of the last one.
+template <typename Msg>
+class Recorder {
+ public:
+  Recorder(ros::NodeHandle& nh, const std::string& topic, std::uint32_t queue = 100) {
+    sub_ = nh.subscribe<Msg>(topic, queue, [this](const typename Msg::ConstPtr& m) {
+      last = *m;
+      arrivals.push_back(ros::WallTime::now());
+      if (keep_all) all.push_back(*m);
+    });
+  }
+  std::size_t count() const { return arrivals.size(); }
+  void clear() {
+    arrivals.clear();
+    all.clear();
+  }
+  // Messages per second between the first and the last arrival.
+  double rate() const {
+    if (arrivals.size() < 2) return 0.0;
+    return (arrivals.size() - 1) / (arrivals.back() - arrivals.front()).toSec();
+  }
+  bool waitFor(std::size_t n, double timeout_s) {
+    return spinUntil([&] { return count() >= n; }, timeout_s);
+  }
+
+  Msg last;
+  std::vector<ros::WallTime> arrivals;
+  bool keep_all = false;
+  std::vector<Msg> all;
+  ros::Subscriber sub_;
+};
+
+// Sorted "type" of an advertised topic, "" when not advertised.
+inline std::string topicType(const std::string& topic) {
+  ros::master::V_TopicInfo topics;
+  ros::master::getTopics(topics);
+  for (const auto& t : topics) {
+    if (t.name == topic) return t.datatype;
+  }
+  return "";
+}
+
+}  // namespace stc_test

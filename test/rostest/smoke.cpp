@@ -1,0 +1,117 @@
+// Smoke test: the node publishes what it advertises, at the configured rates.
+#include "rostest_util.hpp"
+
+#include <gtest/gtest.h>
+#include <sphere_tree_collision/ContactArray.h>
+#include <sphere_tree_collision/TickStats.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <map>
+#include <set>
+
+namespace {
+
+using stc_test::Recorder;
+using visualization_msgs::Marker;
+
+double param(const std::string& name) {
+  double v = 0.0;
+  EXPECT_TRUE(ros::param::get("~" + name, v)) << "test parameter ~" << name << " missing";
+  return v;
+}
+
+std::vector<std::string> entityFrames() {
+  std::vector<std::string> frames;
+  EXPECT_TRUE(ros::param::get("~entity_frames", frames));
+  return frames;
+}
+
+// Rates are measured over a few seconds of wall time; the bound is loose
+// (the machine may be busy) but far from "not publishing" or "every tick".
+constexpr double kRateTolerance = 0.35;
+constexpr double kWindow = 3.0;
+
+TEST(Smoke, AdvertisedTypes) {
+  ros::NodeHandle nh;
+  ASSERT_TRUE(stc_test::spinUntil([] { return stc_test::topicType("/tick_stats") != ""; }, 10.0));
+  EXPECT_EQ(stc_test::topicType("/markers"), "visualization_msgs/MarkerArray");
+  EXPECT_EQ(stc_test::topicType("/tick_stats"), "sphere_tree_collision/TickStats");
+  EXPECT_EQ(stc_test::topicType("/contacts"), "sphere_tree_collision/ContactArray");
+  EXPECT_EQ(stc_test::topicType("/tf"), "tf2_msgs/TFMessage");
+}
+
+TEST(Smoke, MarkersAtConfiguredRate) {
+  ros::NodeHandle nh;
+  const double expected = param("marker_rate");
+  Recorder<visualization_msgs::MarkerArray> markers(nh, "/markers", 10);
+  ASSERT_TRUE(markers.waitFor(1, 10.0)) << "no marker array within 10 s";
+  markers.clear();
+  stc_test::spinFor(kWindow);
+  EXPECT_NEAR(markers.rate(), expected, kRateTolerance * expected);
+
+  // Content of the last array.
+  const auto& m = markers.last.markers;
+  ASSERT_FALSE(m.empty());
+  EXPECT_EQ(m.front().action, Marker::DELETEALL) << "the first marker clears removed entities";
+  std::map<std::string, int> per_ns;
+  for (std::size_t i = 1; i < m.size(); ++i) {
+    ++per_ns[m[i].ns];
+    EXPECT_EQ(m[i].action, Marker::ADD);
+    EXPECT_EQ(m[i].header.frame_id, "world");
+    EXPECT_FALSE(m[i].points.empty()) << m[i].ns << "/" << m[i].id;
+    if (m[i].type == Marker::SPHERE_LIST) {
+      EXPECT_GT(m[i].scale.x, 0.0);
+      EXPECT_EQ(m[i].scale.x, m[i].scale.y);
+      EXPECT_EQ(m[i].scale.x, m[i].scale.z);
+      EXPECT_LT(m[i].color.a, 1.0f) << "tree levels are semi-transparent";
+    }
+  }
+  EXPECT_EQ(per_ns["voxels"], static_cast<int>(entityFrames().size())) << "one CUBE_LIST per entity";
+  EXPECT_GT(per_ns["tree_level_1"], 0);
+  EXPECT_GT(per_ns["tree_level_2"], 0);
+  EXPECT_EQ(per_ns.count("tree_level_0"), 0u) << "only the levels of ~marker_levels";
+  EXPECT_EQ(per_ns.count("tree_level_3"), 0u);
+  // Marker ids are unique within a namespace (rviz would drop duplicates).
+  std::set<std::pair<std::string, int>> ids;
+  for (const Marker& marker : m) EXPECT_TRUE(ids.insert({marker.ns, marker.id}).second);
+}
+
+TEST(Smoke, TfFrameForEveryEntity) {
+  ros::NodeHandle nh;
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer, nh, false);  // spun by spinUntil
+  for (const std::string& frame : entityFrames()) {
+    EXPECT_TRUE(stc_test::spinUntil([&] { return buffer.canTransform("world", frame, ros::Time(0)); }, 10.0))
+        << "no tf world -> " << frame;
+  }
+}
+
+TEST(Smoke, TickStatsAndContactsAtTickRate) {
+  ros::NodeHandle nh;
+  const double expected = param("tick_rate");
+  Recorder<sphere_tree_collision::TickStats> stats(nh, "/tick_stats");
+  Recorder<sphere_tree_collision::ContactArray> contacts(nh, "/contacts");
+  ASSERT_TRUE(stats.waitFor(1, 10.0));
+  ASSERT_TRUE(contacts.waitFor(1, 10.0));
+  stats.clear();
+  contacts.clear();
+  stc_test::spinFor(kWindow);
+  EXPECT_NEAR(stats.rate(), expected, kRateTolerance * expected);
+  EXPECT_NEAR(contacts.rate(), expected, kRateTolerance * expected);
+  EXPECT_EQ(stats.last.entities, entityFrames().size());
+  EXPECT_EQ(stats.last.rejected_inputs, 0u);
+  EXPECT_GT(stats.last.tick, 0u);
+  EXPECT_EQ(stats.last.scheduler, "priority_queues");
+  EXPECT_FALSE(stats.last.perception_used) << "no gaze published: no projection work";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "smoke_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
