@@ -28,10 +28,11 @@ struct SphereTreeOptions {
 struct SphereNode {
   Vec3 centre = Vec3::Zero();  // body frame
   double radius = 0.0;
-  // Max distance from a point of this sphere (its surface) to the shape part it
-  // covers (the occupied voxels of its octree cell); a rigorous upper bound,
-  // within 0.1 voxel + 1% of the radius of the true value. If spheres a and b
-  // touch, the true gap between the shapes is <= h_a + h_b.
+  // Max distance from a point of this sphere (the whole ball, centre included)
+  // to the shape part it covers (the occupied voxels of its octree cell); a
+  // rigorous upper bound, within 0.1 voxel + 3% of the radius of the true
+  // value. If spheres a and b touch, overlap or nest, the true gap between the
+  // shapes is <= h_a + h_b.
   double h = 0.0;
   std::int32_t first_child = -1;  // index of the first child; children contiguous
   std::int32_t child_count = 0;

@@ -16,35 +16,34 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 namespace stc {
 namespace {
 
 constexpr int kMaxLevels = 8;
+constexpr double kNoLimit = std::numeric_limits<double>::infinity();
 
-// h is refined to within this many voxels (plus 1% of the radius, so huge
+// h is refined to within this many voxels (plus 3% of the radius, so huge
 // spheres do not cost a huge number of samples).
-double gapTolerance(double radius_vox) { return 0.1 + 0.01 * radius_vox; }
+double gapTolerance(double radius_vox) { return 0.1 + 0.03 * radius_vox; }
 
-// Small cells (side <= 4 voxels) repeat the same few patterns all over a
-// shape; their sphere and h depend only on which voxels are surface and which
-// occupied, and on the clipped cell size, so they are computed once per pattern
-// (relative to the cell's corner).
+// Cells up to kMemoSide voxels repeat the same few patterns all over a shape
+// (faces, edges, corners of the same slab); their sphere and h depend only on
+// which voxels are surface and which occupied, and on the clipped cell size,
+// so they are computed once per pattern (relative to the cell's corner).
+constexpr int kMemoSide = 16;
 struct PatternKey {
-  int side;
-  std::array<int, 3> clipped;
-  std::uint64_t surface_mask;
-  std::uint64_t occupied_mask;
-  bool operator==(const PatternKey& o) const {
-    return side == o.side && clipped == o.clipped && surface_mask == o.surface_mask &&
-           occupied_mask == o.occupied_mask;
-  }
+  std::array<int, 3> clipped;       // cell size in voxels after clipping to the grid
+  std::vector<std::uint64_t> bits;  // 2 bits per voxel: surface, occupied
+  bool operator==(const PatternKey& o) const { return clipped == o.clipped && bits == o.bits; }
 };
 struct PatternHash {
   std::size_t operator()(const PatternKey& k) const {
-    std::uint64_t h = (k.surface_mask * 0x9E3779B97F4A7C15ull) ^ (k.occupied_mask + 0x632BE59BD9B4E019ull);
-    for (int v : {k.side, k.clipped[0], k.clipped[1], k.clipped[2]}) h = (h ^ static_cast<std::uint64_t>(v)) * 0x100000001B3ull;
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    for (int v : k.clipped) h = (h ^ static_cast<std::uint64_t>(v)) * 0x100000001B3ull;
+    for (std::uint64_t w : k.bits) h = (h ^ w ^ (w >> 32)) * 0x100000001B3ull;
     return static_cast<std::size_t>(h ^ (h >> 29));
   }
 };
@@ -90,33 +89,37 @@ void appendOccupiedColumnCorners(const VoxelShape& shape, const Vec3& lo, const 
 //          paper sphere (they enclose subsets of the clipped cell), so tight
 //          is never looser than paper, by radius or by h.
 FittedCell fitCell(const VoxelShape& shape, const detail::VoxelPyramid& surface,
-                   const detail::VoxelPyramid& solid, int level, const detail::CellIndex& cell, SphereFit fit,
+                   const detail::VoxelPyramid& solid, const detail::VoxelPyramid& empty, int level, const detail::CellIndex& cell, SphereFit fit,
                    std::vector<Vec3>& corners) {
   Vec3 lo, hi;
   surface.cellBox(level, cell, lo, hi);
-  const auto withGap = [&](const Sphere& s) {
+  const auto withGap = [&](const Sphere& s, double give_up_above) {
     return FittedCell{s.centre, s.radius,
-                      detail::sphereGapBound(solid, level, cell, s.centre, s.radius, gapTolerance(s.radius))};
+                      detail::sphereGapBound(solid, empty, level, cell, s.centre, s.radius,
+                                             gapTolerance(s.radius), give_up_above)};
   };
   const Sphere paper{0.5 * (lo + hi), 0.5 * (hi - lo).norm()};
-  if (fit == SphereFit::Paper) return withGap(paper);
+  if (fit == SphereFit::Paper) return withGap(paper, kNoLimit);
 
-  FittedCell best = withGap(paper);
-  const auto consider = [&](const Sphere& s) {
-    if (s.radius > paper.radius) return;  // cannot happen but for rounding
-    const FittedCell c = withGap(s);
-    if (c.h < best.h || (c.h == best.h && c.radius < best.radius)) best = c;
-  };
-  corners.clear();
-  surface.appendCorners(level, cell, corners);
-  const Sphere around_surface = minimalEnclosingSphere(corners);
-  consider(around_surface);
   corners.clear();
   appendOccupiedColumnCorners(shape, lo, hi, corners);
   const Sphere around_occupied = minimalEnclosingSphere(corners);
-  if ((around_occupied.centre - around_surface.centre).norm() > 1e-9 ||
-      around_occupied.radius != around_surface.radius) {
-    consider(around_occupied);
+  corners.clear();
+  surface.appendCorners(level, cell, corners);
+  const Sphere around_surface = minimalEnclosingSphere(corners);
+  // Candidates in the order they usually win; a later one is abandoned as soon
+  // as its h is known to exceed the best so far.
+  FittedCell best{paper.centre, paper.radius, kNoLimit};
+  std::vector<Sphere> tried;
+  for (const Sphere& s : {around_occupied, around_surface, paper}) {
+    if (s.radius > paper.radius) continue;  // cannot happen but for rounding
+    const bool repeat = std::any_of(tried.begin(), tried.end(), [&](const Sphere& t) {
+      return t.radius == s.radius && (t.centre - s.centre).norm() <= 1e-12;
+    });
+    if (repeat) continue;
+    tried.push_back(s);
+    const FittedCell c = withGap(s, best.h);
+    if (c.h < best.h || (c.h == best.h && c.radius < best.radius)) best = c;
   }
   return best;
 }
@@ -134,6 +137,7 @@ SphereTree SphereTree::build(const VoxelShape& shape, const Vec3& body_origin,
 
   const detail::VoxelPyramid pyramid(shape, detail::VoxelSet::Surface);  // which cells are nodes
   const detail::VoxelPyramid solid(shape, detail::VoxelSet::Occupied);    // what h measures to
+  const detail::VoxelPyramid empty(shape, detail::VoxelSet::Empty);       // how deep inside it
   const int levels =
       shape.isSphere() ? 1 : std::min(options.max_levels, pyramid.depth() + 1);
   const double a = shape.voxelSize();
@@ -148,28 +152,29 @@ SphereTree SphereTree::build(const VoxelShape& shape, const Vec3& body_origin,
   // circumscribed cube would be sqrt(3) times too big.
   const SphereFit fit = shape.isSphere() ? SphereFit::Tight : options.fit;
   const auto fitWithGap = [&](int level, const detail::CellIndex& cell) {
-    return fitCell(shape, pyramid, solid, level, cell, fit, corners);
+    return fitCell(shape, pyramid, solid, empty, level, cell, fit, corners);
   };
   const auto addNode = [&](int level, const detail::CellIndex& cell, std::int32_t parent) {
     Vec3 lo, hi;
     pyramid.cellBox(level, cell, lo, hi);
     FittedCell f;
     const int side = pyramid.cellSide(level);
-    if (side <= 4) {
-      PatternKey key{side, {int(hi.x() - lo.x()), int(hi.y() - lo.y()), int(hi.z() - lo.z())}, 0, 0};
-      for (int k = 0; k < side; ++k)
-        for (int j = 0; j < side; ++j)
-          for (int i = 0; i < side; ++i) {
-            const detail::CellIndex v = {cell[0] * side + i, cell[1] * side + j, cell[2] * side + k};
-            const std::uint64_t bit = std::uint64_t{1} << (i + side * (j + side * k));
-            if (pyramid.has(pyramid.depth(), v)) key.surface_mask |= bit;
-            if (shape.occupied(v[0], v[1], v[2])) key.occupied_mask |= bit;
+    if (side <= kMemoSide) {
+      PatternKey key{{int(hi.x() - lo.x()), int(hi.y() - lo.y()), int(hi.z() - lo.z())}, {}};
+      key.bits.assign((2 * static_cast<std::size_t>(key.clipped[0]) * key.clipped[1] * key.clipped[2] + 63) / 64, 0);
+      std::size_t bit = 0;
+      for (int k = int(lo.z()); k < int(hi.z()); ++k)
+        for (int j = int(lo.y()); j < int(hi.y()); ++j)
+          for (int i = int(lo.x()); i < int(hi.x()); ++i, bit += 2) {
+            const std::uint64_t pair = (pyramid.has(pyramid.depth(), {i, j, k}) ? 1u : 0u) |
+                                       (shape.occupied(i, j, k) ? 2u : 0u);
+            key.bits[bit / 64] |= pair << (bit % 64);
           }
       auto it = patterns.find(key);
       if (it == patterns.end()) {
         f = fitWithGap(level, cell);
         f.centre_from_corner = f.centre_from_corner - lo;
-        it = patterns.emplace(key, f).first;
+        it = patterns.emplace(std::move(key), f).first;
       }
       f = it->second;
       f.centre_from_corner += lo;

@@ -23,8 +23,9 @@ VoxelPyramid::VoxelPyramid(const VoxelShape& shape, VoxelSet set) {
   for (int k = 0; k < shape.nz(); ++k)
     for (int j = 0; j < shape.ny(); ++j)
       for (int i = 0; i < shape.nx(); ++i)
-        finest.has_voxel[shape.index(i, j, k)] =
-            (set == VoxelSet::Surface ? shape.isSurfaceVoxel(i, j, k) : shape.occupied(i, j, k)) ? 1 : 0;
+        finest.has_voxel[shape.index(i, j, k)] = set == VoxelSet::Surface    ? shape.isSurfaceVoxel(i, j, k)
+                                                 : set == VoxelSet::Occupied ? shape.occupied(i, j, k)
+                                                                             : !shape.occupied(i, j, k);
 
   for (int level = depth_ - 1; level >= 0; --level) {
     const Level& fine = levels_[static_cast<std::size_t>(level) + 1];
@@ -66,8 +67,18 @@ double boxDistanceSquared(const Vec3& p, const Vec3& lo, const Vec3& hi) {
 }
 }  // namespace
 
-double VoxelPyramid::distanceToSet(const Vec3& p, int level, const CellIndex& c,
-                                         double bound) const {
+double VoxelPyramid::distanceToSet(const Vec3& p, int level, const CellIndex& c, double bound,
+                                   Vec3* nearest) const {
+  if (nearest) *nearest = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  // Fast path: p inside a voxel of the set that lies in the cell.
+  const CellIndex v = {static_cast<int>(std::floor(p.x())), static_cast<int>(std::floor(p.y())),
+                       static_cast<int>(std::floor(p.z()))};
+  const int shift = depth_ - level;
+  if (v[0] >= 0 && v[1] >= 0 && v[2] >= 0 && (v[0] >> shift) == c[0] && (v[1] >> shift) == c[1] &&
+      (v[2] >> shift) == c[2] && has(depth_, v)) {
+    if (nearest) *nearest = p;
+    return 0.0;
+  }
   struct Entry {
     int level;
     CellIndex cell;
@@ -85,6 +96,10 @@ double VoxelPyramid::distanceToSet(const Vec3& p, int level, const CellIndex& c,
     if (e.d2 >= best2) continue;
     if (e.level == depth_) {
       best2 = e.d2;  // a voxel of the set: its box distance is the exact distance
+      if (nearest) {
+        cellBox(e.level, e.cell, lo, hi);
+        *nearest = p.cwiseMax(lo).cwiseMin(hi);
+      }
       continue;
     }
     Entry kids[8];
