@@ -13,7 +13,8 @@ using visualization_msgs::Marker;
 // Spheres whose radii differ by less than this ratio share one SPHERE_LIST,
 // drawn at the group's largest radius (never smaller than the true sphere).
 constexpr double kRadiusGroupRatio = 1.03;
-constexpr float kLevelAlpha = 0.35f;
+// Coarse levels fainter than fine ones, so two levels drawn together both read.
+float levelAlpha(int level) { return level <= 1 ? 0.3f : 0.5f; }
 constexpr double kVoxelFill = 0.94;  // cubes a little smaller than the voxel: the grid shows
 constexpr int kContactClasses = 4;   // contact sphere sizes, by priority relative to the tick's largest
 
@@ -29,15 +30,15 @@ std_msgs::ColorRGBA rgba(float r, float g, float b, float a) {
 // One hue per level, so neighbouring levels read apart.
 std_msgs::ColorRGBA levelColor(int level) {
   static const std::array<std::array<float, 3>, 8> kHues{{{1.0f, 1.0f, 1.0f},
-                                                          {0.2f, 0.5f, 1.0f},
-                                                          {0.1f, 0.9f, 0.5f},
+                                                          {0.25f, 0.55f, 1.0f},
+                                                          {0.1f, 1.0f, 0.75f},
                                                           {1.0f, 0.8f, 0.1f},
                                                           {1.0f, 0.3f, 0.3f},
                                                           {0.7f, 0.3f, 1.0f},
                                                           {0.2f, 0.9f, 0.9f},
                                                           {0.9f, 0.5f, 0.8f}}};
   const auto& h = kHues[static_cast<std::size_t>(level) % kHues.size()];
-  return rgba(h[0], h[1], h[2], kLevelAlpha);
+  return rgba(h[0], h[1], h[2], levelAlpha(level));
 }
 
 const std_msgs::ColorRGBA kResolvedColor = rgba(0.2f, 0.9f, 0.2f, 1.0f);
