@@ -19,6 +19,15 @@ struct Contact {
   int level = 0;                // deepest tree level the pair reached
   bool resolved = false;        // true: found at the leaves; false: accepted unresolved
   double priority = 0.0;        // perceptual priority f(e, g) (0 without gaze)
+  // Signed gap between the two shapes' surfaces along the normal (< 0:
+  // penetration), each surface taken where its sphere's voxel box ends
+  // (ShapeBounds::support in response.hpp): what the solver acts on.
+  double separation = 0.0;
+  std::int32_t node_a = 0;      // sphere pair the contact was built from (tree node indices)
+  std::int32_t node_b = 0;
+  // Filled in by the solver: impulses applied at the point this tick (N s, world).
+  double normal_impulse = 0.0;
+  Vec3 friction_impulse = Vec3::Zero();
 };
 
 }  // namespace stc

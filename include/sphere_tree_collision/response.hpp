@@ -1,0 +1,269 @@
+// Response (paper 3.5, 4): contacts from the deepest intersecting sphere pairs
+// of each colliding PairTest, impulses with restitution and Coulomb friction
+// computed for all contacts before they are applied, split-impulse position
+// correction, and a swept test that stops fast bodies at their first contact.
+//
+// Everything here also works without a World: the free functions and classes
+// take flat std::vector<BodyState> / std::vector<Contact> arrays.
+#pragma once
+
+#include "sphere_tree_collision/body.hpp"
+#include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/dynamics.hpp"
+#include "sphere_tree_collision/pair_test.hpp"
+#include "sphere_tree_collision/voxel_shape.hpp"
+
+#include <algorithm>
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace stc {
+
+struct ShapeInfo;  // world.hpp
+
+// How the impulses of one tick are iterated (docs/response.md has the measurements).
+enum class SolverKind : std::uint8_t {
+  Sequential,  // projected Gauss-Seidel (sequential impulses): each contact sees the last one's impulse
+  Jacobi,      // the paper's simultaneous scheme: every iteration computes all impulses from
+               // one state, then applies them together (mass splitting keeps it convergent)
+};
+// "sequential" | "jacobi"; throws InputError("solver") otherwise.
+SolverKind parseSolverKind(const std::string& name);
+const char* toString(SolverKind kind);
+
+struct ResponseOptions {
+  bool enabled = true;
+  int iterations = 20;                  // velocity (and position) iterations per tick, >= 1
+  // m/s: slower approach is treated as resting. The World raises it to at
+  // least 4 |g| dt: a body resting under gravity falls that fast within a
+  // speculative gap in one or two ticks, and bouncing on that would never settle.
+  double restitution_threshold = 0.2;
+  double position_correction = 0.2;     // fraction of penetration removed per tick, [0, 1]
+  double allowed_penetration = 0.0;     // metres kept as slop (0: 2% of the contact's leaf radius)
+  SolverKind solver = SolverKind::Sequential;
+  bool warm_starting = true;            // start from last tick's impulses of matching contacts
+  int max_contacts_per_pair = 4;        // spread-out representatives of the sphere pairs, 1..16
+  bool face_normals = true;             // voxel-box face axis when it separates more (ContactBuilder)
+  bool continuous = true;               // sweep fast bodies back to their first contact
+  // A body is fast when it moves (incl. rotation at its farthest sphere) more
+  // than this fraction of its smallest leaf radius in one tick.
+  double sweep_threshold = 0.5;
+  bool gyroscopic = true;               // implicit-midpoint w x Iw (see dynamics.hpp)
+};
+// Throws InputError naming the field ("response.iterations", ...).
+void validateResponseOptions(const ResponseOptions& options);
+
+// ---------------------------------------------------------------------------
+// Per-shape bounds, computed once per shape
+
+// Where the shape is inside each node's sphere. A sphere only says the shape
+// lies within r of its centre (up to h inside for a leaf); the voxels whose
+// centres lie in the sphere also bound it by their axis-aligned box (body
+// frame). The surface of the node towards a direction u is then taken at
+// support(u) = min(r, box support): an outer bound (never lets shapes
+// interpenetrate) that is exact for a single-voxel leaf (a cube), and for any
+// leaf face-on, where r alone leaves a gap of up to h.
+struct ShapeBounds {
+  const SphereTree* tree = nullptr;
+  std::vector<Vec3> box_offset;  // per node: box centre minus sphere centre (body frame)
+  std::vector<Vec3> box_half;    // per node: box half extents
+  std::vector<double> reach;     // per node: max over its leaves of |c_leaf - c_node| + r_leaf
+  double min_leaf_radius = 0.0;
+  double bound_radius = 0.0;     // max over leaves of |c_leaf| + r_leaf (about the body origin)
+
+  // Distance from node's centre to its surface towards `direction_body` (unit, body frame).
+  double support(std::int32_t node, const Vec3& direction_body) const {
+    const std::size_t i = static_cast<std::size_t>(node);
+    const double box = box_offset[i].dot(direction_body) + box_half[i].dot(direction_body.cwiseAbs());
+    return std::min(tree->node(node).radius, box);
+  }
+};
+// voxels == nullptr: boxes are the spheres' cubes (support = r). body_origin:
+// the grid-frame point the tree was built about (ShapeInfo::body_origin).
+ShapeBounds makeShapeBounds(const SphereTree& tree, const VoxelShape* voxels = nullptr,
+                            const Vec3& body_origin = Vec3::Zero());
+
+// ---------------------------------------------------------------------------
+// Contacts
+
+struct ContactBuildOptions {
+  int max_contacts_per_pair = 4;
+  bool accept_unresolved = true;  // policy accept: unresolved pairs give contacts too
+  bool face_normals = true;       // see ContactBuilder; false: the paper's line of centres only
+};
+
+// Builds the contacts of PairTests. Candidates are the test's lastPairs()
+// (leaf pairs when Colliding, the frontier when accepted Unresolved, the roots
+// when no sphere was tested). Per candidate (paper Fig. 4): normal along the
+// line of centres a -> b, point dividing the centres in proportion to the
+// radii. With face_normals and ShapeBounds, a face axis of either node's voxel
+// box replaces the line of centres when it separates the two nodes more (the
+// separating-axis rule): face-on, the line of centres of two voxel spheres
+// tilts by up to 45 degrees, making floors bumpy and balls sit in dimples.
+// Up to max_contacts_per_pair representatives are picked spread out among the
+// deep candidates (deepest corner first, then farthest, then largest
+// triangle); every candidate joins its nearest representative, whose normal
+// becomes the overlap^2-weighted mean of its members' normals. separation is
+// measured along that normal between the nodes' surfaces
+// (ShapeBounds::support; the sphere itself without bounds). Coincident
+// centres: the direction between the body centres, then +Z; never NaN.
+class ContactBuilder {
+ public:
+  // Appends the contacts of one test (none when Separate, or Unresolved and not accepted).
+  // bounds_a/bounds_b: of the test's trees, or nullptr (surface at the spheres).
+  void append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b, double priority,
+              const ShapeBounds* bounds_a, const ShapeBounds* bounds_b,
+              const ContactBuildOptions& options, std::vector<Contact>& out);
+
+ private:
+  struct Candidate {
+    Vec3 ca, cb, point, normal;
+    double overlap = 0.0;                     // r_a + r_b - |c_b - c_a|
+    double separation = 0.0;                  // gap between the surfaces along normal
+    std::int32_t node_a = 0, node_b = 0;
+    int cluster = 0;
+  };
+  std::vector<Candidate> candidates_;
+  std::vector<int> reps_;
+  std::vector<double> deepest_of_a_, deepest_of_b_;  // per tree node; -inf when untouched
+};
+
+// ---------------------------------------------------------------------------
+// Impulses
+
+struct SolveStats {
+  std::size_t contacts = 0;
+  std::size_t warm_started = 0;     // contacts that found last tick's impulse
+  std::size_t bounced = 0;          // contacts that got a restitution impulse
+  double max_penetration = 0.0;     // max(-separation) over the contacts, metres
+};
+
+// Velocity solve: non-penetration (speculative: a contact with a gap s > 0
+// lets the bodies close at most s/dt this tick), Coulomb friction (circular
+// cone, friction = sqrt(mu_a mu_b)), then restitution (e = max(e_a, e_b)) for
+// contacts that were approaching faster than the threshold and took an
+// impulse. Position correction by split impulse: pseudo-velocities that move
+// the bodies out of penetration and are then discarded, so no kinetic energy
+// is added. Contacts' normal_impulse/friction_impulse are filled in.
+class ContactSolver {
+ public:
+  SolveStats solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
+                   const ResponseOptions& options, double dt);
+  void forget() { cache_.clear(); }  // drop warm-start impulses
+
+ private:
+  // One contact's constraint rows: normal, two tangents.
+  struct Row {
+    std::uint32_t a = 0, b = 0;
+    std::uint32_t contact = 0;  // index into the contacts array
+    Vec3 ra, rb;  // contact point relative to the centres of mass
+    Vec3 n, t1, t2;
+    // Angular velocity change per unit impulse along n, t1, t2 (I^-1 (r x d)).
+    Vec3 ang_a[3], ang_b[3];
+    double inv_ma = 0.0, inv_mb = 0.0;
+    double mass[3] = {0.0, 0.0, 0.0};  // 1 / effective mass along n, t1, t2
+    double friction = 0.0, restitution = 0.0;
+    double approach = 0.0;     // normal relative velocity before the solve (< 0: closing)
+    double speculative = 0.0;  // closing speed allowed by a gap: max(s, 0) / dt
+    double push = 0.0;         // split impulse: target normal pseudo-velocity
+    double lambda[3] = {0.0, 0.0, 0.0};
+    double lambda_main = 0.0;  // normal impulse before restitution (what warm starts)
+    double lambda_push = 0.0;
+    bool bounced = false;      // took a restitution impulse this tick
+  };
+  struct Cached {
+    EntityId a = kInvalidEntity, b = kInvalidEntity;
+    Vec3 local_a = Vec3::Zero();  // contact point in body A's frame
+    double normal = 0.0;
+    Vec3 friction = Vec3::Zero();  // world frame
+  };
+  void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
+               const ResponseOptions& options, double dt, SolveStats& stats);
+  void orderFromTheGround(const std::vector<BodyState>& bodies);
+  void warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
+                 SolveStats& stats);
+  void solveVelocities(const ResponseOptions& options);
+  void applyRestitution(const ResponseOptions& options, SolveStats& stats);
+  void solvePositions(const ResponseOptions& options);
+  void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
+
+  std::vector<Row> rows_;
+  std::vector<Vec3> v_, w_;    // solver velocities, one per body
+  std::vector<Vec3> dv_, dw_;  // Jacobi: impulses of one iteration, applied together
+  std::vector<Vec3> pv_, pw_;  // split-impulse pseudo-velocities
+  std::vector<int> contact_count_;
+  std::vector<int> depth_, adjacency_start_, fill_;  // contact graph, for the row order
+  std::vector<std::uint32_t> adjacency_, queue_;
+  std::vector<Cached> cache_, next_cache_;
+};
+
+// One-shot solve without warm starting (tests, tools).
+SolveStats solveContacts(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
+                         const ResponseOptions& options, double dt);
+
+// ---------------------------------------------------------------------------
+// Anti-tunnelling: swept test of fast bodies (paper: backtrack to the instant
+// of collision)
+
+struct SweepStats {
+  std::size_t fast_bodies = 0;
+  std::size_t clamped = 0;  // moved back to their first contact
+};
+
+// Bodies moved from start[i] to bodies[i].pose this tick. A fast body (see
+// ResponseOptions::sweep_threshold) has its leaves' voxel boxes swept along
+// the chord from their start to their end position against the leaves of
+// every other body at its end pose (hierarchy pruned by ShapeBounds::reach).
+// At the first instant a pair of boxes overlaps deeper than a quarter of the
+// thinner box (the full spheres then overlap, so the narrow phase reports the
+// contact) the body is put back there (position lerp, orientation slerp).
+// Pairs already overlapping at the start are resting contacts, left to the
+// solver. The velocity is kept: the response of this same tick turns it.
+// shapes[i] may be nullptr (the body is never hit).
+SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
+                           const std::vector<const ShapeBounds*>& shapes, double threshold);
+
+// ---------------------------------------------------------------------------
+// The World's physics: integrate and respond, keeping what lasts between
+// ticks (warm-start impulses by entity id, per-shape sweep data, scratch).
+
+struct PhysicsReport {
+  SweepStats sweep;
+  SolveStats solve;
+};
+
+class Physics {
+ public:
+  // Voxels, tree and body origin of a shape id; called once per new shape.
+  using ShapeOf = std::function<const ShapeInfo&(std::uint32_t shape)>;
+
+  // Tick phase 1: positions, sweep of fast bodies, velocities.
+  void integrate(std::vector<BodyState>& bodies, const std::vector<std::uint32_t>& body_shapes,
+                 const ShapeOf& shape_of, const Vec3& gravity, const ResponseOptions& options,
+                 double dt);
+  // Tick phase 4: contacts of tests[0..count) (pair_bodies: dense indices of
+  // each test's bodies), then impulses when options.enabled.
+  void respond(const std::vector<PairTest>& tests, std::size_t count,
+               const std::vector<std::array<std::uint32_t, 2>>& pair_bodies,
+               const std::vector<double>& priorities, bool accept_unresolved,
+               const std::vector<std::uint32_t>& body_shapes, const ShapeOf& shape_of,
+               std::vector<BodyState>& bodies, const ResponseOptions& options, double dt,
+               std::vector<Contact>& contacts);
+  const PhysicsReport& lastReport() const { return report_; }
+  void forget() { solver_.forget(); }
+
+ private:
+  const ShapeBounds& boundsOf(std::uint32_t shape, const ShapeOf& shape_of);
+
+  ContactBuilder builder_;
+  ContactSolver solver_;
+  double gravity_speed_ = 0.0;  // |g| dt of the last integrate
+  std::vector<ShapeBounds> bounds_;  // by shape id, built on first use
+  std::vector<Pose> start_;
+  std::vector<const ShapeBounds*> body_bounds_;
+  PhysicsReport report_;
+};
+
+}  // namespace stc

@@ -1,0 +1,398 @@
+// Impulse solver: non-penetration + Coulomb friction, restitution, split-impulse
+// position correction; sequential (Gauss-Seidel) or simultaneous (Jacobi).
+#include "sphere_tree_collision/response.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace stc {
+
+namespace {
+
+// Two unit tangents completing n (n unit).
+void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+  t1 = std::abs(n.x()) < 0.57735 ? Vec3(0.0, n.z(), -n.y()) : Vec3(n.y(), -n.x(), 0.0);
+  t1.normalize();
+  t2 = n.cross(t1);
+}
+
+}  // namespace
+
+SolverKind parseSolverKind(const std::string& name) {
+  if (name == "sequential") return SolverKind::Sequential;
+  if (name == "jacobi") return SolverKind::Jacobi;
+  throw InputError("solver", "unknown solver '" + name + "' (sequential | jacobi)");
+}
+
+const char* toString(SolverKind kind) {
+  return kind == SolverKind::Jacobi ? "jacobi" : "sequential";
+}
+
+void validateResponseOptions(const ResponseOptions& o) {
+  if (o.iterations < 1 || o.iterations > 1000) {
+    throw InputError("response.iterations", "must be in [1, 1000]");
+  }
+  if (!(o.restitution_threshold >= 0.0 && std::isfinite(o.restitution_threshold))) {
+    throw InputError("response.restitution_threshold", "must be finite and >= 0");
+  }
+  if (!(o.position_correction >= 0.0 && o.position_correction <= 1.0)) {
+    throw InputError("response.position_correction", "must be in [0, 1]");
+  }
+  if (!(o.allowed_penetration >= 0.0 && std::isfinite(o.allowed_penetration))) {
+    throw InputError("response.allowed_penetration", "must be finite and >= 0");
+  }
+  if (o.max_contacts_per_pair < 1 || o.max_contacts_per_pair > 16) {
+    throw InputError("response.max_contacts_per_pair", "must be in [1, 16]");
+  }
+  if (!(o.sweep_threshold > 0.0 && std::isfinite(o.sweep_threshold))) {
+    throw InputError("response.sweep_threshold", "must be finite and > 0");
+  }
+}
+
+void ContactSolver::prepare(const std::vector<BodyState>& bodies,
+                            const std::vector<Contact>& contacts, const ResponseOptions& options,
+                            double dt, SolveStats& stats) {
+  const std::size_t body_count = bodies.size();
+  v_.resize(body_count);
+  w_.resize(body_count);
+  pv_.assign(body_count, Vec3::Zero());
+  pw_.assign(body_count, Vec3::Zero());
+  contact_count_.assign(body_count, 0);
+  for (std::size_t i = 0; i < body_count; ++i) {
+    v_[i] = bodies[i].linear_velocity;
+    w_[i] = bodies[i].angular_velocity;
+  }
+  const bool jacobi = options.solver == SolverKind::Jacobi;
+  if (jacobi) {
+    dv_.assign(body_count, Vec3::Zero());
+    dw_.assign(body_count, Vec3::Zero());
+  }
+  for (const Contact& c : contacts) {
+    ++contact_count_[c.index_a];
+    ++contact_count_[c.index_b];
+  }
+
+  rows_.clear();
+  for (std::size_t ci = 0; ci < contacts.size(); ++ci) {
+    const Contact& c = contacts[ci];
+    const BodyState& ba = bodies[c.index_a];
+    const BodyState& bb = bodies[c.index_b];
+    Row row;
+    row.contact = static_cast<std::uint32_t>(ci);
+    row.a = c.index_a;
+    row.b = c.index_b;
+    row.inv_ma = ba.is_static ? 0.0 : ba.inv_mass;
+    row.inv_mb = bb.is_static ? 0.0 : bb.inv_mass;
+    if (row.inv_ma == 0.0 && row.inv_mb == 0.0) continue;  // two immovable bodies
+    row.ra = c.point - ba.pose.position;
+    row.rb = c.point - bb.pose.position;
+    row.n = c.normal;
+    tangents(row.n, row.t1, row.t2);
+    const Vec3 dirs[3] = {row.n, row.t1, row.t2};
+    // Mass splitting (Jacobi): each body's inverse mass counts once per contact on it.
+    const double split_a = jacobi ? std::max(1, contact_count_[row.a]) : 1.0;
+    const double split_b = jacobi ? std::max(1, contact_count_[row.b]) : 1.0;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 rxd_a = row.ra.cross(dirs[k]);
+      const Vec3 rxd_b = row.rb.cross(dirs[k]);
+      row.ang_a[k] = ba.is_static ? Vec3::Zero() : Vec3(ba.inv_inertia_world * rxd_a);
+      row.ang_b[k] = bb.is_static ? Vec3::Zero() : Vec3(bb.inv_inertia_world * rxd_b);
+      const double ka = row.inv_ma + rxd_a.dot(row.ang_a[k]);
+      const double kb = row.inv_mb + rxd_b.dot(row.ang_b[k]);
+      const double k_total = split_a * ka + split_b * kb;
+      row.mass[k] = k_total > 0.0 ? 1.0 / k_total : 0.0;
+    }
+    row.friction = std::sqrt(std::max(0.0, ba.material.friction * bb.material.friction));
+    row.restitution = std::max(ba.material.restitution, bb.material.restitution);
+    const Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
+    row.approach = vrel.dot(row.n);
+    const double s = c.separation;
+    row.speculative = s > 0.0 ? s / dt : 0.0;
+    const double slop = options.allowed_penetration > 0.0 ? options.allowed_penetration
+                                                          : 0.02 * c.gap_bound;
+    if (s < -slop) {
+      row.push = options.position_correction * (-s - slop) / dt;
+    } else {
+      row.push = s > 0.0 ? -s / dt : 0.0;  // pseudo-velocities may close a gap, never open one
+    }
+    stats.max_penetration = std::max(stats.max_penetration, -s);
+    rows_.push_back(row);
+  }
+  stats.contacts = rows_.size();
+  orderFromTheGround(bodies);
+}
+
+// Gauss-Seidel converges fastest on a stack when the support is solved
+// before what it supports: rows sorted by the contact-graph distance of their
+// lower body from an immovable one (breadth-first from the static bodies).
+// Jacobi is order-independent and skips this.
+void ContactSolver::orderFromTheGround(const std::vector<BodyState>& bodies) {
+  const std::size_t body_count = bodies.size();
+  constexpr int kUnreached = std::numeric_limits<int>::max();
+  depth_.assign(body_count, kUnreached);
+  // Adjacency as CSR: rows touching each body.
+  adjacency_start_.assign(body_count + 1, 0);
+  for (const Row& row : rows_) {
+    ++adjacency_start_[row.a + 1];
+    ++adjacency_start_[row.b + 1];
+  }
+  for (std::size_t i = 0; i < body_count; ++i) adjacency_start_[i + 1] += adjacency_start_[i];
+  adjacency_.resize(2 * rows_.size());
+  fill_.assign(adjacency_start_.begin(), adjacency_start_.end() - 1);
+  for (std::uint32_t r = 0; r < rows_.size(); ++r) {
+    adjacency_[static_cast<std::size_t>(fill_[rows_[r].a]++)] = r;
+    adjacency_[static_cast<std::size_t>(fill_[rows_[r].b]++)] = r;
+  }
+  queue_.clear();
+  for (const Row& row : rows_) {
+    for (const std::uint32_t i : {row.a, row.b}) {
+      if (depth_[i] == kUnreached && (bodies[i].is_static || bodies[i].inv_mass == 0.0)) {
+        depth_[i] = 0;
+        queue_.push_back(i);
+      }
+    }
+  }
+  for (std::size_t q = 0; q < queue_.size(); ++q) {
+    const std::uint32_t i = queue_[q];
+    for (int k = adjacency_start_[i]; k < adjacency_start_[i + 1]; ++k) {
+      const Row& row = rows_[adjacency_[static_cast<std::size_t>(k)]];
+      const std::uint32_t other = row.a == i ? row.b : row.a;
+      if (depth_[other] == kUnreached) {
+        depth_[other] = depth_[i] + 1;
+        queue_.push_back(other);
+      }
+    }
+  }
+  const auto level = [&](const Row& row) { return std::min(depth_[row.a], depth_[row.b]); };
+  std::stable_sort(rows_.begin(), rows_.end(),
+                   [&](const Row& x, const Row& y) { return level(x) < level(y); });
+}
+
+void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
+                              SolveStats& stats) {
+  if (cache_.empty()) return;
+  const auto by_pair = [](const Cached& x, const Cached& y) {
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  };
+  for (std::size_t r = 0; r < rows_.size(); ++r) {
+    const Contact& c = contacts[rows_[r].contact];
+    Row& row = rows_[r];
+    Cached key;
+    key.a = c.a;
+    key.b = c.b;
+    const auto range = std::equal_range(cache_.begin(), cache_.end(), key, by_pair);
+    if (range.first == range.second) continue;
+    const BodyState& ba = bodies[row.a];
+    const Vec3 local = ba.pose.orientation.conjugate() * (c.point - ba.pose.position);
+    const double tolerance = std::max(0.5 * c.gap_bound, 1e-12);
+    const Cached* best = nullptr;
+    double best_d = tolerance * tolerance;
+    for (auto it = range.first; it != range.second; ++it) {
+      const double d = (it->local_a - local).squaredNorm();
+      if (d <= best_d) {
+        best_d = d;
+        best = &*it;
+      }
+    }
+    if (best == nullptr) continue;
+    row.lambda[0] = best->normal;
+    row.lambda[1] = best->friction.dot(row.t1);
+    row.lambda[2] = best->friction.dot(row.t2);
+    const Vec3 p = row.lambda[0] * row.n + row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
+    v_[row.a] -= row.inv_ma * p;
+    v_[row.b] += row.inv_mb * p;
+    for (int k = 0; k < 3; ++k) {
+      w_[row.a] -= row.lambda[k] * row.ang_a[k];
+      w_[row.b] += row.lambda[k] * row.ang_b[k];
+    }
+    ++stats.warm_started;
+  }
+}
+
+void ContactSolver::solveVelocities(const ResponseOptions& options) {
+  const bool jacobi = options.solver == SolverKind::Jacobi;
+  std::vector<Vec3>& out_v = jacobi ? dv_ : v_;
+  std::vector<Vec3>& out_w = jacobi ? dw_ : w_;
+  for (int it = 0; it < options.iterations; ++it) {
+    for (Row& row : rows_) {
+      // Friction first, bounded by the normal impulse so far (Box2D order).
+      Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
+      const double limit = row.friction * row.lambda[0];
+      const double t1 = row.lambda[1] - row.mass[1] * vrel.dot(row.t1);
+      const double t2 = row.lambda[2] - row.mass[2] * vrel.dot(row.t2);
+      const double tn = std::hypot(t1, t2);
+      const double scale = tn > limit ? (tn > 0.0 ? limit / tn : 0.0) : 1.0;
+      const double d1 = t1 * scale - row.lambda[1];
+      const double d2 = t2 * scale - row.lambda[2];
+      row.lambda[1] += d1;
+      row.lambda[2] += d2;
+      const Vec3 pt = d1 * row.t1 + d2 * row.t2;
+      out_v[row.a] -= row.inv_ma * pt;
+      out_v[row.b] += row.inv_mb * pt;
+      out_w[row.a] -= d1 * row.ang_a[1] + d2 * row.ang_a[2];
+      out_w[row.b] += d1 * row.ang_b[1] + d2 * row.ang_b[2];
+
+      // Non-penetration (Jacobi: from the same state as the friction above).
+      if (!jacobi) vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
+      const double normal =
+          std::max(0.0, row.lambda[0] + row.mass[0] * (-row.speculative - vrel.dot(row.n)));
+      const double dn = normal - row.lambda[0];
+      row.lambda[0] = normal;
+      out_v[row.a] -= row.inv_ma * dn * row.n;
+      out_v[row.b] += row.inv_mb * dn * row.n;
+      out_w[row.a] -= dn * row.ang_a[0];
+      out_w[row.b] += dn * row.ang_b[0];
+    }
+    if (jacobi) {
+      for (std::size_t i = 0; i < v_.size(); ++i) {
+        v_[i] += dv_[i];
+        w_[i] += dw_[i];
+        dv_[i].setZero();
+        dw_[i].setZero();
+      }
+    }
+  }
+  for (Row& row : rows_) row.lambda_main = row.lambda[0];
+}
+
+void ContactSolver::applyRestitution(const ResponseOptions& options, SolveStats& stats) {
+  const bool jacobi = options.solver == SolverKind::Jacobi;
+  std::vector<Vec3>& out_v = jacobi ? dv_ : v_;
+  std::vector<Vec3>& out_w = jacobi ? dw_ : w_;
+  bool any = false;
+  for (const Row& row : rows_) {
+    if (row.approach < -options.restitution_threshold && row.restitution > 0.0 && row.lambda[0] > 0.0) {
+      any = true;
+      ++stats.bounced;
+    }
+  }
+  if (!any) return;
+  for (int it = 0; it < options.iterations; ++it) {
+    for (Row& row : rows_) {
+      if (!(row.approach < -options.restitution_threshold && row.restitution > 0.0 &&
+            row.lambda_main > 0.0)) {
+        continue;
+      }
+      const Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
+      row.bounced = true;
+      const double target = -row.restitution * row.approach;
+      const double normal = std::max(0.0, row.lambda[0] + row.mass[0] * (target - vrel.dot(row.n)));
+      const double delta = normal - row.lambda[0];
+      row.lambda[0] = normal;
+      out_v[row.a] -= row.inv_ma * delta * row.n;
+      out_v[row.b] += row.inv_mb * delta * row.n;
+      out_w[row.a] -= delta * row.ang_a[0];
+      out_w[row.b] += delta * row.ang_b[0];
+    }
+    if (jacobi) {
+      for (std::size_t i = 0; i < v_.size(); ++i) {
+        v_[i] += dv_[i];
+        w_[i] += dw_[i];
+        dv_[i].setZero();
+        dw_[i].setZero();
+      }
+    }
+  }
+}
+
+void ContactSolver::solvePositions(const ResponseOptions& options) {
+  bool any = false;
+  for (const Row& row : rows_) any = any || row.push > 0.0 || (row.bounced && row.push < 0.0);
+  if (!any) return;
+  const bool jacobi = options.solver == SolverKind::Jacobi;
+  std::vector<Vec3>& out_v = jacobi ? dv_ : pv_;
+  std::vector<Vec3>& out_w = jacobi ? dw_ : pw_;
+  for (int it = 0; it < options.iterations; ++it) {
+    for (Row& row : rows_) {
+      const Vec3 vrel =
+          pv_[row.b] + pw_[row.b].cross(row.rb) - pv_[row.a] - pw_[row.a].cross(row.ra);
+      // A contact that bounced across a speculative gap also closes the gap
+      // (may pull): the bounce starts at the surface, not where the gap
+      // was seen, so the rebound height does not gain up to |v| dt.
+      const double unclamped = row.lambda_push + row.mass[0] * (row.push - vrel.dot(row.n));
+      const double normal = row.bounced && row.push < 0.0 ? unclamped : std::max(0.0, unclamped);
+      const double delta = normal - row.lambda_push;
+      row.lambda_push = normal;
+      out_v[row.a] -= row.inv_ma * delta * row.n;
+      out_v[row.b] += row.inv_mb * delta * row.n;
+      out_w[row.a] -= delta * row.ang_a[0];
+      out_w[row.b] += delta * row.ang_b[0];
+    }
+    if (jacobi) {
+      for (std::size_t i = 0; i < pv_.size(); ++i) {
+        pv_[i] += dv_[i];
+        pw_[i] += dw_[i];
+        dv_[i].setZero();
+        dw_[i].setZero();
+      }
+    }
+  }
+}
+
+void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
+                          double dt) {
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    BodyState& body = bodies[i];
+    if (body.is_static) continue;
+    body.linear_velocity = v_[i];
+    body.angular_velocity = w_[i];
+    if (!pv_[i].isZero(0.0) || !pw_[i].isZero(0.0)) {
+      body.pose.position += pv_[i] * dt;
+      if (!pw_[i].isZero(0.0)) {
+        body.pose.orientation = integrateOrientation(body.pose.orientation, pw_[i], dt);
+        refreshWorldInertia(body);
+      }
+    }
+  }
+
+  // Report impulses on the contacts and keep them for next tick's warm start.
+  next_cache_.clear();
+  for (const Row& row : rows_) {
+    Contact& c = contacts[row.contact];
+    c.normal_impulse = row.lambda[0];
+    c.friction_impulse = row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
+    Cached cached;
+    cached.a = c.a;
+    cached.b = c.b;
+    const BodyState& ba = bodies[row.a];
+    cached.local_a = ba.pose.orientation.conjugate() * (c.point - ba.pose.position);
+    cached.normal = row.lambda_main;
+    cached.friction = c.friction_impulse;
+    next_cache_.push_back(cached);
+  }
+  std::sort(next_cache_.begin(), next_cache_.end(), [](const Cached& x, const Cached& y) {
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  });
+  cache_.swap(next_cache_);
+}
+
+SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
+                                const ResponseOptions& options, double dt) {
+  SolveStats stats;
+  if (!(dt > 0.0) || bodies.empty()) return stats;
+  for (Contact& c : contacts) {
+    c.normal_impulse = 0.0;
+    c.friction_impulse.setZero();
+  }
+  prepare(bodies, contacts, options, dt, stats);
+  if (rows_.empty()) {
+    cache_.clear();
+    return stats;
+  }
+  if (options.warm_starting) warmStart(contacts, bodies, stats);
+  solveVelocities(options);
+  applyRestitution(options, stats);
+  solvePositions(options);
+  store(bodies, contacts, dt);
+  if (!options.warm_starting) cache_.clear();
+  return stats;
+}
+
+SolveStats solveContacts(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
+                         const ResponseOptions& options, double dt) {
+  ContactSolver solver;
+  return solver.solve(bodies, contacts, options, dt);
+}
+
+}  // namespace stc
