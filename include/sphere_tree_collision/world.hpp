@@ -8,6 +8,7 @@
 #include "sphere_tree_collision/contact.hpp"
 #include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
+#include "sphere_tree_collision/response.hpp"
 #include "sphere_tree_collision/scheduler.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/sweep_and_prune.hpp"
@@ -33,14 +34,6 @@ enum class BoxMode : std::uint8_t {
 };
 // "auto" | "fixed" | "dynamic"; throws InputError("box_mode").
 BoxMode parseBoxMode(const std::string& name);
-
-struct ResponseOptions {
-  bool enabled = true;
-  int iterations = 10;                  // solver iterations per tick
-  double restitution_threshold = 0.2;   // m/s: slower approach is treated as resting
-  double position_correction = 0.2;     // fraction of penetration removed per tick
-  double allowed_penetration = 0.0;     // metres kept as slop (0: derive from voxel size)
-};
 
 struct WorldConfig {
   Vec3 gravity = Vec3::Zero();
@@ -143,6 +136,8 @@ class World {
   const std::vector<PairTest>& pairTests() const { return pair_tests_; }
   std::size_t pairCount() const { return pair_count_; }
   const std::vector<Contact>& contacts() const { return contacts_; }
+  // What the physics did in the last step: fast bodies swept back, solver stats.
+  const PhysicsReport& physicsReport() const { return physics_.lastReport(); }
 
  private:
   // Phases, in tick order.
@@ -178,6 +173,7 @@ class World {
   std::vector<std::array<std::uint32_t, 2>> pair_bodies_;  // dense indices of each pair test's bodies
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
   std::vector<Contact> contacts_;
+  Physics physics_;  // integration and response (response.hpp), warm-start state
 };
 
 }  // namespace stc

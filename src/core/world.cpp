@@ -268,20 +268,10 @@ TickReport World::step(double dt, const Budget& budget) {
   return report;
 }
 
-// Kinematic: poses follow the velocities; static bodies never move.
+// Semi-implicit Euler with a swept test for fast bodies (response.hpp).
 void World::integrate(double dt, TickReport& /*report*/) {
-  for (BodyState& body : bodies_) {
-    if (body.is_static) continue;
-    body.pose.position += body.linear_velocity * dt;
-    const double speed = body.angular_velocity.norm();
-    if (speed > 0.0) {
-      // World-frame angular velocity: rotate by |w| dt about w, pre-multiplied.
-      const Quat turn(Eigen::AngleAxisd(speed * dt, body.angular_velocity / speed));
-      body.pose.orientation = (turn * body.pose.orientation).normalized();
-    }
-    const Mat3 r = body.pose.orientation.toRotationMatrix();
-    body.inv_inertia_world = r * body.inv_inertia_body * r.transpose();
-  }
+  physics_.integrate(bodies_, body_shapes_, [this](ShapeId s) -> const ShapeInfo& { return shapes_[s]; },
+                     config_.gravity, config_.response, dt);
 }
 
 Aabb World::boxOf(std::size_t index) const {
@@ -375,17 +365,13 @@ void World::narrowPhase(const Budget& budget, TickReport& report) {
   }
 }
 
-// Contacts only for now: one per colliding or accepted pair, from its deepest
-// intersecting sphere pair (paper Fig. 4). Impulses come with the dynamics.
-void World::response(double /*dt*/, TickReport& /*report*/) {
-  contacts_.clear();
-  const bool accept = config_.unresolved_policy == UnresolvedPolicy::Accept;
-  for (std::size_t i = 0; i < pair_count_; ++i) {
-    const PairTest& test = pair_tests_[i];
-    const bool colliding = test.status() == PairStatus::Colliding;
-    if (!colliding && !(accept && test.status() == PairStatus::Unresolved)) continue;
-    contacts_.push_back(makeContact(test, pair_bodies_[i][0], pair_bodies_[i][1], pair_priority_[i]));
-  }
+// Contacts from the deepest sphere pairs of each colliding or accepted pair,
+// then impulses and position correction (response.hpp).
+void World::response(double dt, TickReport& /*report*/) {
+  physics_.respond(pair_tests_, pair_count_, pair_bodies_, pair_priority_,
+                   config_.unresolved_policy == UnresolvedPolicy::Accept, body_shapes_,
+                   [this](ShapeId s) -> const ShapeInfo& { return shapes_[s]; }, bodies_,
+                   config_.response, dt, contacts_);
 }
 
 Contact makeContact(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b,

@@ -1,0 +1,75 @@
+// Physics: the World's integrate and response phases over its flat arrays.
+#include "sphere_tree_collision/response.hpp"
+
+#include "sphere_tree_collision/world.hpp"
+
+#include <algorithm>
+
+namespace stc {
+namespace {
+
+// Approach slower than this many ticks of free fall is resting, not a bounce.
+constexpr double kRestingFallTicks = 4.0;
+
+}  // namespace
+
+const ShapeBounds& Physics::boundsOf(std::uint32_t shape, const ShapeOf& shape_of) {
+  // Built once per shape; the World keeps shapes in a deque, so trees never move.
+  if (shape >= bounds_.size()) bounds_.resize(shape + 1);
+  ShapeBounds& bounds = bounds_[shape];
+  if (bounds.tree == nullptr) {
+    const ShapeInfo& info = shape_of(shape);
+    bounds = makeShapeBounds(info.tree, &info.voxels, info.body_origin);
+  }
+  return bounds;
+}
+
+void Physics::integrate(std::vector<BodyState>& bodies, const std::vector<std::uint32_t>& body_shapes,
+                        const ShapeOf& shape_of, const Vec3& gravity, const ResponseOptions& options,
+                        double dt) {
+  report_.sweep = SweepStats{};
+  gravity_speed_ = gravity.norm() * dt;
+  const bool sweep = options.continuous && dt > 0.0;
+  if (sweep) {
+    start_.resize(bodies.size());
+    for (std::size_t i = 0; i < bodies.size(); ++i) start_[i] = bodies[i].pose;
+  }
+  integratePositions(bodies, dt);
+  if (sweep) {
+    for (const std::uint32_t shape : body_shapes) boundsOf(shape, shape_of);  // no resize below
+    body_bounds_.resize(bodies.size());
+    for (std::size_t i = 0; i < bodies.size(); ++i) body_bounds_[i] = &bounds_[body_shapes[i]];
+    report_.sweep = sweepFastBodies(bodies, start_, body_bounds_, options.sweep_threshold);
+  }
+  IntegrationOptions integration;
+  integration.gravity = gravity;
+  integration.gyroscopic = options.gyroscopic;
+  integrateVelocities(bodies, integration, dt);
+}
+
+void Physics::respond(const std::vector<PairTest>& tests, std::size_t count,
+                      const std::vector<std::array<std::uint32_t, 2>>& pair_bodies,
+                      const std::vector<double>& priorities, bool accept_unresolved,
+                      const std::vector<std::uint32_t>& body_shapes, const ShapeOf& shape_of,
+                      std::vector<BodyState>& bodies, const ResponseOptions& options, double dt,
+                      std::vector<Contact>& contacts) {
+  contacts.clear();
+  ContactBuildOptions build;
+  build.max_contacts_per_pair = options.max_contacts_per_pair;
+  build.accept_unresolved = accept_unresolved;
+  build.face_normals = options.face_normals;
+  for (const std::uint32_t shape : body_shapes) boundsOf(shape, shape_of);  // no resize below
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::uint32_t ia = pair_bodies[i][0];
+    const std::uint32_t ib = pair_bodies[i][1];
+    builder_.append(tests[i], ia, ib, priorities[i], &bounds_[body_shapes[ia]], &bounds_[body_shapes[ib]],
+                    build, contacts);
+  }
+  report_.solve = SolveStats{};
+  if (!options.enabled) return;
+  ResponseOptions solve = options;
+  solve.restitution_threshold = std::max(options.restitution_threshold, kRestingFallTicks * gravity_speed_);
+  report_.solve = solver_.solve(bodies, contacts, solve, dt);
+}
+
+}  // namespace stc
