@@ -77,7 +77,9 @@ struct PresetParams {
   std::uint32_t seed = 1;    // rock only
 };
 const std::vector<std::string>& presetNames();
-// Throws InputError("preset") for an unknown name, and the create() errors.
+// Throws InputError("preset") for an unknown name, InputError("resolution")
+// outside 1..256 (the ring needs >= 3 to have a hole), and the create() errors.
+// The rock is a seeded random blob, 6-connected, the same for the same seed.
 VoxelShape makePreset(const std::string& name, const PresetParams& params = PresetParams{},
                       const VoxelLimits& limits = VoxelLimits{});
 
