@@ -37,6 +37,7 @@ struct PairPerception {
   double gap_estimate_px = 0.0;  // |proj(cA) - proj(cB)| of the last intersecting centres
   double gap_bound_px = 0.0;     // (h_a + h_b) projected at the centre of collision's depth
   double priority = 0.0;         // f(e, gap_estimate_px)
+  double px_per_metre = 0.0;     // focal / depth of the centre of collision (0 behind the camera)
   bool visible = true;           // false: behind the camera or off screen (rule below)
 };
 
@@ -71,6 +72,18 @@ class Perception {
   bool onScreen(const Vec2& pixel) const;
   // Without a fixation every pair is reported invisible with priority 0.
   PairPerception measure(const PairTest& test) const;
+  // What f(e, g) needs of a point besides g, for schedulers that re-measure g
+  // often: weight = exp(-e / 100) with e the point's eccentricity, and the
+  // pixels per metre at its depth. Both 0 behind the camera or without a fixation.
+  struct GazeWeight {
+    double weight = 0.0;
+    double px_per_metre = 0.0;
+  };
+  GazeWeight gazeWeight(const Vec3& world) const;
+  // The paper's on-screen gap estimate alone: |proj(cA) - proj(cB)| of the
+  // last intersecting centres; when either is behind the camera, the 3D gap
+  // estimate times `px_per_metre`. What a scheduler re-measures after a step.
+  double projectedGap(const PairTest& test, double px_per_metre) const;
 
  private:
   Camera camera_;

@@ -114,6 +114,28 @@ std::optional<Vec2> Perception::project(const Vec3& world) const {
               0.5 * camera_.height + focal_px_ * c.y() * inv_z);
 }
 
+Perception::GazeWeight Perception::gazeWeight(const Vec3& world) const {
+  GazeWeight out;
+  const Vec3 c = world_to_camera_rotation_ * (world - camera_position_);
+  if (!(c.z() > kNearDepth) || !fixation_) return out;
+  out.px_per_metre = focal_px_ / c.z();
+  const Vec2 pixel(0.5 * camera_.width + out.px_per_metre * c.x(),
+                   0.5 * camera_.height + out.px_per_metre * c.y());
+  out.weight = std::exp(-(pixel - *fixation_).norm() / 100.0);
+  return out;
+}
+
+// Paper: the distance between the projections of the last intersecting
+// centres. If either is behind the camera (a body straddling the camera
+// plane), fall back to the 3D gap estimate seen at the given scale.
+double Perception::projectedGap(const PairTest& test, double px_per_metre) const {
+  const Vec3 a = world_to_camera_rotation_ * (test.lastCentreA() - camera_position_);
+  const Vec3 b = world_to_camera_rotation_ * (test.lastCentreB() - camera_position_);
+  if (!(a.z() > kNearDepth) || !(b.z() > kNearDepth)) return test.gapEstimate() * px_per_metre;
+  const Vec2 d = focal_px_ * (a.head<2>() / a.z() - b.head<2>() / b.z());
+  return d.norm();
+}
+
 PairPerception Perception::measure(const PairTest& test) const {
   PairPerception out;
   const Vec3 centre = test.centreOfCollision();
@@ -124,17 +146,13 @@ PairPerception Perception::measure(const PairTest& test) const {
     return out;  // gaps and priority 0: nothing of it can be seen
   }
   const double px_per_metre = focal_px_ / c.z();
+  out.px_per_metre = px_per_metre;
   const Vec2 pixel(0.5 * camera_.width + px_per_metre * c.x(),
                    0.5 * camera_.height + px_per_metre * c.y());
   out.visible = onScreen(pixel);
   out.eccentricity_px = (pixel - *fixation_).norm();
 
-  // Paper: the distance between the projections of the last intersecting
-  // centres. If either is behind the camera (a body straddling the camera
-  // plane), fall back to the 3D gap estimate seen at the centre's depth.
-  const auto pa = project(test.lastCentreA());
-  const auto pb = project(test.lastCentreB());
-  out.gap_estimate_px = (pa && pb) ? (*pa - *pb).norm() : test.gapEstimate() * px_per_metre;
+  out.gap_estimate_px = projectedGap(test, px_per_metre);
   out.gap_bound_px = test.gapBound() * px_per_metre;
   out.priority = perceivedInaccuracy(out.eccentricity_px, out.gap_estimate_px);
   return out;

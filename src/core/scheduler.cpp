@@ -13,6 +13,10 @@ void validateSchedulerOptions(const SchedulerOptions& options) {
   if (!std::isfinite(options.queue_ratio) || options.queue_ratio <= 1.0) {
     throw InputError("queue_ratio", "must be finite and > 1");
   }
+  if (!std::isfinite(options.cost_exponent) || options.cost_exponent < 0.0 ||
+      options.cost_exponent > 4.0) {
+    throw InputError("cost_exponent", "must be in [0, 4]");
+  }
 }
 
 std::unique_ptr<Scheduler> makeScheduler(const SchedulerOptions& options) {

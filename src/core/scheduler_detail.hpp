@@ -9,53 +9,61 @@
 #include <utility>
 #include <vector>
 
-#if defined(__x86_64__) || defined(__i386__)
-#include <x86intrin.h>
-#endif
 
 namespace stc::detail {
 
-// Splits one run's wall time into "stepping PairTests" and "everything else"
-// (perception, sorting, queue moves, loop and budget checks): overhead.
-// Steps are timed with the time-stamp counter (a few ns per read) so that
-// timing each step does not itself become the overhead it measures; the
-// counter is converted to seconds by the run's own steady_clock span.
-class RunTimer {
+// Overhead = the decision work of a run, timed block by block: building the
+// order (perception, sorting, queue binning) and re-queueing after each pass.
+// The loop that calls PairTest::step() and checks the budget is counted as
+// testing. Blocks, not steps, are timed: a clock read costs as much as several
+// sphere tests here, so timing every step would become the overhead it measures.
+class OverheadClock {
  public:
-  RunTimer() : wall_start_(std::chrono::steady_clock::now()), tick_start_(ticks()) {}
+  using Clock = std::chrono::steady_clock;
+  void start() { started_ = Clock::now(); }
+  void stop() { total_ += Clock::now() - started_; }
+  double seconds() const { return std::chrono::duration<double>(total_).count(); }
 
-  // One step of `test` if the budget allows; false when the budget is exhausted.
-  bool step(PairTest& test, BudgetTracker& budget, ScheduleStats& stats) {
-    if (budget.exhausted()) return false;
-    const std::uint64_t t0 = ticks();
-    const int tests = test.step();
-    step_ticks_ += ticks() - t0;
-    budget.charge(tests);
-    stats.sphere_tests += tests;
-    return true;
+ private:
+  Clock::time_point started_{};
+  Clock::duration total_{0};
+};
+
+// Times one in kEvery blocks and scales the total up by the block count: an
+// unbiased estimate for many short blocks (the re-queueing after each pass)
+// at an eighth of the clock reads.
+class SampledClock {
+ public:
+  static constexpr std::uint32_t kEvery = 8;
+  void start() {
+    timing_ = blocks_++ % kEvery == 0;
+    if (timing_) started_ = OverheadClock::Clock::now();
   }
-
-  double overheadSeconds() const {
-    const double wall =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
-    const std::uint64_t total = ticks() - tick_start_;
-    if (total == 0 || step_ticks_ >= total) return 0.0;
-    return wall * (1.0 - static_cast<double>(step_ticks_) / static_cast<double>(total));
+  void stop() {
+    if (!timing_) return;
+    total_ += OverheadClock::Clock::now() - started_;
+    ++timed_;
+  }
+  double seconds() const {
+    if (timed_ == 0) return 0.0;
+    return std::chrono::duration<double>(total_).count() * blocks_ / timed_;
   }
 
  private:
-  static std::uint64_t ticks() {
-#if defined(__x86_64__) || defined(__i386__)
-    return __rdtsc();
-#else
-    return static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
-#endif
-  }
-
-  std::chrono::steady_clock::time_point wall_start_;
-  std::uint64_t tick_start_;
-  std::uint64_t step_ticks_ = 0;
+  OverheadClock::Clock::time_point started_{};
+  OverheadClock::Clock::duration total_{0};
+  std::uint32_t blocks_ = 0, timed_ = 0;
+  bool timing_ = false;
 };
+
+// One step of `test` if the budget allows; false when the budget is exhausted.
+inline bool budgetedStep(PairTest& test, BudgetTracker& budget, ScheduleStats& stats) {
+  if (budget.exhausted()) return false;
+  const int tests = test.step();
+  budget.charge(tests);
+  stats.sphere_tests += tests;
+  return true;
+}
 
 inline bool perceptionActive(const Perception* perception) {
   return perception != nullptr && perception->hasFixation();
@@ -86,21 +94,32 @@ class SequentialScheduler final : public Scheduler {
 };
 
 // K queues, highest first; round-robin inside a queue; the perceptual model
-// only picks the queue (see priority_queue_scheduler.cpp for the bins).
+// only picks the queue (see scheduler_priority_queues.cpp for the bins).
 class PriorityQueueScheduler final : public Scheduler {
  public:
   explicit PriorityQueueScheduler(const SchedulerOptions& options);
   ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const Perception* perception,
                     BudgetTracker& budget) override;
 
-  // Queue of a priority given the run's reference (largest initial) priority.
-  int queueOf(double priority, double reference) const;
-
  private:
+  struct Refined {
+    double cost = 1.0;
+    Vec3 centre_a = Vec3::Zero(), centre_b = Vec3::Zero();
+  };
+  static Refined refine(const PairTest& test);
+  double perCost(double f, double cost) const;
+  double remeasure(const PairTest& test, const Perception& perception, double weight,
+                   double px_per_metre) const;
+  int binOf(double priority, double reference) const;
+  int rebin(double priority, int from) const;
+
   int queue_count_;
-  double inv_log_ratio_;
+  double log_ratio_;
+  double cost_exponent_;
   std::vector<std::vector<std::uint32_t>> queues_;  // [0] lowest .. [K-1] highest; capacity reused
-  std::vector<double> priorities_;                  // initial f per pair; capacity reused
+  std::vector<double> lower_edge_;                  // f at the bottom of each queue, this run
+  // Per pair, this run (capacity reused): initial priority, exp(-e/100), pixels per metre.
+  std::vector<double> priorities_, weight_, scale_;
 };
 
 }  // namespace stc::detail

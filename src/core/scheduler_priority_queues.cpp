@@ -1,14 +1,22 @@
 // Priority-queue scheduling (paper 3.4.3). The perceptual model only picks
 // one of K queues; inside a queue pairs go round-robin; the highest non-empty
-// queue is always served next. After each step a pair's estimate is refined,
-// so it is re-measured and moves queue when its priority crossed a bin edge.
+// queue is always served next. After each pass over a queue, the pairs it
+// stepped are re-measured (their estimates refined) and move queue when their
+// priority crossed a bin edge.
 //
-// Bins are log-scale, relative to the largest priority fmax at the start of
-// the run (scale-free: camera distance, resolution and scene size do not
-// matter): queue K-1 holds f >= fmax / r, queue K-2 holds f >= fmax / r^2, ...,
-// queue 0 the rest, including f = 0 (behind the camera). A pair whose f rose
-// above fmax stays in the top queue. A pass over a queue is finished before
-// a higher queue that filled meanwhile is served (no preemption mid-pass).
+// Priority: f(e, g) / c^a, c the sphere tests of the pair's next step (see
+// SchedulerOptions::cost_exponent; a = 0 is the paper's f). Bins are
+// log-scale, relative to the largest priority fmax at the start of the run
+// (scale-free: camera distance, resolution and scene size do not matter):
+// queue K-1 holds f >= fmax / r, queue K-2 holds f >= fmax / r^2, ..., queue 0
+// the rest, including f = 0 (behind the camera). A pass over a queue is
+// finished before a higher queue that filled meanwhile is served.
+//
+// Measuring a pair computes the on-screen gap g (the paper's projected
+// distance of the last intersecting centres, see refine()) and the step cost;
+// the eccentricity weight exp(-e/100) and the pixels per metre are those of
+// the centre of collision at the start of the run (it moves by less than the
+// pair's size on screen while the pair refines; a bin spans a factor r).
 // Without a fixation every pair sits in one queue: plain round-robin in list order.
 #include "scheduler_detail.hpp"
 
@@ -19,37 +27,111 @@ namespace stc::detail {
 
 PriorityQueueScheduler::PriorityQueueScheduler(const SchedulerOptions& options)
     : queue_count_(options.queue_count),
-      inv_log_ratio_(1.0 / std::log(options.queue_ratio)),
-      queues_(static_cast<std::size_t>(options.queue_count)) {}
+      log_ratio_(std::log(options.queue_ratio)),
+      cost_exponent_(options.cost_exponent),
+      queues_(static_cast<std::size_t>(options.queue_count)),
+      lower_edge_(static_cast<std::size_t>(options.queue_count)) {}
 
-int PriorityQueueScheduler::queueOf(double priority, double reference) const {
+// What a re-measure needs from a pair, in constant time from its frontier
+// (the intersecting sphere pairs of its last step), represented by its first
+// pair (the frontier is one tree level, so its pairs are alike):
+// - cost: the sphere tests of the next step: 1 before any step (root against
+//   root); then frontier size x the children of the node the first pair will
+//   be tested against (a leaf's partner's under the unequal-height rule, else
+//   the mean of the two);
+// - the centres of the first frontier pair: the paper's "last intersecting
+//   spheres" (PairTest::lastPair() picks the deepest of the frontier, which
+//   needs a pass with two rotations per frontier pair: too dear per step for
+//   choosing a queue whose bins span a factor r).
+PriorityQueueScheduler::Refined PriorityQueueScheduler::refine(const PairTest& test) {
+  Refined out;
+  const SpherePairSpan frontier = test.lastPairs();
+  if (test.stepsDone() == 0 || frontier.empty()) {
+    out.centre_a = test.bodyA().pose->position;
+    out.centre_b = test.bodyB().pose->position;
+    return out;
+  }
+  const SphereNode& na = test.bodyA().tree->node(frontier[0].a);
+  const SphereNode& nb = test.bodyB().tree->node(frontier[0].b);
+  const double children = na.child_count == 0   ? nb.child_count
+                          : nb.child_count == 0 ? na.child_count
+                                                : 0.5 * (na.child_count + nb.child_count);
+  out.cost = std::max(1.0, children * static_cast<double>(frontier.size()));
+  out.centre_a = test.bodyA().pose->apply(na.centre);
+  out.centre_b = test.bodyB().pose->apply(nb.centre);
+  return out;
+}
+
+double PriorityQueueScheduler::perCost(double f, double cost) const {
+  if (cost_exponent_ == 0.0 || f == 0.0) return f;
+  return cost_exponent_ == 1.0 ? f / cost : f / std::pow(cost, cost_exponent_);
+}
+
+// Priority after a step: the projected distance of the refined centres
+// (the 3D distance at the pair's scale when either is behind the camera),
+// times the pair's eccentricity weight, per cost.
+double PriorityQueueScheduler::remeasure(const PairTest& test, const Perception& perception,
+                                         double weight, double px_per_metre) const {
+  if (weight == 0.0) return 0.0;
+  const Refined r = refine(test);
+  const auto pa = perception.project(r.centre_a);
+  const auto pb = perception.project(r.centre_b);
+  const double g = (pa && pb) ? (*pa - *pb).norm() : (r.centre_a - r.centre_b).norm() * px_per_metre;
+  return perCost(g * weight, r.cost);
+}
+
+// Initial binning: k = floor(log_r(fmax / f)) counted down from the top queue.
+int PriorityQueueScheduler::binOf(double priority, double reference) const {
   const int top = queue_count_ - 1;
   if (!(priority > 0.0) || !(reference > 0.0)) return 0;
   if (priority >= reference) return top;
-  // Bin k = floor(log_r(fmax / f)) counted down from the top queue.
-  const double k = std::floor(std::log(reference / priority) * inv_log_ratio_);
+  const double k = std::floor(std::log(reference / priority) / log_ratio_);
   return k >= top ? 0 : top - static_cast<int>(k);
+}
+
+// Re-binning from the current queue: estimates move by a bin or two per step,
+// so walking the edges beats a logarithm.
+int PriorityQueueScheduler::rebin(double priority, int from) const {
+  int q = from;
+  while (q + 1 < queue_count_ && priority >= lower_edge_[static_cast<std::size_t>(q + 1)]) ++q;
+  while (q > 0 && priority < lower_edge_[static_cast<std::size_t>(q)]) --q;
+  return q;
 }
 
 ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::size_t count,
                                           const Perception* perception, BudgetTracker& budget) {
-  RunTimer timer;
   ScheduleStats stats;
+  OverheadClock overhead;  // the set-up: measuring and binning every pair
+  SampledClock requeue;    // the re-measuring after each pass
+  overhead.start();
   for (auto& q : queues_) q.clear();
   stats.used_perception = perceptionActive(perception);
 
-  double reference = 0.0;
   if (stats.used_perception) {
     // Measure every pair once; fmax is known only after all are measured.
-    priorities_.clear();
+    weight_.resize(count);
+    scale_.resize(count);
+    priorities_.resize(count);
+    double reference = 0.0;
     for (std::size_t i = 0; i < count; ++i) {
-      const double f = tests[i].resolved() ? 0.0 : perception->measure(tests[i]).priority;
-      priorities_.push_back(f);
-      reference = std::max(reference, f);
+      if (tests[i].resolved()) {
+        priorities_[i] = 0.0;
+        continue;
+      }
+      const Perception::GazeWeight gw = perception->gazeWeight(tests[i].centreOfCollision());
+      weight_[i] = gw.weight;
+      scale_[i] = gw.px_per_metre;
+      priorities_[i] = remeasure(tests[i], *perception, gw.weight, gw.px_per_metre);
+      reference = std::max(reference, priorities_[i]);
+    }
+    // Queue q >= 1 holds f >= fmax / r^(K - q).
+    lower_edge_[0] = 0.0;
+    for (int q = 1; q < queue_count_; ++q) {
+      lower_edge_[static_cast<std::size_t>(q)] = reference * std::exp(-(queue_count_ - q) * log_ratio_);
     }
     for (std::size_t i = 0; i < count; ++i) {
       if (tests[i].resolved()) continue;
-      queues_[static_cast<std::size_t>(queueOf(priorities_[i], reference))].push_back(
+      queues_[static_cast<std::size_t>(binOf(priorities_[i], reference))].push_back(
           static_cast<std::uint32_t>(i));
     }
   } else {
@@ -57,26 +139,37 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
       if (!tests[i].resolved()) queues_[0].push_back(static_cast<std::uint32_t>(i));
     }
   }
+  overhead.stop();
 
   for (;;) {
     int q = queue_count_ - 1;
     while (q >= 0 && queues_[static_cast<std::size_t>(q)].empty()) --q;
     if (q < 0) break;  // everything resolved
     auto& queue = queues_[static_cast<std::size_t>(q)];
-    // One round-robin pass; pairs that stay are compacted in place, order kept;
-    // pairs that move are appended to their new queue (never this one).
-    const std::size_t pass = queue.size();
+    // One round-robin pass; pairs still unresolved are compacted in place, order kept.
     std::size_t kept = 0;
-    for (std::size_t r = 0; r < pass; ++r) {
-      const std::uint32_t index = queue[r];
-      PairTest& test = tests[index];
-      if (!timer.step(test, budget, stats)) {
-        stats.interrupted = true;
-        stats.overhead_seconds = timer.overheadSeconds();
-        return stats;
+    bool out_of_budget = false;
+    for (std::size_t r = 0; r < queue.size(); ++r) {
+      PairTest& test = tests[queue[r]];
+      if (!budgetedStep(test, budget, stats)) {
+        out_of_budget = true;
+        break;
       }
-      if (test.resolved()) continue;
-      const int moved = stats.used_perception ? queueOf(perception->measure(test).priority, reference) : q;
+      if (!test.resolved()) queue[kept++] = queue[r];
+    }
+    if (out_of_budget) {
+      stats.interrupted = true;
+      break;
+    }
+    queue.resize(kept);
+    if (!stats.used_perception) continue;
+    // Re-measure what the pass refined; movers go to the back of their new queue.
+    requeue.start();
+    kept = 0;
+    for (std::size_t r = 0; r < queue.size(); ++r) {
+      const std::uint32_t index = queue[r];
+      const double f = remeasure(tests[index], *perception, weight_[index], scale_[index]);
+      const int moved = rebin(f, q);
       if (moved == q) {
         queue[kept++] = index;
       } else {
@@ -84,8 +177,9 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
       }
     }
     queue.resize(kept);
+    requeue.stop();
   }
-  stats.overhead_seconds = timer.overheadSeconds();
+  stats.overhead_seconds = overhead.seconds() + requeue.seconds();
   return stats;
 }
 

@@ -7,27 +7,29 @@ namespace stc::detail {
 
 ScheduleStats RoundRobinScheduler::run(std::vector<PairTest>& tests, std::size_t count,
                                        const Perception* /*perception*/, BudgetTracker& budget) {
-  RunTimer timer;
   ScheduleStats stats;
+  OverheadClock overhead;
+  overhead.start();
   active_.clear();
   for (std::size_t i = 0; i < count; ++i) {
     if (!tests[i].resolved()) active_.push_back(static_cast<std::uint32_t>(i));
   }
+  overhead.stop();
   while (!active_.empty()) {
     // One pass; resolved pairs are compacted out in place, order kept.
     std::size_t kept = 0;
     for (std::size_t r = 0; r < active_.size(); ++r) {
       PairTest& test = tests[active_[r]];
-      if (!timer.step(test, budget, stats)) {
+      if (!budgetedStep(test, budget, stats)) {
         stats.interrupted = true;
-        stats.overhead_seconds = timer.overheadSeconds();
+        stats.overhead_seconds = overhead.seconds();
         return stats;
       }
       if (!test.resolved()) active_[kept++] = active_[r];
     }
     active_.resize(kept);
   }
-  stats.overhead_seconds = timer.overheadSeconds();
+  stats.overhead_seconds = overhead.seconds();
   return stats;
 }
 

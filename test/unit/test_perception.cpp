@@ -195,6 +195,21 @@ TEST_F(MeasurePair, EccentricityGapAndPriorityOnScreen) {
   EXPECT_GT(m.gap_bound_px, 0.0);
 }
 
+TEST_F(MeasurePair, GazeWeightAndProjectedGapAgreeWithMeasure) {
+  Perception p = defaultPerception();
+  p.setFixation(Vec2(500, 300));
+  place(Vec3(0.4, -0.2, 6.0), Vec3(0.25, 0.1, 0.05));
+  const PairPerception m = p.measure(test_);
+  const Perception::GazeWeight gw = p.gazeWeight(test_.centreOfCollision());
+  EXPECT_NEAR(gw.weight, std::exp(-m.eccentricity_px / 100.0), 1e-12);
+  EXPECT_NEAR(gw.px_per_metre, m.px_per_metre, 1e-9);
+  EXPECT_NEAR(p.projectedGap(test_, gw.px_per_metre), m.gap_estimate_px, 1e-9);
+  EXPECT_NEAR(gw.weight * m.gap_estimate_px, m.priority, 1e-9);
+  const Perception::GazeWeight behind = p.gazeWeight(Vec3(0, 0, -1));
+  EXPECT_EQ(behind.weight, 0.0);
+  EXPECT_EQ(behind.px_per_metre, 0.0);
+}
+
 TEST_F(MeasurePair, BehindTheCameraIsInvisibleWithPriorityZero) {
   Perception p = defaultPerception();
   p.setFixation(Vec2(640, 360));

@@ -39,13 +39,16 @@ constexpr double kDepth = 8.0;  // metres in front of the default camera
 // default camera (origin, looking along +z, 1280x720, 60 deg).
 class SchedulerTest : public ::testing::Test {
  protected:
-  void SetUp() override {
+  // One tree for the whole suite: building it is the slow part.
+  static void SetUpTestSuite() {
     PresetParams params;
     params.resolution = 16;
     params.voxel_size = 0.05;
     params.seed = 3;
     const VoxelShape shape = makePreset("rock", params);
     tree_ = SphereTree::build(shape, computeMassProperties(shape, 1.0).centre_of_mass);
+  }
+  void SetUp() override {
     ASSERT_GE(tree_.levelCount(), 3);
     camera_.setCamera(Camera{});
   }
@@ -129,11 +132,13 @@ class SchedulerTest : public ::testing::Test {
     return order;
   }
 
-  SphereTree tree_;
+  static SphereTree tree_;
   Perception camera_;
   std::vector<Pose> poses_;
   std::vector<PairTest> tests_;
 };
+
+SphereTree SchedulerTest::tree_;
 
 TEST_F(SchedulerTest, UnlimitedBudgetGivesIdenticalResultsForAllFour) {
   build(rowAt({100, 300, 500, 700, 900, 1100, 640, 200}),
@@ -243,8 +248,10 @@ TEST_F(SchedulerTest, PriorityQueuesFinishThePairsNearestTheFixationFirst) {
   const std::vector<double> us = {1150, 900, 650, 400, 150};
   build(rowAt(us), {5, 5, 5, 5, 5});
   camera_.setFixation(Vec2(150, 360));
-  auto pq = makeScheduler(SchedulerOptions{SchedulerKind::PriorityQueues, 5, 8.0});
-  EXPECT_EQ(finishOrder(*pq), (std::vector<std::size_t>{4, 3, 2, 1, 0}));
+  for (double cost_exponent : {0.0, 1.0}) {
+    auto pq = makeScheduler(SchedulerOptions{SchedulerKind::PriorityQueues, 5, 8.0, cost_exponent});
+    EXPECT_EQ(finishOrder(*pq), (std::vector<std::size_t>{4, 3, 2, 1, 0})) << cost_exponent;
+  }
   auto rr = makeScheduler(SchedulerOptions{SchedulerKind::RoundRobin, 4, 4.0});
   EXPECT_EQ(finishOrder(*rr), (std::vector<std::size_t>{0, 1, 2, 3, 4}));
 }
@@ -253,7 +260,7 @@ TEST_F(SchedulerTest, PriorityQueuesServeTheTopQueueBeforeLowerOnes) {
   const std::vector<double> us = {1150, 900, 650, 400, 150, 160};
   build(rowAt(us), {5, 6, 7, 8, 9, 10});
   camera_.setFixation(Vec2(150, 360));
-  auto pq = makeScheduler(SchedulerOptions{SchedulerKind::PriorityQueues, 5, 8.0});
+  auto pq = makeScheduler(SchedulerOptions{SchedulerKind::PriorityQueues, 5, 8.0, 0.0});
   // The two pairs at the fixation are stepped before any far pair is touched.
   std::vector<std::vector<int>> stops;
   finishOrder(*pq, true, &stops);
@@ -264,6 +271,40 @@ TEST_F(SchedulerTest, PriorityQueuesServeTheTopQueueBeforeLowerOnes) {
       EXPECT_EQ(steps[1], 0);
     }
   }
+}
+
+TEST_F(SchedulerTest, CostAwarePriorityGivesAFarPairItsCheapRootTestEarly) {
+  // Same geometry, one whose full test is expensive (>= 5 steps, >= 150 sphere
+  // tests); the far pair is 500 px from the fixation (f about 150x lower).
+  unsigned seed = 1;
+  for (; seed < 200; ++seed) {
+    build(rowAt({150}), {seed});
+    while (!tests_[0].resolved()) tests_[0].step();
+    if (tests_[0].stepsDone() >= 5 && tests_[0].sphereTests() >= 150) break;
+  }
+  ASSERT_LT(seed, 200u);
+  build(rowAt({150, 650}), {seed, seed});
+  camera_.setFixation(Vec2(150, 360));
+  auto far_stepped_while_near_open = [&](double cost_exponent) {
+    SchedulerOptions o;
+    o.kind = SchedulerKind::PriorityQueues;
+    o.queue_count = 16;
+    o.queue_ratio = 2.0;
+    o.cost_exponent = cost_exponent;
+    auto s = makeScheduler(o);
+    std::vector<std::vector<int>> stops;
+    const auto order = finishOrder(*s, true, &stops);
+    EXPECT_EQ(order, (std::vector<std::size_t>{0, 1}));  // the near pair still finishes first
+    for (const auto& steps : stops) {
+      if (steps[0] >= 0 && steps[1] > 0) return true;
+    }
+    return false;
+  };
+  // The paper's f: the far pair waits until the near one is resolved.
+  EXPECT_FALSE(far_stepped_while_near_open(0.0));
+  // Per sphere test: once the near pair's steps cost tens of tests, the far
+  // pair's 1-test root step is worth more.
+  EXPECT_TRUE(far_stepped_while_near_open(1.0));
 }
 
 TEST_F(SchedulerTest, PerceptualSequentialFinishesInPriorityOrder) {
@@ -330,6 +371,7 @@ TEST(SchedulerOptionsTest, BadOptionsNameTheField) {
   EXPECT_EQ(field(SchedulerOptions{SchedulerKind::PriorityQueues, 0, 4.0}), "queue_count");
   EXPECT_EQ(field(SchedulerOptions{SchedulerKind::PriorityQueues, 4, 1.0}), "queue_ratio");
   EXPECT_EQ(field(SchedulerOptions{SchedulerKind::PriorityQueues, 4, std::nan("")}), "queue_ratio");
+  EXPECT_EQ(field(SchedulerOptions{SchedulerKind::PriorityQueues, 4, 2.0, -1.0}), "cost_exponent");
   EXPECT_EQ(field(SchedulerOptions{SchedulerKind::RoundRobin, 4, 4.0}), "<no throw>");
 }
 
