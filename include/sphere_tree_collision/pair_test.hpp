@@ -131,6 +131,9 @@ class PairTest {
   mutable bool best_valid_ = false;
   PairStatus status_ = PairStatus::Unresolved;
   bool first_contact_only_ = false;
+  // Body frame s to body frame 1 - s, made at the first step.
+  Mat3 rot_to_other_[2] = {Mat3::Identity(), Mat3::Identity()};
+  Vec3 pos_to_other_[2] = {Vec3::Zero(), Vec3::Zero()};
   int steps_ = 0;
   int deepest_level_ = -1;
   std::int64_t sphere_tests_ = 0;

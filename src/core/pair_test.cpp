@@ -37,6 +37,43 @@ T* roomFor(std::vector<T>& v, std::size_t used, std::size_t extra) {
   return v.data() + used;
 }
 
+// Tests a target against one test list. Every candidate is written and the
+// write index advances only on an intersection: no unpredictable branch per
+// sphere test. The tree side and whether the target is a leaf are template
+// arguments, so each of the four loops is straight-line code. Intersections
+// that make a new hit are not written as pairs here: the pair is the hit's
+// target and the parent of its test list (see step()).
+template <int kTargetSide, bool kTargetLeaf, bool kMembersLeaves = false>
+void testList(const SphereHit& hit, const SphereNode& target, const Vec3& target_centre,
+              const SphereNode* members, SphereHit* hit_out, SpherePair* leaf_out, std::size_t& hit_count,
+              std::size_t& leaf_pairs) {
+  constexpr auto kMemberSide = static_cast<std::uint8_t>(1 - kTargetSide);
+  const std::int32_t end = hit.test_first + hit.test_count;
+  for (std::int32_t m = hit.test_first; m < end; ++m) {
+    const SphereNode& member = members[m];
+    const double reach = target.radius + member.radius;
+    const bool touching = (member.centre - target_centre).squaredNorm() <= reach * reach;
+    if constexpr (!kTargetLeaf) {
+      // Crossover: the member becomes the target, the target's children the test list.
+      hit_out[hit_count] = SphereHit{m, target.first_child, target.child_count, kMemberSide};
+      hit_count += touching;
+    } else if constexpr (kMembersLeaves) {
+      // Leaf against leaves (the last level of equal-height trees): leaf pairs only.
+      leaf_out[leaf_pairs] = kTargetSide == 0 ? SpherePair{hit.target, m} : SpherePair{m, hit.target};
+      leaf_pairs += touching;
+    } else {
+      // Unequal heights: a leaf target stays, the member's children become
+      // the test list; a leaf member makes a leaf pair instead (a on tree A).
+      const bool member_leaf = isLeaf(member);
+      hit_out[hit_count] = SphereHit{hit.target, member.first_child, member.child_count,
+                                     static_cast<std::uint8_t>(kTargetSide)};
+      hit_count += touching && !member_leaf;
+      leaf_out[leaf_pairs] = kTargetSide == 0 ? SpherePair{hit.target, m} : SpherePair{m, hit.target};
+      leaf_pairs += touching && member_leaf;
+    }
+  }
+}
+
 }  // namespace
 
 void PairTest::reset(const PairBody& a, const PairBody& b, PairArena* arena) {
@@ -64,18 +101,22 @@ int PairTest::step() {
   // Distances do not change under a rigid motion, so each target centre is
   // taken into the body frame of the tree it is tested against, once per hit;
   // the members are then used as stored, with no transform per sphere test.
-  // to_other[s] maps body frame s to body frame 1 - s.
+  // The poses are fixed for the test's lifetime (one tick): the relative
+  // transforms are made at the first step.
+  if (steps_ == 0) {
+    const Mat3 ra = a_.pose->orientation.toRotationMatrix();
+    const Mat3 rb = b_.pose->orientation.toRotationMatrix();
+    const Vec3 pa_in_b = rb.transpose() * (a_.pose->position - b_.pose->position);
+    rot_to_other_[0] = rb.transpose() * ra;
+    rot_to_other_[1] = ra.transpose() * rb;
+    pos_to_other_[0] = pa_in_b;
+    pos_to_other_[1] = -(rot_to_other_[1] * pa_in_b);
+  }
   const SphereNode* nodes[2] = {a_.tree->nodes().data(), b_.tree->nodes().data()};
-  const Mat3 ra = a_.pose->orientation.toRotationMatrix();
-  const Mat3 rb = b_.pose->orientation.toRotationMatrix();
-  const Vec3 pa_in_b = rb.transpose() * (a_.pose->position - b_.pose->position);
-  const Mat3 rot_to_other[2] = {rb.transpose() * ra, ra.transpose() * rb};
-  const Vec3 pos_to_other[2] = {pa_in_b, -(rot_to_other[1] * pa_in_b)};
+  const std::int32_t last_level[2] = {a_.tree->levelCount() - 1, b_.tree->levelCount() - 1};
 
-  // New hits and this step's intersecting pairs are appended to the arena.
-  // Room for the worst case (every test intersects) is made first, and the
-  // loop writes every candidate and advances the write index only when it
-  // intersects: no unpredictable branch per sphere test.
+  // New hits and this step's intersecting pairs are appended to the arena,
+  // with room for the worst case (every test intersects) made first.
   PairArena& store = arena();
   std::size_t most = 0;  // tests if every hit is done
   for (std::size_t h = hits_begin_; h < hits_begin_ + hits_count_; ++h) most += store.hits[h].test_count;
@@ -84,56 +125,49 @@ int PairTest::step() {
   SphereHit* hit_out = roomFor(store.hits, new_hits_begin, most);
   SpherePair* pair_out = roomFor(store.pairs, pairs_begin, most);
   const SphereHit* hits = store.hits.data();  // after the growth above
-  std::size_t hit_count = 0, pair_count = 0, leaf_pairs = 0;
+  std::size_t hit_count = 0, leaf_pairs = 0;
   int tests = 0;
 
   for (std::size_t h = hits_begin_; h < hits_begin_ + hits_count_; ++h) {
     if (first_contact_only_ && leaf_pairs > 0) break;  // the answer is known
-    const SphereHit hit = hits[h];
+    const SphereHit& hit = hits[h];
     tests += hit.test_count;
     const int ts = hit.target_side;
-    const auto ms = static_cast<std::uint8_t>(1 - ts);
     const SphereNode& target = nodes[ts][hit.target];
-    const Vec3 target_centre = rot_to_other[ts] * target.centre + pos_to_other[ts];
-    const SphereNode* members = nodes[ms];
-    const std::int32_t end = hit.test_first + hit.test_count;
+    const Vec3 centre = rot_to_other_[ts] * target.centre + pos_to_other_[ts];
+    const SphereNode* members = nodes[1 - ts];
     deepest_level_ = std::max({deepest_level_, target.level, members[hit.test_first].level});
-
-    for (std::int32_t m = hit.test_first; m < end; ++m) {
-      const SphereNode& member = members[m];
-      const double reach = target.radius + member.radius;
-      const bool touching = (member.centre - target_centre).squaredNorm() <= reach * reach;
-      // Keep a on tree A and b on tree B whichever tree holds the target.
-      pair_out[pair_count] = ts == 0 ? SpherePair{hit.target, m} : SpherePair{m, hit.target};
-      pair_count += touching;
-      if (!isLeaf(target)) {
-        // Crossover: the member becomes the target, the target's children the test list.
-        hit_out[hit_count] = SphereHit{m, target.first_child, target.child_count, ms};
-        hit_count += touching;
-      } else {
-        // Unequal heights: a leaf target stays, the member's children become
-        // the test list; a leaf member makes a leaf pair instead.
-        const bool member_leaf = isLeaf(member);
-        hit_out[hit_count] = SphereHit{hit.target, member.first_child, member.child_count, hit.target_side};
-        hit_count += touching && !member_leaf;
-        leaf_pairs += touching && member_leaf;
-      }
+    // 0: inner target, 1: leaf target, 2: leaf target and a test list on the
+    // last level of its tree (all leaves: the last step of equal-height trees).
+    int kind = 3 * ts;
+    if (isLeaf(target)) kind += members[hit.test_first].level == last_level[1 - ts] ? 2 : 1;
+    switch (kind) {
+      case 0: testList<0, false>(hit, target, centre, members, hit_out, pair_out, hit_count, leaf_pairs); break;
+      case 1: testList<0, true>(hit, target, centre, members, hit_out, pair_out, hit_count, leaf_pairs); break;
+      case 2: testList<0, true, true>(hit, target, centre, members, hit_out, pair_out, hit_count, leaf_pairs); break;
+      case 3: testList<1, false>(hit, target, centre, members, hit_out, pair_out, hit_count, leaf_pairs); break;
+      case 4: testList<1, true>(hit, target, centre, members, hit_out, pair_out, hit_count, leaf_pairs); break;
+      default: testList<1, true, true>(hit, target, centre, members, hit_out, pair_out, hit_count, leaf_pairs); break;
     }
   }
 
   ++steps_;
   sphere_tests_ += tests;
   best_valid_ = false;
+  std::size_t pair_count = leaf_pairs;
   if (leaf_pairs > 0) {
-    // Colliding: the last pairs are the leaf pairs only; drop the rest of the step.
+    // Colliding: the last pairs are the leaf pairs; the new hits are dropped.
     status_ = PairStatus::Colliding;
-    std::size_t kept = 0;
-    for (std::size_t i = 0; i < pair_count; ++i) {
-      if (isLeaf(nodes[0][pair_out[i].a]) && isLeaf(nodes[1][pair_out[i].b])) pair_out[kept++] = pair_out[i];
-    }
-    pair_count = kept;
     hits_count_ = 0;
-  } else if (pair_count > 0) {
+  } else if (hit_count > 0) {
+    // Every intersection made one new hit, whose target and the parent of
+    // its test list are the two spheres that intersected.
+    for (std::size_t i = 0; i < hit_count; ++i) {
+      const SphereHit& next = hit_out[i];
+      const std::int32_t other = nodes[1 - next.target_side][next.test_first].parent;
+      pair_out[i] = next.target_side == 0 ? SpherePair{next.target, other} : SpherePair{other, next.target};
+    }
+    pair_count = hit_count;
     store.hits_used = new_hits_begin + hit_count;
     hits_begin_ = new_hits_begin;
     hits_count_ = hit_count;
