@@ -4,9 +4,8 @@
 // setTranslation + computeAABB), update the manager, collect the overlapping
 // pairs (no narrow phase). Pair counts must agree on every tick.
 //
-// Usage: bench_broad_phase [--quick] [--markdown FILE]
-//   --quick     N = 1k, 10k only, 30 ticks (a smoke run)
-//   --markdown  also write the table to FILE (docs/broad_phase.md)
+// Usage: bench_broad_phase [--quick]     (--quick: N = 1k, 10k only, 20 ticks)
+// Prints two markdown tables: time per tick against N, and against speed.
 #include "sphere_tree_collision/sweep_and_prune.hpp"
 
 #include <fcl/broadphase/broadphase_SaP.h>
@@ -20,7 +19,6 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
-#include <fstream>
 #include <functional>
 #include <memory>
 #include <random>
@@ -40,23 +38,22 @@ double cpuMs() {
 using stc::Vec3;
 
 // N unit cubes in a cube world at fixed density: 1 cube per 8 unit^3, so each
-// cube overlaps one other on average. Velocities random-walk; walls reflect.
+// cube overlaps about one other. Each moves `speed` box sides per tick in a
+// slowly turning direction; walls reflect.
 class Movers {
  public:
-  Movers(std::size_t count, unsigned seed)
-      : side_(std::cbrt(8.0 * static_cast<double>(count))), rng_(seed), pos_(count), vel_(count) {
+  Movers(std::size_t count, double speed, unsigned seed)
+      : side_(std::cbrt(8.0 * static_cast<double>(count))), speed_(speed), rng_(seed), pos_(count), vel_(count) {
     std::uniform_real_distribution<double> u(0.0, 1.0);
     for (std::size_t i = 0; i < count; ++i) {
       pos_[i] = Vec3(u(rng_), u(rng_), u(rng_)) * side_;
-      vel_[i] = Vec3(u(rng_) - 0.5, u(rng_) - 0.5, u(rng_) - 0.5) * 0.04;
+      vel_[i] = randomDirection() * speed_;
     }
   }
 
-  // One tick of motion: about 2% of a box side, so the sort stays nearly sorted.
   void advance() {
-    std::uniform_real_distribution<double> u(-0.002, 0.002);
     for (std::size_t i = 0; i < pos_.size(); ++i) {
-      vel_[i] += Vec3(u(rng_), u(rng_), u(rng_));
+      vel_[i] = (vel_[i] + randomDirection() * (0.1 * speed_)).normalized() * speed_;
       pos_[i] += vel_[i];
       for (int a = 0; a < 3; ++a) {
         if (pos_[i][a] < 0.0 || pos_[i][a] > side_) vel_[i][a] = -vel_[i][a];
@@ -66,10 +63,15 @@ class Movers {
   }
 
   const std::vector<Vec3>& positions() const { return pos_; }
-  double side() const { return side_; }
 
  private:
+  Vec3 randomDirection() {
+    std::normal_distribution<double> g(0.0, 1.0);
+    return Vec3(g(rng_), g(rng_), g(rng_)).normalized();
+  }
+
   double side_;
+  double speed_;
   std::mt19937 rng_;
   std::vector<Vec3> pos_, vel_;
 };
@@ -164,8 +166,8 @@ struct Result {
   std::vector<std::size_t> pair_counts;  // per tick
 };
 
-Result run(Contender& c, std::size_t n, int ticks) {
-  Movers movers(n, 12345);  // same seed: same motion for every contender
+Result run(Contender& c, std::size_t n, double speed, int ticks) {
+  Movers movers(n, speed, 12345);  // same seed: same motion for every contender
   Result r;
   const double t0 = cpuMs();
   c.load(movers.positions());
@@ -182,75 +184,90 @@ Result run(Contender& c, std::size_t n, int ticks) {
   return r;
 }
 
+struct Case {
+  std::size_t n;
+  double speed;  // box sides per tick
+  int ticks;
+};
+
+// Runs every contender on one case; appends a markdown row; false on any
+// pair-count disagreement.
+bool runCase(std::vector<Contender>& contenders, const Case& k, std::ostringstream& table) {
+  std::vector<Result> results;
+  for (Contender& c : contenders) {
+    results.push_back(run(c, k.n, k.speed, k.ticks));
+    std::printf("N=%-6zu speed %.3f  %-26s load %8.1f ms  tick %8.3f ms  pairs first %zu last %zu\n", k.n,
+                k.speed, c.name.c_str(), results.back().load_ms, results.back().ms_per_tick,
+                results.back().pair_counts.front(), results.back().pair_counts.back());
+    std::fflush(stdout);
+  }
+  bool agree = true;
+  for (std::size_t c = 1; c < results.size(); ++c) {
+    for (int t = 0; t < k.ticks; ++t) {
+      if (results[c].pair_counts[t] != results[0].pair_counts[t]) {
+        std::printf("!!!!! MISMATCH N=%zu tick %d: %s %zu pairs, %s %zu pairs !!!!!\n", k.n, t,
+                    contenders[0].name.c_str(), results[0].pair_counts[t], contenders[c].name.c_str(),
+                    results[c].pair_counts[t]);
+        agree = false;
+        break;
+      }
+    }
+  }
+  double fastest_fcl = results[1].ms_per_tick;
+  for (std::size_t c = 2; c < results.size(); ++c) fastest_fcl = std::min(fastest_fcl, results[c].ms_per_tick);
+  double mean_pairs = 0;
+  for (std::size_t p : results[0].pair_counts) mean_pairs += static_cast<double>(p);
+  mean_pairs /= k.ticks;
+  char row[512];
+  int len = std::snprintf(row, sizeof row, "| %zu | %.3f | %d | %.0f |", k.n, k.speed, k.ticks, mean_pairs);
+  for (const Result& r : results) len += std::snprintf(row + len, sizeof row - len, " %.3f |", r.ms_per_tick);
+  std::snprintf(row + len, sizeof row - len, " **%.2fx** |\n", fastest_fcl / results[0].ms_per_tick);
+  table << row;
+  return agree;
+}
+
+std::string tableHeader(const std::vector<Contender>& contenders) {
+  std::ostringstream h;
+  h << "| N | speed (box sides/tick) | ticks | mean pairs |";
+  for (const Contender& c : contenders) h << ' ' << c.name << " ms/tick |";
+  h << " FCL fastest / stc |\n|---|---|---|---|";
+  for (std::size_t i = 0; i < contenders.size(); ++i) h << "---|";
+  h << "---|\n";
+  return h.str();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   bool quick = false;
-  std::string markdown;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--quick")) quick = true;
-    else if (!std::strcmp(argv[i], "--markdown") && i + 1 < argc) markdown = argv[++i];
-    else {
-      std::fprintf(stderr, "usage: %s [--quick] [--markdown FILE]\n", argv[0]);
+    if (!std::strcmp(argv[i], "--quick")) {
+      quick = true;
+    } else {
+      std::fprintf(stderr, "usage: %s [--quick]\n", argv[0]);
       return 2;
     }
   }
-  struct Size { std::size_t n; int ticks; };
-  const std::vector<Size> sizes = quick ? std::vector<Size>{{1000, 30}, {10000, 30}}
-                                        : std::vector<Size>{{1000, 100}, {10000, 100}, {50000, 100}};
-
   std::vector<Contender> contenders = {
       ours(),
       fclManager<fcl::DynamicAABBTreeCollisionManagerd>("FCL DynamicAABBTree"),
       fclManager<fcl::DynamicAABBTreeCollisionManager_Arrayd>("FCL DynamicAABBTree_Array"),
       fclManager<fcl::SaPCollisionManagerd>("FCL SaP"),
   };
+  const int ticks = quick ? 20 : 100;
+  const double speed = 0.02;  // 2% of a box side per tick, e.g. 1.2 sides/s at 60 Hz
 
-  std::ostringstream table;
-  table << "| N | ticks | mean pairs |";
-  for (const Contender& c : contenders) table << ' ' << c.name << " ms/tick |";
-  table << " FCL fastest / ours |\n|---|---|---|";
-  for (std::size_t i = 0; i < contenders.size(); ++i) table << "---|";
-  table << "---|\n";
+  std::ostringstream by_n, by_speed;
+  by_n << tableHeader(contenders);
+  by_speed << tableHeader(contenders);
+  bool agree = true;
+  const std::vector<std::size_t> sizes = quick ? std::vector<std::size_t>{1000, 10000}
+                                               : std::vector<std::size_t>{1000, 10000, 50000};
+  for (std::size_t n : sizes) agree &= runCase(contenders, {n, speed, ticks}, by_n);
+  for (double s : {0.005, 0.02, 0.08}) agree &= runCase(contenders, {10000, s, ticks}, by_speed);
 
-  bool all_agree = true;
-  for (const Size& size : sizes) {
-    std::vector<Result> results;
-    for (Contender& c : contenders) {
-      results.push_back(run(c, size.n, size.ticks));
-      std::printf("N=%-6zu %-26s load %8.1f ms  tick %8.3f ms  pairs first %zu last %zu\n", size.n,
-                  c.name.c_str(), results.back().load_ms, results.back().ms_per_tick,
-                  results.back().pair_counts.front(), results.back().pair_counts.back());
-      std::fflush(stdout);
-    }
-    for (std::size_t k = 1; k < results.size(); ++k) {
-      for (int t = 0; t < size.ticks; ++t) {
-        if (results[k].pair_counts[t] != results[0].pair_counts[t]) {
-          std::printf("!!!!! MISMATCH N=%zu tick %d: %s %zu pairs, %s %zu pairs !!!!!\n", size.n, t,
-                      contenders[0].name.c_str(), results[0].pair_counts[t],
-                      contenders[k].name.c_str(), results[k].pair_counts[t]);
-          all_agree = false;
-          break;
-        }
-      }
-    }
-    double fastest_fcl = results[1].ms_per_tick;
-    for (std::size_t k = 2; k < results.size(); ++k) fastest_fcl = std::min(fastest_fcl, results[k].ms_per_tick);
-    double mean_pairs = 0;
-    for (std::size_t p : results[0].pair_counts) mean_pairs += static_cast<double>(p);
-    mean_pairs /= size.ticks;
-    char row[512];
-    int len = std::snprintf(row, sizeof row, "| %zu | %d | %.0f |", size.n, size.ticks, mean_pairs);
-    for (const Result& r : results) len += std::snprintf(row + len, sizeof row - len, " %.3f |", r.ms_per_tick);
-    std::snprintf(row + len, sizeof row - len, " %.1fx |\n", fastest_fcl / results[0].ms_per_tick);
-    table << row;
-  }
-
-  std::printf("\n%s", table.str().c_str());
-  std::printf("\npair counts %s on every tick\n", all_agree ? "AGREE" : "DISAGREE");
-  if (!markdown.empty()) {
-    std::ofstream out(markdown);
-    out << table.str();
-  }
-  return all_agree ? 0 : 1;
+  std::printf("\n### Scaling with N (speed %.3f)\n\n%s", speed, by_n.str().c_str());
+  std::printf("\n### Coherence: N = 10000, speed varied\n\n%s", by_speed.str().c_str());
+  std::printf("\npair counts %s on every tick\n", agree ? "AGREE" : "DISAGREE");
+  return agree ? 0 : 1;
 }

@@ -1,22 +1,30 @@
-// SweepAndPrune: I-COLLIDE sweep-and-prune (paper 3.2).
+// SweepAndPrune: I-COLLIDE sweep-and-prune (paper 3.2), with banded lists.
 //
-// Per axis one array of endpoints {value, slot, is_max}, kept sorted by
-// insertion sort. Sorting order: value, then min before max at equal value, so
-// "a.min precedes b.max" is exactly "a.min <= b.max" (Aabb::overlaps counts
-// touching boxes). Insertion sort swaps every inverted pair exactly once, and a
-// pair's overlap can only change when one of its min/max orders changes, so the
-// swaps alone keep the overlap set exact:
+// Per axis, endpoints {value, slot, is_max} kept sorted by insertion sort.
+// Sorting order: value, then min before max at equal value, so "a.min
+// precedes b.max" is exactly "a.min <= b.max" (Aabb::overlaps counts touching
+// boxes). Insertion sort swaps every inverted pair exactly once, and a pair's
+// overlap can only change when one of its min/max orders changes, so the swaps
+// keep the overlap set exact:
 //   a min moves left past a max  -> the pair may start overlapping (join);
 //   a max moves left past a min  -> the pair is now separated on this axis.
-// Most such swaps are between boxes far apart on the other axes, so two filters
-// that need no random memory access drop them during the sort:
+//
+// Bands. One list per axis holding every box makes each endpoint pass every
+// box that moves past it along that axis however far away on the other axes:
+// swaps grow as N^(5/3) at constant density. So each axis's list is split into
+// bands along the next axis (x lists by y, y by z, z by x); a box is in every
+// band its extent there touches. Two boxes that overlap share a band on every
+// list. Bands are sorted before memberships change, so a pair that overlapped
+// (shared a band) has its flips seen there; a pair that starts overlapping
+// either shared a band before too, or one box just entered their common band,
+// and a local sweep of that band on entry finds the new pairs. With one band
+// this is the classic single list.
+//
+// Filters that need no random memory access drop most swaps in the sort:
 //   join:     each endpoint carries its box's ranges on the two other axes,
-//             quantised monotonically to 8 bits (conservative): no overlap
-//             there, no event;
-//   separate: each slot has a 64-bit Bloom mask of its current partners' slots:
-//             bit clear, the pair is not in the set, nothing to remove.
-// Surviving events are applied after the three sorts. Entities are dense slots
-// inside; ids map to slots.
+//             quantised monotonically to 8 bits (conservative);
+//   separate: each slot has a 64-bit Bloom mask of its current partners' slots.
+// Surviving events are applied after all lists are sorted.
 #include "sphere_tree_collision/sweep_and_prune.hpp"
 
 #include "flat_hash_map.hpp"
@@ -32,7 +40,7 @@ using detail::FlatHashMap;
 
 struct Endpoint {
   double value;
-  std::uint32_t tag;    // slot << 1 | is_max
+  std::uint32_t tag;     // slot << 1 | is_max
   std::uint32_t others;  // the box's quantised ranges on the other two axes
 };
 
@@ -62,14 +70,16 @@ struct alignas(32) Span {
   std::uint32_t others;
 };
 
-// Monotone map of a coordinate to 0..255: a <= b implies q(a) <= q(b), so
-// quantised ranges of overlapping intervals overlap.
+// Monotone map of a coordinate to 0..top: a <= b implies q(a) <= q(b), so the
+// images of overlapping intervals overlap. Used for the 8-bit filter ranges
+// and for band indices.
 struct Quantiser {
   double origin = 0.0;
   double scale = 0.0;
+  double top = 0.0;
   std::uint32_t operator()(double v) const {
     const double x = (v - origin) * scale;  // NaN only when scale is 0: maps to 0 like all
-    return x > 0.0 ? static_cast<std::uint32_t>(std::min(x, 255.0)) : 0u;
+    return x > 0.0 ? static_cast<std::uint32_t>(std::min(x, top)) : 0u;
   }
 };
 
@@ -83,7 +93,7 @@ inline std::uint64_t bloomBit(std::uint32_t slot) { return std::uint64_t{1} << (
 enum class SlotState : std::uint8_t {
   kFree,     // reusable
   kAdded,    // added since the last update(), endpoints not yet inserted
-  kLive,     // endpoints in the arrays
+  kLive,     // endpoints in the lists
   kRemoved,  // removed since the last update(); endpoints and pairs still there
 };
 
@@ -94,10 +104,26 @@ void checkBox(const Aabb& a) {
     throw InputError("box", "box min must be <= max on every axis");
 }
 
+constexpr std::uint32_t kMaxBands = 256;
+// Band width in mean box extents: wider bands, fewer duplicates; narrower,
+// fewer swaps. 4: a box is in 1.25 bands on average.
+constexpr double kBandWidthInBoxes = 4.0;
+constexpr std::size_t kLookAhead = 8;  // prefetch distance of the span reads
+
+// The lists of one axis: bands along the next axis.
+struct AxisLists {
+  Quantiser band_of;  // coordinate on the band axis -> band
+  std::vector<std::vector<Endpoint>> bands;
+  std::vector<std::uint8_t> band_lost;  // by band: a box left it this update
+  std::vector<std::uint16_t> lo, hi;    // by slot: bands the box is in now
+  std::vector<std::uint16_t> new_lo, new_hi;  // by slot: bands it must be in
+  double max_extent = 0.0;                    // on this axis, over boxes in use
+};
+
 }  // namespace
 
 struct SweepAndPrune::Impl {
-  std::vector<Endpoint> axis[3];
+  AxisLists lists[3];
   std::vector<Span> spans[3];    // by slot, per axis: the box for the next update()
   std::vector<EntityId> ids;     // by slot
   std::vector<SlotState> state;  // by slot
@@ -107,6 +133,7 @@ struct SweepAndPrune::Impl {
   std::vector<std::uint32_t> removed;  // slots to drop at the next update()
   FlatHashMap slot_of_id;
   std::uint32_t last_set = ~0u;  // slot of the last setBox: callers often go in add order
+  std::size_t live_at_banding = 0;  // boxes when the bands were last chosen
 
   // Pair set: pairs (owned by SweepAndPrune) and pair_keys are parallel dense
   // arrays; pair_index maps a key to its index there.
@@ -116,10 +143,13 @@ struct SweepAndPrune::Impl {
   // Swaps that may change the pair set: moving slot << 32 | kind | passed slot;
   // events[0, event_count) are this update's, the rest is room.
   static constexpr std::uint64_t kSeparate = 1u << 31;
-  static constexpr std::size_t kLookAhead = 8;
   std::vector<std::uint64_t> events;
   std::size_t event_count = 0;
-  std::vector<Endpoint> scratch;  // new endpoints of one axis, sorted before merging
+
+  std::vector<std::uint64_t> entering;  // band << 32 | slot, boxes to insert into bands
+  std::vector<Endpoint> scratch;        // new endpoints of one band, sorted before merging
+
+  // --- slots and pairs -------------------------------------------------------
 
   std::uint32_t slotOfId(EntityId id) const {
     const std::uint32_t slot = slot_of_id.find(id);
@@ -127,7 +157,7 @@ struct SweepAndPrune::Impl {
     return slot;
   }
 
-  bool inUse(std::uint32_t slot) const {
+  bool inUse(std::size_t slot) const {
     return state[slot] == SlotState::kLive || state[slot] == SlotState::kAdded;
   }
 
@@ -175,24 +205,28 @@ struct SweepAndPrune::Impl {
     if (index != FlatHashMap::kMissing) removePairAt(index, pairs);
   }
 
-  // Drop the endpoints and pairs of removed slots and free the slots.
-  void dropRemoved(std::vector<BroadPair>& pairs) {
-    for (auto& endpoints : axis) {
-      endpoints.erase(std::remove_if(endpoints.begin(), endpoints.end(),
-                                     [&](const Endpoint& e) {
-                                       return state[slotOf(e)] == SlotState::kRemoved;
-                                     }),
-                      endpoints.end());
-    }
+  // Remove every pair for which drop(slot a, slot b) holds.
+  template <typename Drop>
+  void removePairsWhere(std::vector<BroadPair>& pairs, Drop drop) {
     for (std::size_t i = 0; i < pairs.size();) {
       const std::uint64_t key = pair_keys[i];
-      const auto a = static_cast<std::uint32_t>(key >> 32);
-      const auto b = static_cast<std::uint32_t>(key & 0xFFFFFFFFu);
-      if (state[a] == SlotState::kRemoved || state[b] == SlotState::kRemoved)
+      if (drop(static_cast<std::uint32_t>(key >> 32), static_cast<std::uint32_t>(key & 0xFFFFFFFFu)))
         removePairAt(i, pairs);  // the last pair moved to i: look at i again
       else
         ++i;
     }
+  }
+
+  // Drop the endpoints and pairs of removed slots and free the slots.
+  void dropRemoved(std::vector<BroadPair>& pairs) {
+    for (AxisLists& list : lists)
+      for (std::vector<Endpoint>& band : list.bands)
+        band.erase(std::remove_if(band.begin(), band.end(),
+                                  [&](const Endpoint& e) { return state[slotOf(e)] == SlotState::kRemoved; }),
+                   band.end());
+    removePairsWhere(pairs, [&](std::uint32_t a, std::uint32_t b) {
+      return state[a] == SlotState::kRemoved || state[b] == SlotState::kRemoved;
+    });
     for (std::uint32_t slot : removed) {
       state[slot] = SlotState::kFree;
       free_slots.push_back(slot);
@@ -211,39 +245,105 @@ struct SweepAndPrune::Impl {
     }
   }
 
+  // --- bands -------------------------------------------------------------------
+
+  // Choose the bands from the boxes in use and put every box back as if just
+  // added (so its pairs are found again by the local sweeps). Done when the
+  // box count has changed by 2x since the last choice: amortised O(1) per add.
+  void chooseBands(std::vector<BroadPair>& pairs) {
+    std::size_t in_use = 0;
+    for (int a = 0; a < 3; ++a) {
+      const int band_axis = (a + 1) % 3;
+      double lo = INFINITY, hi = -INFINITY, extent_sum = 0.0;
+      in_use = 0;
+      for (std::size_t s = 0; s < state.size(); ++s) {
+        if (!inUse(s)) continue;
+        const Span& span = spans[band_axis][s];
+        lo = std::min(lo, span.min);
+        hi = std::max(hi, span.max);
+        extent_sum += span.max - span.min;
+        ++in_use;
+      }
+      Quantiser& q = lists[a].band_of;
+      q = Quantiser{};
+      const double extent = hi - lo;
+      if (in_use > 0 && extent > 0.0 && std::isfinite(extent)) {
+        const double mean = extent_sum / static_cast<double>(in_use);
+        const double width = std::max(kBandWidthInBoxes * mean, extent / kMaxBands);
+        q.origin = lo;
+        q.scale = 1.0 / width;
+        q.top = std::floor(extent / width);  // boxes beyond the ends go to the end bands
+      }
+      lists[a].bands.resize(static_cast<std::size_t>(q.top) + 1);
+      lists[a].band_lost.assign(lists[a].bands.size(), 0);
+      for (std::vector<Endpoint>& band : lists[a].bands) band.clear();
+    }
+    pairs.clear();
+    pair_keys.clear();
+    pair_index = FlatHashMap();
+    added.clear();
+    for (std::size_t s = 0; s < state.size(); ++s) {
+      if (!inUse(s)) continue;
+      state[s] = SlotState::kAdded;
+      added.push_back(static_cast<std::uint32_t>(s));
+    }
+    live_at_banding = in_use;
+  }
+
+  bool bandsStale() const {
+    const std::size_t n = slot_of_id.size();
+    if (live_at_banding == 0) return n > 0;
+    return n > 2 * live_at_banding || 2 * n < live_at_banding;
+  }
+
   // Quantise every box over the bounds of all boxes into the others field of
-  // its spans (the endpoints copy it in sortAxis).
-  void quantiseRanges() {
+  // its spans (the endpoints copy it when sorted), and find the bands each box
+  // must be in.
+  void quantise() {
     const std::size_t slots = state.size();
     Quantiser q[3];
     for (int a = 0; a < 3; ++a) {
-      double lo = INFINITY, hi = -INFINITY;
+      double lo = INFINITY, hi = -INFINITY, max_extent = 0.0;
       for (std::size_t s = 0; s < slots; ++s) {
-        if (!inUse(static_cast<std::uint32_t>(s))) continue;
+        if (!inUse(s)) continue;
         lo = std::min(lo, spans[a][s].min);
         hi = std::max(hi, spans[a][s].max);
+        max_extent = std::max(max_extent, spans[a][s].max - spans[a][s].min);
       }
       q[a].origin = lo <= hi ? lo : 0.0;
       const double extent = hi - lo;
       // Zero or overflowing extent: scale 0 maps all to 0, still conservative.
       q[a].scale = extent > 0.0 && std::isfinite(extent) ? 255.0 / extent : 0.0;
+      q[a].top = 255.0;
+      lists[a].max_extent = max_extent;
+      lists[a].lo.resize(slots);
+      lists[a].hi.resize(slots);
+      lists[a].new_lo.resize(slots);
+      lists[a].new_hi.resize(slots);
     }
     for (std::size_t s = 0; s < slots; ++s) {
+      if (!inUse(s)) continue;
       std::uint32_t range[3];
       for (int a = 0; a < 3; ++a) range[a] = q[a](spans[a][s].min) | (q[a](spans[a][s].max) << 8);
-      for (int a = 0; a < 3; ++a) spans[a][s].others = range[(a + 1) % 3] | (range[(a + 2) % 3] << 16);
+      for (int a = 0; a < 3; ++a) {
+        spans[a][s].others = range[(a + 1) % 3] | (range[(a + 2) % 3] << 16);
+        const Span& band_span = spans[(a + 1) % 3][s];
+        lists[a].new_lo[s] = static_cast<std::uint16_t>(lists[a].band_of(band_span.min));
+        lists[a].new_hi[s] = static_cast<std::uint16_t>(lists[a].band_of(band_span.max));
+      }
     }
   }
 
-  // Refresh and insertion-sort one axis, recording the min/max swaps that
-  // pass the filters as events. The inner loop is branch-free but for its exit: an
+  // --- sorting -----------------------------------------------------------------
+
+  // Refresh and insertion-sort one band, recording the min/max swaps that pass
+  // the filters as events. The inner loop is branch-free but for its exit: an
   // event is always written, the cursor advanced only when it counts.
   // Returns the number of swaps.
-  std::size_t sortAxis(int a) {
-    Endpoint* e = axis[a].data();
-    const std::size_t n = axis[a].size();
+  std::size_t sortBand(std::vector<Endpoint>& band, const Span* span) {
+    Endpoint* e = band.data();
+    const std::size_t n = band.size();
     const std::uint64_t* bloom = partner_bloom.data();
-    const Span* span = spans[a].data();
     std::size_t swaps = 0;
     for (std::size_t i = 0; i < n; ++i) {
       // Copy the new box into e[i] (untouched so far: the sort has only
@@ -281,9 +381,8 @@ struct SweepAndPrune::Impl {
     return swaps;
   }
 
-  // Apply the events of all three axes. Order does not matter: a join adds a
-  // pair only if the boxes overlap on every axis now, and a pair with a
-  // separate event does not.
+  // Apply the events. Order does not matter: a join adds a pair only if the
+  // boxes overlap on every axis now, and a pair with a separate event does not.
   void applyEvents(std::vector<BroadPair>& pairs) {
     for (std::size_t k = 0; k < event_count; ++k) {
       const std::uint64_t ev = events[k];
@@ -297,54 +396,101 @@ struct SweepAndPrune::Impl {
     event_count = 0;
   }
 
-  // Merge the endpoints of newly added slots into the sorted arrays, then find
-  // each new box's overlaps with a local sweep along x.
+  // --- boxes entering and leaving bands ----------------------------------------
+
+  // Merge the boxes listed in `entering` (band << 32 | slot) into the bands of
+  // list a; with `sweep`, then look for each box's pairs in the band it entered.
+  void insertEntering(int a, bool sweep, std::vector<BroadPair>& pairs) {
+    std::sort(entering.begin(), entering.end());
+    const Span* span = spans[a].data();
+    for (std::size_t g = 0; g < entering.size();) {
+      const auto b = static_cast<std::uint32_t>(entering[g] >> 32);
+      std::size_t end = g;
+      scratch.clear();
+      for (; end < entering.size() && (entering[end] >> 32) == b; ++end) {
+        const auto s = static_cast<std::uint32_t>(entering[end]);
+        scratch.push_back({span[s].min, s << 1, span[s].others});
+        scratch.push_back({span[s].max, (s << 1) | 1u, span[s].others});
+      }
+      std::sort(scratch.begin(), scratch.end(), before);
+      std::vector<Endpoint>& band = lists[a].bands[b];
+      std::size_t i = band.size(), j = scratch.size();
+      band.resize(i + j);
+      for (std::size_t w = band.size(); j > 0;) {
+        if (i > 0 && before(scratch[j - 1], band[i - 1]))
+          band[--w] = band[--i];
+        else
+          band[--w] = scratch[--j];
+      }
+      for (; g < end; ++g)
+        if (sweep) sweepBand(a, band, static_cast<std::uint32_t>(entering[g]), pairs);
+    }
+    entering.clear();
+  }
+
+  // Pairs of box s among the boxes of one band of list a: every box overlapping
+  // s on axis a has its min in [s.min - max_extent, s.max] (with a margin for
+  // rounding).
+  void sweepBand(int a, const std::vector<Endpoint>& band, std::uint32_t s, std::vector<BroadPair>& pairs) {
+    const Span& sp = spans[a][s];
+    const double width = lists[a].max_extent;
+    const double from = sp.min - width - 1e-9 * (std::abs(sp.min) + width);
+    auto it = std::lower_bound(band.begin(), band.end(), from,
+                               [](const Endpoint& e, double v) { return e.value < v; });
+    for (; it != band.end() && it->value <= sp.max; ++it) {
+      if (isMax(*it) || !rangesMayOverlap(sp.others, it->others)) continue;
+      const std::uint32_t t = slotOf(*it);
+      if (t != s && overlaps(s, t)) addPair(s, t, pairs);
+    }
+  }
+
+  // Move live boxes whose band range changed on list a (after the sort, which
+  // saw their flips in the bands they leave): drop them from bands they left,
+  // add them to bands they entered, finding their pairs there.
+  void moveBands(int a, std::vector<BroadPair>& pairs) {
+    AxisLists& list = lists[a];
+    for (std::size_t s = 0; s < state.size(); ++s) {
+      if (state[s] != SlotState::kLive) continue;
+      const std::uint32_t lo = list.lo[s], hi = list.hi[s], nlo = list.new_lo[s], nhi = list.new_hi[s];
+      if (lo == nlo && hi == nhi) continue;
+      for (std::uint32_t b = lo; b <= hi; ++b)
+        if (b < nlo || b > nhi) list.band_lost[b] = 1;
+      for (std::uint32_t b = nlo; b <= nhi; ++b)
+        if (b < lo || b > hi) entering.push_back((std::uint64_t{b} << 32) | s);
+      list.lo[s] = static_cast<std::uint16_t>(nlo);
+      list.hi[s] = static_cast<std::uint16_t>(nhi);
+    }
+    for (std::size_t b = 0; b < list.bands.size(); ++b) {
+      if (!list.band_lost[b]) continue;
+      list.band_lost[b] = 0;
+      std::vector<Endpoint>& band = list.bands[b];
+      band.erase(std::remove_if(band.begin(), band.end(),
+                                [&](const Endpoint& e) {
+                                  const std::uint32_t t = slotOf(e);
+                                  return b < list.lo[t] || b > list.hi[t];
+                                }),
+                 band.end());
+    }
+    insertEntering(a, /*sweep=*/true, pairs);
+  }
+
+  // New boxes: into their bands on every list; pairs from the x lists' sweeps
+  // (two overlapping boxes share an x-list band).
   void insertAdded(std::vector<BroadPair>& pairs) {
     // Slots removed again before this update were freed by dropRemoved().
     added.erase(std::remove_if(added.begin(), added.end(),
                                [&](std::uint32_t s) { return state[s] != SlotState::kAdded; }),
                 added.end());
     if (added.empty()) return;
-    for (int a = 0; a < 3; ++a) {
-      const std::vector<Span>& span = spans[a];
-      scratch.clear();
-      for (std::uint32_t s : added) {
-        scratch.push_back({span[s].min, s << 1, span[s].others});
-        scratch.push_back({span[s].max, (s << 1) | 1u, span[s].others});
-      }
-      std::sort(scratch.begin(), scratch.end(), before);
-      std::vector<Endpoint>& endpoints = axis[a];
-      std::size_t i = endpoints.size(), j = scratch.size();
-      endpoints.resize(i + j);
-      for (std::size_t w = endpoints.size(); j > 0;) {
-        if (i > 0 && before(scratch[j - 1], endpoints[i - 1]))
-          endpoints[--w] = endpoints[--i];
-        else
-          endpoints[--w] = scratch[--j];
-      }
-    }
     for (std::uint32_t s : added) state[s] = SlotState::kLive;
-
-    // Every box overlapping box s on x has its min in [s.min - width, s.max],
-    // width = the largest x extent of any box (with a margin for rounding).
-    const std::vector<Span>& xspan = spans[0];
-    double width = 0.0;
-    for (std::size_t s = 0; s < state.size(); ++s)
-      if (state[s] == SlotState::kLive) width = std::max(width, xspan[s].max - xspan[s].min);
-    const std::vector<Endpoint>& xs = axis[0];
-    // In x order, consecutive windows overlap and stay in cache.
-    std::sort(added.begin(), added.end(),
-              [&](std::uint32_t s, std::uint32_t t) { return xspan[s].min < xspan[t].min; });
-    for (std::uint32_t s : added) {
-      const Span& x = xspan[s];
-      const double from = x.min - width - 1e-9 * (std::abs(x.min) + width);
-      auto it = std::lower_bound(xs.begin(), xs.end(), from,
-                                 [](const Endpoint& e, double v) { return e.value < v; });
-      for (; it != xs.end() && it->value <= x.max; ++it) {
-        if (isMax(*it) || !rangesMayOverlap(x.others, it->others)) continue;
-        const std::uint32_t t = slotOf(*it);
-        if (t != s && overlaps(s, t)) addPair(s, t, pairs);
+    for (int a = 0; a < 3; ++a) {
+      AxisLists& list = lists[a];
+      for (std::uint32_t s : added) {
+        list.lo[s] = list.new_lo[s];
+        list.hi[s] = list.new_hi[s];
+        for (std::uint32_t b = list.lo[s]; b <= list.hi[s]; ++b) entering.push_back((std::uint64_t{b} << 32) | s);
       }
+      insertEntering(a, /*sweep=*/a == 0, pairs);
     }
     added.clear();
   }
@@ -404,11 +550,14 @@ void SweepAndPrune::setBox(EntityId id, const Aabb& box) {
 void SweepAndPrune::update() {
   Impl& m = *impl_;
   if (!m.removed.empty()) m.dropRemoved(pairs_);
+  if (m.bandsStale()) m.chooseBands(pairs_);
   m.rebuildBlooms();
-  m.quantiseRanges();
+  m.quantise();
   last_swaps_ = 0;
-  for (int a = 0; a < 3; ++a) last_swaps_ += m.sortAxis(a);
+  for (int a = 0; a < 3; ++a)
+    for (std::vector<Endpoint>& band : m.lists[a].bands) last_swaps_ += m.sortBand(band, m.spans[a].data());
   m.applyEvents(pairs_);
+  for (int a = 0; a < 3; ++a) m.moveBands(a, pairs_);
   if (!m.added.empty()) {
     const std::size_t entities = m.slot_of_id.size();
     // Room for a typical pair count, so steady-state ticks rarely grow them.

@@ -193,6 +193,80 @@ TEST(SweepAndPrune, FarFromOriginAddsFindTouchingNeighbours) {
   }
 }
 
+TEST(SweepAndPrune, PairsFollowBoxesAcrossBands) {
+  // The lists are split into bands along another axis (y lists by z, about 4
+  // mean box extents wide here: bands [0, 4.5), [4.5, 9), ...). A box moving
+  // to another band keeps, loses and finds pairs there.
+  SweepAndPrune sap;
+  for (EntityId i = 0; i < 20; ++i) {  // spread the boxes over 0..39 on every axis
+    const double d = 2.0 * i;
+    sap.add(100 + i, box(d + 40, d, d, d + 41, d + 1, d + 1));
+  }
+  sap.add(1, box(0, 0, 3.0, 1, 1, 3.5));  // A, band 0
+  sap.add(2, box(0, 0.5, 2, 1, 1.5, 6));  // B, bands 0 and 1
+  sap.add(3, box(0, -3, 7, 1, -2, 8));    // C, band 1
+  sap.update();
+  EXPECT_EQ(sorted(sap.pairs()), (PairList{{1, 2}}));
+  // A leaves band 0 for band 1 (still inside B's z range) and away from B in y.
+  sap.setBox(1, box(0, -3, 5.0, 1, -2, 5.5));
+  sap.update();
+  EXPECT_TRUE(sap.pairs().empty());
+  // A moves within band 1 onto C.
+  sap.setBox(1, box(0, -3, 6.0, 1, -2, 7.0));
+  sap.update();
+  EXPECT_EQ(sorted(sap.pairs()), (PairList{{1, 3}}));
+  // Far away, in other bands on every list...
+  sap.setBox(1, box(30, 10, 20, 31, 11, 20.5));
+  sap.update();
+  EXPECT_TRUE(sap.pairs().empty());
+  // ... and back in one jump onto B: no list saw a flip, the entry sweep finds it.
+  sap.setBox(1, box(0, 0, 3.0, 1, 1, 3.5));
+  sap.update();
+  EXPECT_EQ(sorted(sap.pairs()), (PairList{{1, 2}}));
+}
+
+TEST(SweepAndPrune, GrowAndShrinkMatchBruteForce) {
+  // Counts changing by more than 2x re-choose the bands; pairs survive it.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0, 1);
+  SweepAndPrune sap;
+  std::vector<EntityId> ids;
+  std::vector<Aabb> boxes;
+  auto check = [&](const char* when) {
+    sap.update();
+    ASSERT_EQ(sorted(sap.pairs()), bruteForce(ids, boxes)) << when << " at " << ids.size();
+  };
+  EntityId next = 0;
+  while (ids.size() < 1500) {
+    const std::size_t grow = 1 + ids.size() / 3;
+    for (std::size_t k = 0; k < grow; ++k) {
+      const Vec3 c(u(rng) * 12, u(rng) * 12, u(rng) * 12);
+      ids.push_back(next++);
+      boxes.push_back(cube(c, 0.2 + 0.4 * u(rng)));
+      sap.add(ids.back(), boxes.back());
+    }
+    check("growing");
+  }
+  while (ids.size() > 3) {
+    const std::size_t shrink = ids.size() / 2;
+    for (std::size_t k = 0; k < shrink; ++k) {
+      const std::size_t i = rng() % ids.size();
+      sap.remove(ids[i]);
+      ids[i] = ids.back();
+      boxes[i] = boxes.back();
+      ids.pop_back();
+      boxes.pop_back();
+    }
+    for (std::size_t i = 0; i < ids.size(); ++i) {  // and everyone moves a little
+      const Vec3 d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+      boxes[i].min += 0.3 * d;
+      boxes[i].max += 0.3 * d;
+      sap.setBox(ids[i], boxes[i]);
+    }
+    check("shrinking");
+  }
+}
+
 // --- Random movers -----------------------------------------------------------
 
 struct Mover {
