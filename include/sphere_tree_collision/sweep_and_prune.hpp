@@ -1,7 +1,8 @@
-// SweepAndPrune: the I-COLLIDE broad phase (paper 3.2). Three sorted endpoint
-// arrays kept sorted by insertion sort each tick (temporal coherence); the
+// SweepAndPrune: the I-COLLIDE broad phase (paper 3.2). Sorted endpoint lists
+// per axis kept sorted by insertion sort each tick (temporal coherence); the
 // overlap-pair set is updated by the swaps, never rebuilt by an all-pairs pass
-// after the first sort.
+// after the first sort. Each axis's list is split into bands along another
+// axis so that endpoints only pass boxes near them (sweep_and_prune.cpp).
 #pragma once
 
 #include "sphere_tree_collision/types.hpp"
