@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <functional>
+#include <utility>
 
 namespace stc {
 namespace {
@@ -270,6 +271,64 @@ TEST_F(Cubes, SphereTestsAreTheSumOfTheSteps) {
   while (!t.resolved()) sum += t.step();
   EXPECT_EQ(t.sphereTests(), sum);
   EXPECT_GT(sum, 7);
+}
+
+TEST_F(Cubes, FirstContactModeGivesTheSameAnswerWithFewerTests) {
+  b.pose.position = Vec3(0.6, 0.15, -0.1);
+  b.pose.orientation = Quat(Eigen::AngleAxisd(0.7, Vec3(1, -1, 2).normalized()));
+  PairTest all, first;
+  first.setFirstContactOnly(true);
+  all.reset(a.view(1), b.view(2));
+  first.reset(a.view(1), b.view(2));
+  runToEnd(all);
+  runToEnd(first);
+  ASSERT_EQ(all.status(), PairStatus::Colliding);
+  EXPECT_EQ(first.status(), PairStatus::Colliding);
+  EXPECT_EQ(first.stepsDone(), all.stepsDone());
+  EXPECT_EQ(first.deepestLevel(), all.deepestLevel());
+  EXPECT_LT(first.sphereTests(), all.sphereTests());
+  ASSERT_GE(all.lastPairs().size(), first.lastPairs().size());
+  for (const SpherePair& p : first.lastPairs()) {
+    bool found = false;
+    for (const SpherePair& q : all.lastPairs()) found = found || (p.a == q.a && p.b == q.b);
+    EXPECT_TRUE(found);
+  }
+}
+
+// Pair tests sharing one arena, stepped interleaved (as a round-robin
+// scheduler does), give what each gives alone; their pairs stay readable
+// until the arena is cleared.
+TEST_F(Cubes, PairTestsSharingAnArenaInterleaveCorrectly) {
+  Body c(makePreset("rock", params()), 4);
+  b.pose.position = Vec3(0.7, 0.1, 0.0);
+  c.pose.position = Vec3(-0.1, 0.65, 0.2);
+  c.pose.orientation = Quat(Eigen::AngleAxisd(1.1, Vec3(0, 1, 1).normalized()));
+  PairTest alone_ab, alone_ac;
+  alone_ab.reset(a.view(1), b.view(2));
+  alone_ac.reset(a.view(1), c.view(3));
+  runToEnd(alone_ab);
+  runToEnd(alone_ac);
+
+  PairArena arena;
+  arena.clear();
+  PairTest ab, ac;
+  ab.reset(a.view(1), b.view(2), &arena);
+  ac.reset(a.view(1), c.view(3), &arena);
+  while (!ab.resolved() || !ac.resolved()) {
+    ab.step();
+    ac.step();
+  }
+  for (const auto& [shared, alone] : {std::pair<const PairTest*, const PairTest*>{&ab, &alone_ab},
+                                      std::pair<const PairTest*, const PairTest*>{&ac, &alone_ac}}) {
+    EXPECT_EQ(shared->status(), alone->status());
+    EXPECT_EQ(shared->sphereTests(), alone->sphereTests());
+    ASSERT_EQ(shared->lastPairs().size(), alone->lastPairs().size());
+    for (std::size_t i = 0; i < alone->lastPairs().size(); ++i) {
+      EXPECT_EQ(shared->lastPairs()[i].a, alone->lastPairs()[i].a);
+      EXPECT_EQ(shared->lastPairs()[i].b, alone->lastPairs()[i].b);
+    }
+    EXPECT_DOUBLE_EQ(shared->gapBound(), alone->gapBound());
+  }
 }
 
 // Unequal heights: a one-level sphere against a four-level rock. The
