@@ -86,13 +86,6 @@ struct ShapeInfo {
   bool elongated = false;     // Auto box mode picks Dynamic
 };
 
-// Contact from a PairTest's deepest intersecting sphere pair (the roots when
-// it has none): normal along the line of centres from a to b (UnitZ when the
-// centres coincide), point dividing the centres in proportion to the radii,
-// depth = max(0, r_a + r_b - |c_b - c_a|), gap_bound = test.gapBound().
-Contact makeContact(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b,
-                    double priority);
-
 class World {
  public:
   explicit World(const WorldConfig& config = WorldConfig{});

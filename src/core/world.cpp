@@ -374,33 +374,4 @@ void World::response(double dt, TickReport& /*report*/) {
                    config_.response, dt, contacts_);
 }
 
-Contact makeContact(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b,
-                    double priority) {
-  const PairBody& a = test.bodyA();
-  const PairBody& b = test.bodyB();
-  // The deepest intersecting sphere pair; the roots when none was tested yet.
-  const SphereNode& sa = test.hasLastPair() ? a.tree->node(test.lastPair().a) : a.tree->root();
-  const SphereNode& sb = test.hasLastPair() ? b.tree->node(test.lastPair().b) : b.tree->root();
-  const Vec3 ca = a.pose->apply(sa.centre);
-  const Vec3 cb = b.pose->apply(sb.centre);
-  const Vec3 d = cb - ca;
-  const double dist = d.norm();
-  const double reach = sa.radius + sb.radius;
-
-  Contact c;
-  c.a = a.id;
-  c.b = b.id;
-  c.index_a = index_a;
-  c.index_b = index_b;
-  // Coincident centres have no line of centres: any fixed unit axis, never NaN.
-  c.normal = dist > 0.0 ? Vec3(d / dist) : Vec3::UnitZ();
-  c.point = reach > 0.0 ? Vec3(ca + d * (sa.radius / reach)) : Vec3(0.5 * (ca + cb));
-  c.depth = std::max(0.0, reach - dist);
-  c.gap_bound = test.gapBound();
-  c.level = std::max(0, test.deepestLevel());
-  c.resolved = test.status() == PairStatus::Colliding;
-  c.priority = priority;
-  return c;
-}
-
 }  // namespace stc
