@@ -5,7 +5,7 @@ packages=(
   cmake g++ git make pkg-config
   catkin ros-base-dev ros-message-generation ros-message-runtime
   libroscpp-dev libtf2-ros-dev libtf2-dev libvisualization-msgs-dev libgeometry-msgs-dev libstd-msgs-dev
-  librostest-dev python3-rostest rostest python3-roslaunch roslaunch
+  librostest-dev python3-rostest python3-roslaunch libtf2-msgs-dev
   libeigen3-dev libyaml-cpp-dev libfcl-dev libgtest-dev googletest
   python3-matplotlib
   rviz xvfb xauth imagemagick x11-utils
