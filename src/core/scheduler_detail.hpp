@@ -103,8 +103,8 @@ class PriorityQueueScheduler final : public Scheduler {
 
  private:
   struct Refined {
-    double cost = 1.0;
-    Vec3 centre_a = Vec3::Zero(), centre_b = Vec3::Zero();
+    double cost = 1.0;   // sphere tests of the next step
+    double reach = 0.0;  // r_a + r_b of a frontier pair; 0 before any step
   };
   static Refined refine(const PairTest& test);
   double perCost(double f, double cost) const;

@@ -12,11 +12,15 @@
 // the rest, including f = 0 (behind the camera). A pass over a queue is
 // finished before a higher queue that filled meanwhile is served.
 //
-// Measuring a pair computes the on-screen gap g (the paper's projected
-// distance of the last intersecting centres, see refine()) and the step cost;
-// the eccentricity weight exp(-e/100) and the pixels per metre are those of
-// the centre of collision at the start of the run (it moves by less than the
-// pair's size on screen while the pair refines; a bin spans a factor r).
+// Measuring a pair: f = g exp(-e/100) with the eccentricity weight exp(-e/100)
+// and the pixels per metre of its centre of collision at the start of the run
+// (the centre moves by less than the pair's size on screen while it refines;
+// a bin spans a factor r). g before any step is the paper's estimate, the
+// projected distance of the entity origins. After a step it is the reach
+// r_a + r_b of an intersecting frontier pair, in pixels: an upper bound of the
+// paper's g (the distance of two intersecting centres is at most their reach)
+// that costs two loads instead of two rotations and two projections per step,
+// and schedules as well or better (docs/error_vs_runtime.md).
 // Without a fixation every pair sits in one queue: plain round-robin in list order.
 #include "scheduler_detail.hpp"
 
@@ -39,26 +43,18 @@ PriorityQueueScheduler::PriorityQueueScheduler(const SchedulerOptions& options)
 //   root); then frontier size x the children of the node the first pair will
 //   be tested against (a leaf's partner's under the unequal-height rule, else
 //   the mean of the two);
-// - the centres of the first frontier pair: the paper's "last intersecting
-//   spheres" (PairTest::lastPair() picks the deepest of the frontier, which
-//   needs a pass with two rotations per frontier pair: too dear per step for
-//   choosing a queue whose bins span a factor r).
+// - reach: r_a + r_b of that pair (0 before any step).
 PriorityQueueScheduler::Refined PriorityQueueScheduler::refine(const PairTest& test) {
   Refined out;
   const SpherePairSpan frontier = test.lastPairs();
-  if (test.stepsDone() == 0 || frontier.empty()) {
-    out.centre_a = test.bodyA().pose->position;
-    out.centre_b = test.bodyB().pose->position;
-    return out;
-  }
+  if (test.stepsDone() == 0 || frontier.empty()) return out;
   const SphereNode& na = test.bodyA().tree->node(frontier[0].a);
   const SphereNode& nb = test.bodyB().tree->node(frontier[0].b);
+  out.reach = na.radius + nb.radius;
   const double children = na.child_count == 0   ? nb.child_count
                           : nb.child_count == 0 ? na.child_count
                                                 : 0.5 * (na.child_count + nb.child_count);
   out.cost = std::max(1.0, children * static_cast<double>(frontier.size()));
-  out.centre_a = test.bodyA().pose->apply(na.centre);
-  out.centre_b = test.bodyB().pose->apply(nb.centre);
   return out;
 }
 
@@ -67,16 +63,19 @@ double PriorityQueueScheduler::perCost(double f, double cost) const {
   return cost_exponent_ == 1.0 ? f / cost : f / std::pow(cost, cost_exponent_);
 }
 
-// Priority after a step: the projected distance of the refined centres
-// (the 3D distance at the pair's scale when either is behind the camera),
-// times the pair's eccentricity weight, per cost.
+// Priority of a pair now: g (see the top of the file) times its eccentricity weight, per cost.
 double PriorityQueueScheduler::remeasure(const PairTest& test, const Perception& perception,
                                          double weight, double px_per_metre) const {
   if (weight == 0.0) return 0.0;
   const Refined r = refine(test);
-  const auto pa = perception.project(r.centre_a);
-  const auto pb = perception.project(r.centre_b);
-  const double g = (pa && pb) ? (*pa - *pb).norm() : (r.centre_a - r.centre_b).norm() * px_per_metre;
+  double g = r.reach * px_per_metre;
+  if (r.reach == 0.0) {  // before any step: the projected distance of the entity origins
+    const Vec3& a = test.bodyA().pose->position;
+    const Vec3& b = test.bodyB().pose->position;
+    const auto pa = perception.project(a);
+    const auto pb = perception.project(b);
+    g = (pa && pb) ? (*pa - *pb).norm() : (a - b).norm() * px_per_metre;
+  }
   return perCost(g * weight, r.cost);
 }
 
@@ -141,9 +140,11 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
   }
   overhead.stop();
 
+  requeue.start();  // choosing the next queue is decision work too
   for (;;) {
     int q = queue_count_ - 1;
     while (q >= 0 && queues_[static_cast<std::size_t>(q)].empty()) --q;
+    requeue.stop();
     if (q < 0) break;  // everything resolved
     auto& queue = queues_[static_cast<std::size_t>(q)];
     // One round-robin pass; pairs still unresolved are compacted in place, order kept.
@@ -162,9 +163,9 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
       break;
     }
     queue.resize(kept);
+    requeue.start();
     if (!stats.used_perception) continue;
     // Re-measure what the pass refined; movers go to the back of their new queue.
-    requeue.start();
     kept = 0;
     for (std::size_t r = 0; r < queue.size(); ++r) {
       const std::uint32_t index = queue[r];
@@ -177,7 +178,6 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
       }
     }
     queue.resize(kept);
-    requeue.stop();
   }
   stats.overhead_seconds = overhead.seconds() + requeue.seconds();
   return stats;
