@@ -6,8 +6,11 @@ set -euo pipefail
 source "$(dirname "$0")/common.sh"
 bash "$STC_ROOT/scripts/install_deps.sh"
 bash "$STC_ROOT/scripts/build.sh"
+# ROS setup files read unset variables: source them without -u.
+set +u
 # shellcheck disable=SC1091
 source "$STC_BUILD/devel/setup.bash"
+set -u
 rviz=true
 if [ -z "${DISPLAY:-}" ]; then
   echo "demo: no DISPLAY, running headless (rviz:=false)"
