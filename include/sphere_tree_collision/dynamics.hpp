@@ -48,7 +48,11 @@ void integrateVelocities(std::vector<BodyState>& bodies, const IntegrationOption
 double kineticEnergy(const BodyState& body);
 // -m g.x: zero when gravity is zero.
 double potentialEnergy(const BodyState& body, const Vec3& gravity);
-double totalEnergy(const std::vector<BodyState>& bodies, const Vec3& gravity);
+// Kinetic + potential. After World::step the poses were moved with the
+// previous velocities and the velocities then updated, so positions lag
+// the velocities by half a tick: pass the tick's dt to take the potential at
+// x + v dt/2, which free fall conserves exactly (dt = 0: plain x).
+double totalEnergy(const std::vector<BodyState>& bodies, const Vec3& gravity, double dt = 0.0);
 Vec3 linearMomentum(const std::vector<BodyState>& bodies);
 // About the world origin: sum of x cross m v + I w.
 Vec3 angularMomentum(const std::vector<BodyState>& bodies);

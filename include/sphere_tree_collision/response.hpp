@@ -44,6 +44,11 @@ struct ResponseOptions {
   double allowed_penetration = 0.0;     // metres kept as slop (0: 2% of the contact's leaf radius)
   SolverKind solver = SolverKind::Sequential;
   bool warm_starting = true;            // start from last tick's impulses of matching contacts
+  // After the iterations, one sweep up the contact graph from the static
+  // bodies in which each supporting body counts as immovable for what rests
+  // on it (shock propagation, Guendelman et al. 2003): stacks and heavy-on-light
+  // hold; only approach towards the support is removed, never added.
+  bool shock_propagation = true;
   int max_contacts_per_pair = 4;        // spread-out representatives of the sphere pairs, 1..16
   bool face_normals = true;             // voxel-box face axis when it separates more (ContactBuilder)
   bool continuous = true;               // sweep fast bodies back to their first contact
@@ -54,6 +59,10 @@ struct ResponseOptions {
 };
 // Throws InputError naming the field ("response.iterations", ...).
 void validateResponseOptions(const ResponseOptions& options);
+
+// Two unit vectors completing unit n to a right-handed basis (t1, t2, n);
+// continuous in n away from n = +-x.
+void tangentBasis(const Vec3& n, Vec3& t1, Vec3& t2);
 
 // ---------------------------------------------------------------------------
 // Per-shape bounds, computed once per shape
@@ -104,8 +113,9 @@ struct ContactBuildOptions {
 // tilts by up to 45 degrees, making floors bumpy and balls sit in dimples.
 // Up to max_contacts_per_pair representatives are picked spread out among the
 // deep candidates (deepest corner first, then farthest, then largest
-// triangle); every candidate joins its nearest representative, whose normal
-// becomes the overlap^2-weighted mean of its members' normals. separation is
+// triangle); every candidate joins its nearest representative; the cluster's
+// normal is the mean over its deepest members (sphere overlap within 10% of
+// its deepest: the pairs straight across the contact). separation is
 // measured along that normal between the nodes' surfaces
 // (ShapeBounds::support; the sphere itself without bounds). Coincident
 // centres: the direction between the body centres, then +Z; never NaN.
@@ -124,10 +134,10 @@ class ContactBuilder {
     double separation = 0.0;                  // gap between the surfaces along normal
     std::int32_t node_a = 0, node_b = 0;
     int cluster = 0;
+    bool refined = false;                     // separation and face normal evaluated (deep enough)
   };
   std::vector<Candidate> candidates_;
   std::vector<int> reps_;
-  std::vector<double> deepest_of_a_, deepest_of_b_;  // per tree node; -inf when untouched
 };
 
 // ---------------------------------------------------------------------------
@@ -164,6 +174,10 @@ class ContactSolver {
     Vec3 ang_a[3], ang_b[3];
     double inv_ma = 0.0, inv_mb = 0.0;
     double mass[3] = {0.0, 0.0, 0.0};  // 1 / effective mass along n, t1, t2
+    double k_a[3] = {0.0, 0.0, 0.0};   // each body's part of the effective inverse mass
+    double k_b[3] = {0.0, 0.0, 0.0};
+    int level = 0;             // contact-graph distance of the lower body from a static one
+    std::uint8_t support = 0;  // 1: a supports b (a is nearer the ground), 2: b supports a, 0: neither
     double friction = 0.0, restitution = 0.0;
     double approach = 0.0;     // normal relative velocity before the solve (< 0: closing)
     double speculative = 0.0;  // closing speed allowed by a gap: max(s, 0) / dt
@@ -185,11 +199,13 @@ class ContactSolver {
   void warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
                  SolveStats& stats);
   void solveVelocities(const ResponseOptions& options);
+  void propagateShock(const ResponseOptions& options);
   void applyRestitution(const ResponseOptions& options, SolveStats& stats);
   void solvePositions(const ResponseOptions& options);
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
 
-  std::vector<Row> rows_;
+  std::vector<Row> rows_, sorted_rows_;
+  std::vector<std::uint32_t> order_;
   std::vector<Vec3> v_, w_;    // solver velocities, one per body
   std::vector<Vec3> dv_, dw_;  // Jacobi: impulses of one iteration, applied together
   std::vector<Vec3> pv_, pw_;  // split-impulse pseudo-velocities

@@ -109,9 +109,14 @@ double potentialEnergy(const BodyState& body, const Vec3& gravity) {
   return -gravity.dot(body.pose.position) / body.inv_mass;
 }
 
-double totalEnergy(const std::vector<BodyState>& bodies, const Vec3& gravity) {
+double totalEnergy(const std::vector<BodyState>& bodies, const Vec3& gravity, double dt) {
   double e = 0.0;
-  for (const BodyState& body : bodies) e += kineticEnergy(body) + potentialEnergy(body, gravity);
+  for (const BodyState& body : bodies) {
+    e += kineticEnergy(body) + potentialEnergy(body, gravity);
+    if (dt != 0.0 && !body.is_static && body.inv_mass > 0.0) {
+      e -= gravity.dot(body.linear_velocity) * 0.5 * dt / body.inv_mass;
+    }
+  }
   return e;
 }
 

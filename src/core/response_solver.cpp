@@ -8,16 +8,11 @@
 
 namespace stc {
 
-namespace {
-
-// Two unit tangents completing n (n unit).
-void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+void tangentBasis(const Vec3& n, Vec3& t1, Vec3& t2) {
   t1 = std::abs(n.x()) < 0.57735 ? Vec3(0.0, n.z(), -n.y()) : Vec3(n.y(), -n.x(), 0.0);
   t1.normalize();
   t2 = n.cross(t1);
 }
-
-}  // namespace
 
 SolverKind parseSolverKind(const std::string& name) {
   if (name == "sequential") return SolverKind::Sequential;
@@ -88,7 +83,7 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     row.ra = c.point - ba.pose.position;
     row.rb = c.point - bb.pose.position;
     row.n = c.normal;
-    tangents(row.n, row.t1, row.t2);
+    tangentBasis(row.n, row.t1, row.t2);
     const Vec3 dirs[3] = {row.n, row.t1, row.t2};
     // Mass splitting (Jacobi): each body's inverse mass counts once per contact on it.
     const double split_a = jacobi ? std::max(1, contact_count_[row.a]) : 1.0;
@@ -100,6 +95,8 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
       row.ang_b[k] = bb.is_static ? Vec3::Zero() : Vec3(bb.inv_inertia_world * rxd_b);
       const double ka = row.inv_ma + rxd_a.dot(row.ang_a[k]);
       const double kb = row.inv_mb + rxd_b.dot(row.ang_b[k]);
+      row.k_a[k] = ka;
+      row.k_b[k] = kb;
       const double k_total = split_a * ka + split_b * kb;
       row.mass[k] = k_total > 0.0 ? 1.0 / k_total : 0.0;
     }
@@ -164,9 +161,74 @@ void ContactSolver::orderFromTheGround(const std::vector<BodyState>& bodies) {
       }
     }
   }
-  const auto level = [&](const Row& row) { return std::min(depth_[row.a], depth_[row.b]); };
-  std::stable_sort(rows_.begin(), rows_.end(),
-                   [&](const Row& x, const Row& y) { return level(x) < level(y); });
+  for (Row& row : rows_) {
+    const int da = depth_[row.a];
+    const int db = depth_[row.b];
+    row.level = std::min(da, db);
+    row.support = da < db ? 1 : (db < da ? 2 : 0);
+  }
+  // Stable sort by level through an index (rows are large).
+  order_.resize(rows_.size());
+  for (std::uint32_t r = 0; r < rows_.size(); ++r) order_[r] = r;
+  std::stable_sort(order_.begin(), order_.end(), [&](std::uint32_t x, std::uint32_t y) {
+    return rows_[x].level < rows_[y].level;
+  });
+  sorted_rows_.resize(rows_.size());
+  for (std::size_t r = 0; r < rows_.size(); ++r) sorted_rows_[r] = rows_[order_[r]];
+  rows_.swap(sorted_rows_);
+}
+
+// One sweep up the levels; within a level its rows are iterated, the
+// supporting body of each row held still. Unreached rows (nothing static
+// below them) are left as the iterations made them.
+void ContactSolver::propagateShock(const ResponseOptions& options) {
+  constexpr int kUnreached = std::numeric_limits<int>::max();
+  const int passes = std::max(2, options.iterations / 2);
+  std::size_t begin = 0;
+  while (begin < rows_.size() && rows_[begin].level != kUnreached) {
+    std::size_t end = begin;
+    while (end < rows_.size() && rows_[end].level == rows_[begin].level) ++end;
+    for (int pass = 0; pass < passes; ++pass) {
+      for (std::size_t r = begin; r < end; ++r) {
+        Row& row = rows_[r];
+        const bool move_a = row.support != 1;  // a is held when it supports b
+        const bool move_b = row.support != 2;
+        double mass[3];
+        for (int k = 0; k < 3; ++k) {
+          const double kk = (move_a ? row.k_a[k] : 0.0) + (move_b ? row.k_b[k] : 0.0);
+          mass[k] = kk > 0.0 ? 1.0 / kk : 0.0;
+        }
+        const auto apply = [&](int k, double delta) {
+          const Vec3& d = k == 0 ? row.n : (k == 1 ? row.t1 : row.t2);
+          if (move_a) {
+            v_[row.a] -= row.inv_ma * delta * d;
+            w_[row.a] -= delta * row.ang_a[k];
+          }
+          if (move_b) {
+            v_[row.b] += row.inv_mb * delta * d;
+            w_[row.b] += delta * row.ang_b[k];
+          }
+        };
+        Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
+        const double limit = row.friction * row.lambda[0];
+        const double t1 = row.lambda[1] - mass[1] * vrel.dot(row.t1);
+        const double t2 = row.lambda[2] - mass[2] * vrel.dot(row.t2);
+        const double tn = std::sqrt(t1 * t1 + t2 * t2);
+        const double scale = tn > limit ? (tn > 0.0 ? limit / tn : 0.0) : 1.0;
+        const double d1 = t1 * scale - row.lambda[1];
+        const double d2 = t2 * scale - row.lambda[2];
+        row.lambda[1] += d1;
+        row.lambda[2] += d2;
+        apply(1, d1);
+        apply(2, d2);
+        vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
+        const double normal = std::max(0.0, row.lambda[0] + mass[0] * (-row.speculative - vrel.dot(row.n)));
+        apply(0, normal - row.lambda[0]);
+        row.lambda[0] = normal;
+      }
+    }
+    begin = end;
+  }
 }
 
 void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
@@ -221,7 +283,7 @@ void ContactSolver::solveVelocities(const ResponseOptions& options) {
       const double limit = row.friction * row.lambda[0];
       const double t1 = row.lambda[1] - row.mass[1] * vrel.dot(row.t1);
       const double t2 = row.lambda[2] - row.mass[2] * vrel.dot(row.t2);
-      const double tn = std::hypot(t1, t2);
+      const double tn = std::sqrt(t1 * t1 + t2 * t2);
       const double scale = tn > limit ? (tn > 0.0 ? limit / tn : 0.0) : 1.0;
       const double d1 = t1 * scale - row.lambda[1];
       const double d2 = t2 * scale - row.lambda[2];
@@ -253,7 +315,6 @@ void ContactSolver::solveVelocities(const ResponseOptions& options) {
       }
     }
   }
-  for (Row& row : rows_) row.lambda_main = row.lambda[0];
 }
 
 void ContactSolver::applyRestitution(const ResponseOptions& options, SolveStats& stats) {
@@ -382,6 +443,10 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
   }
   if (options.warm_starting) warmStart(contacts, bodies, stats);
   solveVelocities(options);
+  const bool jacobi = options.solver == SolverKind::Jacobi;
+  if (jacobi) for (Row& row : rows_) row.lambda_main = row.lambda[0];
+  if (options.shock_propagation) propagateShock(options);
+  if (!jacobi) for (Row& row : rows_) row.lambda_main = row.lambda[0];
   applyRestitution(options, stats);
   solvePositions(options);
   store(bodies, contacts, dt);

@@ -1,0 +1,147 @@
+// Stability report (issue 4, item 6): per stiff or extreme scene, the max
+// energy drift, max penetration, max speed, NaN count and steps per second;
+// then the solver choices side by side on the scenes that decide between
+// them (docs/response.md). Prints markdown tables.
+//
+//   bench_stability            all scenes, default response options
+//   bench_stability --quick    shorter runs (a smoke check of the bench itself)
+#include "stability_scenes.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+using namespace stc;
+using namespace stc::stability;
+
+namespace {
+
+struct Row {
+  std::string scene;
+  std::string outcome;
+  Metrics m;
+};
+
+void printTable(const std::vector<Row>& rows) {
+  std::printf("| scene | outcome | max energy gain | max penetration (voxels) | max speed (m/s) | NaN | steps/s |\n");
+  std::printf("|---|---|---:|---:|---:|---:|---:|\n");
+  for (const Row& r : rows) {
+    std::printf("| %s | %s | %.2e | %.3f | %.3g | %zu | %.0f |\n", r.scene.c_str(), r.outcome.c_str(),
+                r.m.energy_gain, r.m.max_penetration, r.m.max_speed, r.m.nan_count, r.m.steps_per_second);
+  }
+}
+
+std::string fmt(const char* format, double a, double b = 0.0) {
+  char buffer[160];
+  std::snprintf(buffer, sizeof(buffer), format, a, b);
+  return buffer;
+}
+
+Row stackRow(const std::string& label, Scene scene) {
+  const Metrics m = run(scene);
+  return {label, fmt("drift %.3f voxel/s after settling", m.drift), m};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  const double t = quick ? 0.25 : 1.0;  // fraction of the full durations
+
+  std::vector<Row> rows;
+  rows.push_back(stackRow("stack of 10 cubes, 10 s", stack(10, 0.05, 1.0 / 60.0, 10.0 * t, 2.0 * t)));
+
+  {
+    Scene scene = massRatio(1000.0, 5.0 * t);
+    const std::size_t heavy = scene.movers.back();
+    const double rest = scene.world->bodies()[heavy].pose.position.z();
+    const Metrics m = run(scene);
+    const double sink = (rest - scene.world->bodies()[heavy].pose.position.z()) / scene.voxel;
+    rows.push_back({"heavy cube on 4 light cubes, 1000:1", fmt("heavy sank %.3f voxels", sink), m});
+  }
+  {
+    Scene scene = fastSphere(100.0, 0.5);
+    double lowest = 1e9;
+    const std::size_t ball = scene.movers.front();
+    const Metrics m = run(scene, [&](const World& w, int) {
+      lowest = std::min(lowest, w.bodies()[ball].pose.position.z());
+    });
+    const bool through = lowest < 0.0;
+    rows.push_back({"1-voxel sphere at 100 m/s vs 1-voxel plate",
+                    fmt(through ? "TUNNELLED (lowest centre %.3f voxels)" : "no tunnelling (lowest centre %.3f voxels above the plate centre)",
+                        lowest / scene.voxel),
+                    m});
+  }
+  {
+    Scene scene = spinningRod(100.0, 10.0 * t);
+    const std::size_t rod = scene.movers.front();
+    const double e0 = kineticEnergy(scene.world->bodies()[rod]);
+    double worst = 0.0;
+    double min_axis = 1.0;
+    const Metrics m = run(scene, [&](const World& w, int) {
+      const BodyState& b = w.bodies()[rod];
+      worst = std::max(worst, (kineticEnergy(b) - e0) / e0);
+      const Vec3 body_w = b.pose.orientation.conjugate() * b.angular_velocity;
+      min_axis = std::min(min_axis, body_w.y() / 100.0);
+    });
+    rows.push_back({"thin rod at 100 rad/s about its intermediate axis",
+                    fmt("kinetic energy max rise %.1e; spin axis flips (min w_y/w0 %.2f)", worst, min_axis), m});
+  }
+  rows.push_back(stackRow("stack of 10, 1 mm voxels", stack(10, 0.001, 1.0 / 60.0, 10.0 * t, 2.0 * t)));
+  rows.push_back(stackRow("stack of 10, 100 m voxels", stack(10, 100.0, 1.0 / 60.0, 10.0 * t, 2.0 * t)));
+  rows.push_back(stackRow("stack of 10, dt = 1e-4", stack(10, 0.05, 1e-4, 2.0 * t, 0.5 * t)));
+  rows.push_back(stackRow("stack of 10, dt = 0.1", stack(10, 0.05, 0.1, 20.0 * t, 5.0 * t)));
+  {
+    Scene scene = cornerPile(125, 4, 4.0 * t, Budget::ofSphereTests(0));
+    const Metrics m = run(scene);
+    rows.push_back({"zero budget (125 rocks, all pairs accepted unresolved)",
+                    fmt("final max speed %.3f m/s", m.final_max_speed), m});
+  }
+  {
+    Scene scene = cornerPile(500, 4, 4.0 * t);
+    const Metrics m = run(scene);
+    rows.push_back({"500 rocks dropped into a corner", fmt("final max speed %.3f m/s", m.final_max_speed), m});
+  }
+  std::printf("## Stiff and extreme scenes (default ResponseOptions)\n\n");
+  printTable(rows);
+
+  // Solver choices: what holds a stack and a heavy body, at what cost.
+  struct Choice {
+    const char* name;
+    std::function<void(ResponseOptions&)> set;
+  };
+  const std::vector<Choice> choices = {
+      {"sequential, warm start, shock propagation (default)", [](ResponseOptions&) {}},
+      {"sequential, warm start, no shock propagation", [](ResponseOptions& o) { o.shock_propagation = false; }},
+      {"sequential, no warm start, no shock propagation",
+       [](ResponseOptions& o) { o.shock_propagation = false; o.warm_starting = false; }},
+      {"Jacobi (simultaneous), warm start, shock propagation",
+       [](ResponseOptions& o) { o.solver = SolverKind::Jacobi; }},
+      {"Jacobi (simultaneous), warm start, no shock propagation",
+       [](ResponseOptions& o) { o.solver = SolverKind::Jacobi; o.shock_propagation = false; }},
+      {"sequential, paper normals only (no voxel-box faces)", [](ResponseOptions& o) { o.face_normals = false; }},
+      {"sequential, 10 iterations", [](ResponseOptions& o) { o.iterations = 10; }},
+  };
+  std::printf("\n## Solver choices (20 iterations unless stated)\n\n");
+  std::printf("| solver | stack of 10: drift (voxel/s) | stack: max speed at end (m/s) | 1000:1: heavy sank (voxels) | 1000:1: max penetration (voxels) | 500 rocks: max speed at end (m/s) | 500 rocks: steps/s |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|\n");
+  for (const Choice& c : choices) {
+    ResponseOptions o;
+    c.set(o);
+    Scene s = stack(10, 0.05, 1.0 / 60.0, 10.0 * t, 2.0 * t, o);
+    const Metrics ms = run(s);
+    Scene r = massRatio(1000.0, 5.0 * t, o);
+    const std::size_t heavy = r.movers.back();
+    const double rest = r.world->bodies()[heavy].pose.position.z();
+    const Metrics mr = run(r);
+    const double sink = (rest - r.world->bodies()[heavy].pose.position.z()) / r.voxel;
+    Scene p = cornerPile(500, 4, 4.0 * t, Budget::unlimited(), o);
+    const Metrics mp = run(p);
+    std::printf("| %s | %.3g | %.3g | %.3g | %.3g | %.3g | %.0f |\n", c.name, ms.drift, ms.final_max_speed, sink,
+                mr.max_penetration, mp.final_max_speed, mp.steps_per_second);
+    std::fflush(stdout);
+  }
+  return 0;
+}

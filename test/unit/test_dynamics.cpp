@@ -1,0 +1,411 @@
+// Integration, contact building, impulse solver and swept test, each on flat
+// arrays of BodyState / Contact without a World.
+#include "sphere_tree_collision/dynamics.hpp"
+#include "sphere_tree_collision/response.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace stc {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A free body with the inertia of a solid box of side lengths `size`.
+BodyState boxBody(double mass, const Vec3& size, const Vec3& position = Vec3::Zero()) {
+  BodyState b;
+  b.inv_mass = 1.0 / mass;
+  const Vec3 s2 = size.cwiseProduct(size);
+  const Vec3 inertia = mass / 12.0 * Vec3(s2.y() + s2.z(), s2.x() + s2.z(), s2.x() + s2.y());
+  b.inv_inertia_body = inertia.cwiseInverse().asDiagonal();
+  b.pose.position = position;
+  refreshWorldInertia(b);
+  return b;
+}
+
+BodyState staticBody(const Vec3& position = Vec3::Zero()) {
+  BodyState b;
+  b.is_static = true;
+  b.pose.position = position;
+  return b;
+}
+
+Contact contactBetween(std::uint32_t a, std::uint32_t b, const Vec3& point, const Vec3& normal,
+                       double separation) {
+  Contact c;
+  c.a = a;
+  c.b = b;
+  c.index_a = a;
+  c.index_b = b;
+  c.point = point;
+  c.normal = normal;
+  c.separation = separation;
+  c.gap_bound = 0.01;
+  return c;
+}
+
+SphereTree cubeTree(int n, double voxel, Vec3* origin = nullptr) {
+  const VoxelShape shape = VoxelShape::create(n, n, n, voxel, std::vector<std::uint8_t>(n * n * n, 1));
+  const Vec3 centre = Vec3::Constant(0.5 * n * voxel);
+  if (origin != nullptr) *origin = centre;
+  return SphereTree::build(shape, centre);
+}
+
+// ---------------------------------------------------------------------------
+// Integration
+
+TEST(Dynamics, SemiImplicitEulerFallsExactlyAndStaticBodiesNeverMove) {
+  std::vector<BodyState> bodies = {boxBody(2.0, Vec3::Ones()), staticBody(Vec3(1, 2, 3))};
+  bodies[0].linear_velocity = Vec3(1.0, 0.0, 0.0);
+  IntegrationOptions options;
+  options.gravity = Vec3(0.0, 0.0, -9.81);
+  const double dt = 0.01;
+  for (int n = 0; n < 100; ++n) {
+    integratePositions(bodies, dt);
+    integrateVelocities(bodies, options, dt);
+  }
+  // Positions move with the previous velocity: z = -g dt^2 n (n - 1) / 2.
+  EXPECT_NEAR(bodies[0].pose.position.x(), 1.0, 1e-12);
+  EXPECT_NEAR(bodies[0].pose.position.z(), -9.81 * dt * dt * 100 * 99 / 2.0, 1e-12);
+  EXPECT_NEAR(bodies[0].linear_velocity.z(), -9.81, 1e-12);
+  EXPECT_EQ(bodies[1].pose.position, Vec3(1, 2, 3));
+  EXPECT_EQ(bodies[1].linear_velocity, Vec3::Zero());
+  // Positions lag the velocities by half a tick: the energy taken at x + v dt/2 is conserved.
+  std::vector<BodyState> start = {boxBody(2.0, Vec3::Ones())};
+  start[0].linear_velocity = Vec3(1.0, 0.0, 0.0);
+  EXPECT_NEAR(totalEnergy(bodies, options.gravity, dt), totalEnergy(start, options.gravity, dt), 1e-9);
+}
+
+TEST(Dynamics, ZeroGravityLeavesVelocitiesAlone) {
+  std::vector<BodyState> bodies = {boxBody(1.0, Vec3::Ones())};
+  bodies[0].linear_velocity = Vec3(0.5, -0.25, 2.0);
+  integrateVelocities(bodies, IntegrationOptions{}, 0.1);
+  EXPECT_EQ(bodies[0].linear_velocity, Vec3(0.5, -0.25, 2.0));
+}
+
+TEST(Dynamics, ExponentialMapTurnsByExactlyWDtEvenForFastSpin) {
+  const Vec3 w(0.0, 0.0, 100.0);
+  const double dt = 1.0 / 60.0;  // 1.67 rad per tick
+  Quat q = Quat::Identity();
+  for (int n = 0; n < 7; ++n) q = integrateOrientation(q, w, dt);
+  const Quat expected(Eigen::AngleAxisd(100.0 * 7 * dt, Vec3::UnitZ()));
+  EXPECT_NEAR(q.angularDistance(expected), 0.0, 1e-12);
+  EXPECT_NEAR(q.norm(), 1.0, 1e-15);
+  // World inertia follows the orientation.
+  BodyState b = boxBody(1.0, Vec3(4, 1, 1));
+  b.pose.orientation = Quat(Eigen::AngleAxisd(kPi / 2, Vec3::UnitZ()));
+  refreshWorldInertia(b);
+  EXPECT_NEAR(b.inv_inertia_world(1, 1), b.inv_inertia_body(0, 0), 1e-12);  // long axis now along y
+}
+
+TEST(Dynamics, GyroscopicStepKeepsEnergyAndMomentumAndTumblesAboutTheIntermediateAxis) {
+  // Box 16 x 3 x 1: x least, y intermediate, z most inertia.
+  BodyState b = boxBody(1.0, Vec3(1.6, 0.3, 0.1));
+  b.angular_velocity = Vec3(0.1, 100.0, 0.1);
+  const double e0 = kineticEnergy(b);
+  const Mat3 inertia0 = worldInertia(b);
+  const Vec3 l0 = inertia0 * b.angular_velocity;
+  std::vector<BodyState> bodies = {b};
+  IntegrationOptions options;  // gyroscopic on, no gravity
+  double min_axis = 1.0;
+  for (int n = 0; n < 600; ++n) {
+    integratePositions(bodies, 1.0 / 60.0);
+    integrateVelocities(bodies, options, 1.0 / 60.0);
+    const double e = kineticEnergy(bodies[0]);
+    ASSERT_LE(e, e0 * (1.0 + 1e-12)) << "energy grew at tick " << n;
+    const Vec3 l = worldInertia(bodies[0]) * bodies[0].angular_velocity;
+    ASSERT_NEAR(l.norm(), l0.norm(), 1e-9 * l0.norm());
+    const Vec3 body_w = bodies[0].pose.orientation.conjugate() * bodies[0].angular_velocity;
+    min_axis = std::min(min_axis, body_w.y() / 100.0);
+  }
+  EXPECT_NEAR(kineticEnergy(bodies[0]), e0, 1e-9 * e0);  // midpoint rule: conserved, not dissipated
+  EXPECT_LT(min_axis, -0.5);  // the spin axis flipped (Dzhanibekov effect)
+
+  // Isotropic bodies have no gyroscopic term: w unchanged.
+  BodyState cube = boxBody(1.0, Vec3::Ones());
+  cube.angular_velocity = Vec3(3, -2, 7);
+  EXPECT_EQ(gyroscopicStep(cube, 0.1), cube.angular_velocity);
+}
+
+// ---------------------------------------------------------------------------
+// Impulses
+
+TEST(Response, HeadOnElasticContactSwapsEqualMassesAndInelasticEndsTogether) {
+  for (const SolverKind kind : {SolverKind::Sequential, SolverKind::Jacobi}) {
+    for (const double e : {1.0, 0.0}) {
+      std::vector<BodyState> bodies = {boxBody(1.0, Vec3::Ones(), Vec3(-0.5, 0, 0)),
+                                       boxBody(1.0, Vec3::Ones(), Vec3(0.5, 0, 0))};
+      bodies[0].linear_velocity = Vec3(2.0, 0, 0);
+      bodies[1].linear_velocity = Vec3(-1.0, 0, 0);
+      for (BodyState& b : bodies) b.material = Material{e, 0.0};
+      std::vector<Contact> contacts = {contactBetween(0, 1, Vec3::Zero(), Vec3::UnitX(), 0.0)};
+      ResponseOptions options;
+      options.solver = kind;
+      solveContacts(bodies, contacts, options, 0.01);
+      if (e == 1.0) {
+        EXPECT_NEAR(bodies[0].linear_velocity.x(), -1.0, 1e-12) << toString(kind);
+        EXPECT_NEAR(bodies[1].linear_velocity.x(), 2.0, 1e-12);
+      } else {
+        EXPECT_NEAR(bodies[0].linear_velocity.x(), 0.5, 1e-12) << toString(kind);
+        EXPECT_NEAR(bodies[1].linear_velocity.x(), 0.5, 1e-12);
+      }
+      EXPECT_GT(contacts[0].normal_impulse, 0.0);
+    }
+  }
+}
+
+TEST(Response, FrictionIsBoundedByMuTimesTheNormalImpulse) {
+  // A box sliding at 5 m/s lands on a static floor: friction takes mu * dv_n of its speed.
+  std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 0.5))};
+  bodies[1].linear_velocity = Vec3(5.0, 0.0, -1.0);
+  for (BodyState& b : bodies) b.material = Material{0.0, 0.4};
+  std::vector<Contact> contacts = {contactBetween(0, 1, Vec3::Zero(), Vec3::UnitZ(), 0.0)};
+  solveContacts(bodies, contacts, ResponseOptions{}, 0.01);
+  EXPECT_NEAR(contacts[0].normal_impulse, 1.0, 1e-12);  // stops the 1 m/s approach of 1 kg
+  EXPECT_NEAR(contacts[0].friction_impulse.norm(), 0.4, 1e-12);  // saturated: sliding
+  EXPECT_LT(contacts[0].friction_impulse.x(), 0.0);
+  EXPECT_NEAR(bodies[1].linear_velocity.z(), 0.0, 1e-12);
+  EXPECT_NEAR(bodies[1].linear_velocity.x(), 5.0 - 0.4, 1e-12);
+  EXPECT_GT(bodies[1].angular_velocity.y(), 0.0);  // friction below the centre pitches it forward (+y)
+
+  // Slow enough to stick: friction below its limit stops the slip.
+  bodies[1].linear_velocity = Vec3(0.01, 0.0, -1.0);
+  bodies[1].angular_velocity.setZero();
+  solveContacts(bodies, contacts, ResponseOptions{}, 0.01);
+  EXPECT_LT(contacts[0].friction_impulse.norm(), 0.4 * contacts[0].normal_impulse);
+  const Vec3 slip = bodies[1].linear_velocity + bodies[1].angular_velocity.cross(Vec3(0, 0, -0.5));
+  EXPECT_NEAR(slip.x(), 0.0, 1e-9);
+}
+
+TEST(Response, SplitImpulseRemovesPenetrationWithoutAddingVelocity) {
+  std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 0.45))};
+  std::vector<Contact> contacts;
+  for (const double x : {-0.5, 0.5}) {
+    for (const double y : {-0.5, 0.5}) {
+      contacts.push_back(contactBetween(0, 1, Vec3(x, y, -0.05), Vec3::UnitZ(), -0.05));
+    }
+  }
+  ResponseOptions options;
+  options.allowed_penetration = 0.01;
+  options.position_correction = 0.5;
+  const double dt = 0.01;
+  const SolveStats stats = solveContacts(bodies, contacts, options, dt);
+  EXPECT_NEAR(stats.max_penetration, 0.05, 1e-12);
+  EXPECT_EQ(bodies[1].linear_velocity, Vec3::Zero());  // pseudo-velocities are discarded
+  EXPECT_EQ(kineticEnergy(bodies[1]), 0.0);
+  EXPECT_NEAR(bodies[1].pose.position.z(), 0.45 + 0.5 * (0.05 - 0.01), 1e-6);
+  EXPECT_NEAR(bodies[1].pose.position.x(), 0.0, 1e-9);
+}
+
+TEST(Response, SpeculativeGapLetsABodyCloseItButNotMore) {
+  std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 0.52))};
+  bodies[1].linear_velocity = Vec3(0, 0, -0.1);  // 1 mm per 10 ms tick, gap 20 mm: untouched
+  std::vector<Contact> contacts = {contactBetween(0, 1, Vec3(0, 0, 0.01), Vec3::UnitZ(), 0.02)};
+  const double dt = 0.01;
+  solveContacts(bodies, contacts, ResponseOptions{}, dt);
+  EXPECT_EQ(bodies[1].linear_velocity, Vec3(0, 0, -0.1));
+  bodies[1].linear_velocity = Vec3(0, 0, -5.0);  // would pass 50 mm: stopped at the surface
+  for (BodyState& b : bodies) b.material.restitution = 0.0;
+  solveContacts(bodies, contacts, ResponseOptions{}, dt);
+  EXPECT_NEAR(bodies[1].linear_velocity.z(), -0.02 / dt, 1e-9);
+}
+
+TEST(Response, WarmStartingFindsLastTicksImpulse) {
+  std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 0.5))};
+  std::vector<Contact> contacts = {contactBetween(0, 1, Vec3(0, 0, 0), Vec3::UnitZ(), 0.0)};
+  ContactSolver solver;
+  ResponseOptions options;
+  bodies[1].linear_velocity = Vec3(0, 0, -0.1);
+  SolveStats first = solver.solve(bodies, contacts, options, 0.01);
+  EXPECT_EQ(first.warm_started, 0u);
+  bodies[1].linear_velocity = Vec3(0, 0, -0.1);
+  SolveStats second = solver.solve(bodies, contacts, options, 0.01);
+  EXPECT_EQ(second.warm_started, 1u);
+  EXPECT_NEAR(contacts[0].normal_impulse, 0.1, 1e-12);
+  solver.forget();
+  EXPECT_EQ(solver.solve(bodies, contacts, options, 0.01).warm_started, 0u);
+}
+
+TEST(Response, OptionsAndSolverNamesAreValidatedByField) {
+  EXPECT_EQ(parseSolverKind("jacobi"), SolverKind::Jacobi);
+  EXPECT_STREQ(toString(parseSolverKind("sequential")), "sequential");
+  try {
+    parseSolverKind("gauss");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "solver");
+  }
+  ResponseOptions o;
+  validateResponseOptions(o);
+  o.iterations = 0;
+  try {
+    validateResponseOptions(o);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "response.iterations");
+  }
+  o = ResponseOptions{};
+  o.position_correction = 1.5;
+  EXPECT_THROW(validateResponseOptions(o), InputError);
+  Vec3 t1, t2;
+  for (const Vec3& n : {Vec3(Vec3::UnitX()), Vec3(Vec3::UnitZ()), Vec3(Vec3(1, 2, 3).normalized())}) {
+    tangentBasis(n, t1, t2);
+    EXPECT_NEAR(t1.dot(n), 0.0, 1e-15);
+    EXPECT_NEAR(t2.dot(n), 0.0, 1e-15);
+    EXPECT_NEAR(t1.norm(), 1.0, 1e-15);
+    EXPECT_NEAR(t1.cross(t2).dot(n), 1.0, 1e-15);
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Contacts from sphere pairs
+
+struct TwoCubes {
+  SphereTree tree;
+  VoxelShape shape = VoxelShape::create(4, 4, 4, 0.1, std::vector<std::uint8_t>(64, 1));
+  Vec3 origin;
+  ShapeBounds bounds;
+  Pose pose_a, pose_b;
+  PairTest test;
+
+  explicit TwoCubes(const Vec3& offset, const Quat& turn = Quat::Identity()) {
+    origin = Vec3::Constant(0.2);
+    tree = SphereTree::build(shape, origin);
+    bounds = makeShapeBounds(tree, &shape, origin);
+    pose_b.position = offset;
+    pose_b.orientation = turn;
+    test.reset(PairBody{0, &tree, &pose_a}, PairBody{1, &tree, &pose_b});
+    while (!test.resolved()) test.step();
+  }
+};
+
+TEST(Contacts, FaceOnCubesGiveSpreadContactsWithTheFaceNormalAndTheTrueOverlap) {
+  TwoCubes cubes(Vec3(0.39, 0.0, 0.0));  // 40 cm cubes, 1 cm overlap along x
+  ASSERT_EQ(cubes.test.status(), PairStatus::Colliding);
+  ContactBuilder builder;
+  std::vector<Contact> contacts;
+  builder.append(cubes.test, 0, 1, 0.0, &cubes.bounds, &cubes.bounds, ContactBuildOptions{}, contacts);
+  ASSERT_EQ(contacts.size(), 4u);
+  for (const Contact& c : contacts) {
+    EXPECT_NEAR(c.normal.x(), 1.0, 1e-12);
+    EXPECT_NEAR(c.separation, -0.01, 1e-12);  // voxel boxes: exact face overlap
+    EXPECT_GT(c.depth, 0.0);
+    EXPECT_NEAR(c.point.x(), 0.195, 1e-9);   // halfway between the faces
+    EXPECT_LE(std::abs(c.point.y()), 0.2);
+    EXPECT_TRUE(c.resolved);
+    EXPECT_EQ(c.a, 0u);
+    EXPECT_EQ(c.b, 1u);
+  }
+  // Spread over the face: the four corners' quadrants.
+  Vec3 lo = Vec3::Constant(1e9), hi = Vec3::Constant(-1e9);
+  for (const Contact& c : contacts) {
+    lo = lo.cwiseMin(c.point);
+    hi = hi.cwiseMax(c.point);
+  }
+  EXPECT_GT(hi.y() - lo.y(), 0.2);
+  EXPECT_GT(hi.z() - lo.z(), 0.2);
+
+  // The paper's rule alone: normals along lines of centres, tilted off the face.
+  ContactBuildOptions paper;
+  paper.face_normals = false;
+  contacts.clear();
+  builder.append(cubes.test, 0, 1, 0.0, &cubes.bounds, &cubes.bounds, paper, contacts);
+  ASSERT_FALSE(contacts.empty());
+  for (const Contact& c : contacts) EXPECT_GT(c.normal.x(), 0.7);
+
+  // Without bounds: sphere surfaces (the leaves' radius), a deeper overlap.
+  contacts.clear();
+  ContactBuildOptions one;
+  one.max_contacts_per_pair = 1;
+  builder.append(cubes.test, 0, 1, 0.0, nullptr, nullptr, one, contacts);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_LT(contacts[0].separation, -0.01);
+}
+
+TEST(Contacts, CoincidentCentresNeverGiveNaN) {
+  TwoCubes cubes(Vec3::Zero());
+  ContactBuilder builder;
+  std::vector<Contact> contacts;
+  builder.append(cubes.test, 0, 1, 0.0, &cubes.bounds, &cubes.bounds, ContactBuildOptions{}, contacts);
+  ASSERT_FALSE(contacts.empty());
+  for (const Contact& c : contacts) {
+    EXPECT_TRUE(c.normal.allFinite());
+    EXPECT_NEAR(c.normal.norm(), 1.0, 1e-12);
+    EXPECT_TRUE(c.point.allFinite());
+    EXPECT_TRUE(std::isfinite(c.separation));
+    EXPECT_LT(c.separation, 0.0);
+  }
+  // And the solver pushes them apart with finite numbers.
+  std::vector<BodyState> bodies = {boxBody(1.0, Vec3::Constant(0.4)), boxBody(1.0, Vec3::Constant(0.4))};
+  solveContacts(bodies, contacts, ResponseOptions{}, 0.01);
+  for (const BodyState& b : bodies) EXPECT_TRUE(isFinite(b));
+  EXPECT_GT((bodies[1].pose.position - bodies[0].pose.position).norm(), 0.0);
+}
+
+TEST(Contacts, SeparateOrRejectedPairsGiveNoneAndUntestedPairsUseTheRoots) {
+  ContactBuilder builder;
+  std::vector<Contact> contacts;
+  TwoCubes apart(Vec3(0.6, 0.0, 0.0));  // roots overlap, leaves do not
+  EXPECT_EQ(apart.test.status(), PairStatus::Separate);
+  builder.append(apart.test, 0, 1, 0.0, &apart.bounds, &apart.bounds, ContactBuildOptions{}, contacts);
+  EXPECT_TRUE(contacts.empty());
+
+  // Zero budget: never stepped, accepted unresolved -> one contact from the roots.
+  PairTest untested;
+  untested.reset(PairBody{0, &apart.tree, &apart.pose_a}, PairBody{1, &apart.tree, &apart.pose_b});
+  ContactBuildOptions reject;
+  reject.accept_unresolved = false;
+  builder.append(untested, 0, 1, 0.0, &apart.bounds, &apart.bounds, reject, contacts);
+  EXPECT_TRUE(contacts.empty());
+  builder.append(untested, 0, 1, 0.0, &apart.bounds, &apart.bounds, ContactBuildOptions{}, contacts);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_FALSE(contacts[0].resolved);
+  EXPECT_EQ(contacts[0].node_a, 0);
+  EXPECT_NEAR(contacts[0].normal.x(), 1.0, 1e-12);
+  EXPECT_NEAR(contacts[0].separation, 0.2, 1e-12);  // root boxes are the cubes: 20 cm apart
+}
+
+// ---------------------------------------------------------------------------
+// Swept test
+
+TEST(Sweep, AFastSmallBodyIsStoppedAtAThinPlateAndSlowOrSlidingOnesAreNot) {
+  const double voxel = 0.05;
+  const VoxelShape plate_shape = VoxelShape::create(16, 16, 1, voxel, std::vector<std::uint8_t>(256, 1));
+  const Vec3 plate_origin(0.4, 0.4, 0.025);
+  const SphereTree plate_tree = SphereTree::build(plate_shape, plate_origin);
+  const ShapeBounds plate = makeShapeBounds(plate_tree, &plate_shape, plate_origin);
+  const VoxelShape ball_shape = VoxelShape::create(1, 1, 1, voxel, {1});
+  const Vec3 ball_origin = Vec3::Constant(0.025);
+  const SphereTree ball_tree = SphereTree::build(ball_shape, ball_origin);
+  const ShapeBounds ball = makeShapeBounds(ball_tree, &ball_shape, ball_origin);
+
+  std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Constant(voxel))};
+  std::vector<Pose> start(2);
+  start[1].position = Vec3(0.01, 0.02, 0.5);
+  bodies[1].pose.position = Vec3(0.01, 0.02, -1.0);  // straight through the plate in one tick
+  const std::vector<const ShapeBounds*> shapes = {&plate, &ball};
+  SweepStats stats = sweepFastBodies(bodies, start, shapes, 0.5);
+  EXPECT_EQ(stats.fast_bodies, 1u);
+  EXPECT_EQ(stats.clamped, 1u);
+  const double z = bodies[1].pose.position.z();
+  EXPECT_GT(z, 0.025);         // centre still above the plate's top face
+  EXPECT_LT(z, 0.05);          // and touching it (ball half + plate half = 1 voxel)
+
+  // Slow: moved less than half its smallest leaf radius -> not swept.
+  bodies[1].pose.position = Vec3(0.01, 0.02, 0.49);
+  stats = sweepFastBodies(bodies, start, shapes, 0.5);
+  EXPECT_EQ(stats.fast_bodies, 0u);
+  EXPECT_NEAR(bodies[1].pose.position.z(), 0.49, 1e-15);
+
+  // Sliding fast along the plate while resting on it: nothing to stop.
+  start[1].position = Vec3(-0.3, 0.02, 0.05);
+  bodies[1].pose.position = Vec3(0.3, 0.02, 0.05);
+  stats = sweepFastBodies(bodies, start, shapes, 0.5);
+  EXPECT_EQ(stats.fast_bodies, 1u);
+  EXPECT_EQ(stats.clamped, 0u);
+  EXPECT_NEAR(bodies[1].pose.position.x(), 0.3, 1e-15);
+}
+
+}  // namespace
+}  // namespace stc

@@ -1,0 +1,120 @@
+// Stiff and extreme scenes (issue 4, item 5). Every scene: all state finite,
+// no gain of total energy beyond kEnergyTolerance of its energy scale (nothing
+// drives these scenes), penetration bounded, no body faster than free fall
+// allows, and its own outcome. Scenes: test/support/stability_scenes.hpp.
+#include "stability_scenes.hpp"
+
+#include "sphere_tree_collision/dynamics.hpp"
+
+#include <gtest/gtest.h>
+
+namespace stc::stability {
+namespace {
+
+// Stated tolerances.
+constexpr double kEnergyTolerance = 1e-3;   // of KE(0) + potential above the lowest body
+constexpr double kRestingPenetration = 0.1; // voxels, in resting scenes
+constexpr double kDrift = 0.1;              // voxels per second once settled
+
+void expectSane(const Scene& scene, const Metrics& m, double max_penetration) {
+  SCOPED_TRACE(scene.name);
+  EXPECT_EQ(m.nan_count, 0u);
+  EXPECT_LE(m.energy_gain, kEnergyTolerance);
+  EXPECT_LE(m.max_penetration, max_penetration);
+  EXPECT_LE(m.max_speed, scene.speed_bound);
+  for (const BodyState& b : scene.world->bodies()) EXPECT_TRUE(isFinite(b));
+}
+
+void expectStackRests(Scene scene) {
+  const Metrics m = run(scene);
+  expectSane(scene, m, kRestingPenetration);
+  EXPECT_LE(m.drift, kDrift) << scene.name;
+  // Still a stack: every cube above the one below it.
+  const auto& b = scene.world->bodies();
+  for (std::size_t k = 1; k < scene.movers.size(); ++k) {
+    EXPECT_NEAR(b[scene.movers[k]].pose.position.z() - b[scene.movers[k - 1]].pose.position.z(),
+                8 * scene.voxel, kRestingPenetration * scene.voxel);
+  }
+}
+
+TEST(Stability, StackOfTenCubesRestsTenSeconds) { expectStackRests(stack(10)); }
+
+TEST(Stability, StackRestsAtMillimetreVoxels) { expectStackRests(stack(10, 0.001)); }
+
+TEST(Stability, StackRestsAtHundredMetreVoxels) { expectStackRests(stack(10, 100.0)); }
+
+TEST(Stability, StackRestsWithATenthOfAMillisecondTick) {
+  expectStackRests(stack(10, 0.05, 1e-4, 0.6, 0.2));
+}
+
+TEST(Stability, StackRestsWithATenthOfASecondTick) { expectStackRests(stack(10, 0.05, 0.1, 20.0, 5.0)); }
+
+TEST(Stability, HeavyCubeOnLightCubesAtMassRatio1000Holds) {
+  Scene scene = massRatio(1000.0);
+  const std::size_t heavy = scene.movers.back();
+  const Vec3 rest = scene.world->bodies()[heavy].pose.position;
+  std::vector<Vec3> light;
+  for (std::size_t k = 0; k + 1 < scene.movers.size(); ++k) light.push_back(scene.world->bodies()[scene.movers[k]].pose.position);
+  const Metrics m = run(scene);
+  expectSane(scene, m, kRestingPenetration);
+  EXPECT_LE(m.drift, kDrift);
+  const auto& b = scene.world->bodies();
+  EXPECT_LE((b[heavy].pose.position - rest).norm(), kRestingPenetration * scene.voxel);
+  for (std::size_t k = 0; k < light.size(); ++k) {
+    EXPECT_LE((b[scene.movers[k]].pose.position - light[k]).norm(), kRestingPenetration * scene.voxel);
+  }
+}
+
+TEST(Stability, OneVoxelSphereAtHundredMetresPerSecondDoesNotTunnelThroughAOneVoxelPlate) {
+  Scene scene = fastSphere(100.0);
+  const std::size_t ball = scene.movers.front();
+  double lowest = 1e9;
+  const Metrics m = run(scene, [&](const World& w, int) {
+    lowest = std::min(lowest, w.bodies()[ball].pose.position.z());
+  });
+  expectSane(scene, m, 0.25);
+  // The plate's top face is at half a voxel: the ball's centre never gets past it.
+  EXPECT_GT(lowest, 0.5 * scene.voxel);
+  // It bounced back with e = 0.5.
+  EXPECT_NEAR(scene.world->bodies()[ball].linear_velocity.z(), 50.0, 0.5);
+  EXPECT_GT(scene.world->bodies()[ball].pose.position.z(), 1.0);
+}
+
+TEST(Stability, ThinRodSpinningAboutItsUnstableAxisNeverGainsEnergy) {
+  Scene scene = spinningRod(100.0);
+  const std::size_t rod = scene.movers.front();
+  const double e0 = kineticEnergy(scene.world->bodies()[rod]);
+  double highest = e0;
+  double min_axis = 1.0;
+  const Metrics m = run(scene, [&](const World& w, int) {
+    const BodyState& b = w.bodies()[rod];
+    highest = std::max(highest, kineticEnergy(b));
+    min_axis = std::min(min_axis, (b.pose.orientation.conjugate() * b.angular_velocity).y() / 100.0);
+  });
+  expectSane(scene, m, 0.0);
+  EXPECT_LE(highest, e0 * (1.0 + 1e-9));
+  EXPECT_GE(kineticEnergy(scene.world->bodies()[rod]), e0 * (1.0 - 1e-6));  // and keeps it
+  EXPECT_LT(min_axis, -0.5);  // it tumbles: the spin about the intermediate axis reverses
+}
+
+TEST(Stability, ZeroDetectionBudgetStaysFiniteAndBounded) {
+  WorldConfig probe;
+  ASSERT_EQ(probe.unresolved_policy, UnresolvedPolicy::Accept);
+  Scene scene = cornerPile(125, 4, 4.0, Budget::ofSphereTests(0));
+  const Metrics m = run(scene);
+  // Root spheres stand in for the shapes: contacts repel at the roots' boxes,
+
+  expectSane(scene, m, 2.0);
+  EXPECT_LE(m.final_max_speed, 0.5);
+}
+
+TEST(Stability, FiveHundredRocksDroppedIntoACornerSettle) {
+  Scene scene = cornerPile(500, 4, 4.0);
+  ASSERT_EQ(scene.movers.size(), 500u);
+  const Metrics m = run(scene);
+  expectSane(scene, m, 1.5);
+  EXPECT_LE(m.final_max_speed, 0.5);
+}
+
+}  // namespace
+}  // namespace stc::stability
