@@ -249,6 +249,11 @@ TEST(RvizRender, DemoIsDrawn) {
 
   rviz.stop();
   xvfb.stop();
+  std::string keep;  // optional: where to keep the last screenshot (PPM), e.g. for docs
+  if (ros::param::get("~keep_screenshot", keep) && !keep.empty()) {
+    std::ifstream in(screenshot, std::ios::binary);
+    std::ofstream(keep, std::ios::binary) << in.rdbuf();
+  }
   if (!::testing::Test::HasFailure()) {  // keep the screenshot and logs of a failure only
     for (const char* f : {"/screenshot.ppm", "/rviz.log", "/xvfb.log"}) std::remove((dir + f).c_str());
     ::rmdir(dir.c_str());
