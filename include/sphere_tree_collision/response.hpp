@@ -17,6 +17,7 @@
 #include <array>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace stc {
@@ -205,7 +206,7 @@ class ContactSolver {
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
 
   std::vector<Row> rows_, sorted_rows_;
-  std::vector<std::uint32_t> order_;
+  std::vector<std::uint32_t> order_, level_start_;
   std::vector<Vec3> v_, w_;    // solver velocities, one per body
   std::vector<Vec3> dv_, dw_;  // Jacobi: impulses of one iteration, applied together
   std::vector<Vec3> pv_, pw_;  // split-impulse pseudo-velocities
@@ -238,8 +239,13 @@ struct SweepStats {
 // Pairs already overlapping at the start are resting contacts, left to the
 // solver. The velocity is kept: the response of this same tick turns it.
 // shapes[i] may be nullptr (the body is never hit).
+// Node-pair stack of the sweep, kept between calls so a tick allocates nothing.
+struct SweepScratch {
+  std::vector<std::pair<std::int32_t, std::int32_t>> stack;
+};
 SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
-                           const std::vector<const ShapeBounds*>& shapes, double threshold);
+                           const std::vector<const ShapeBounds*>& shapes, double threshold,
+                           SweepScratch* scratch = nullptr);
 
 // ---------------------------------------------------------------------------
 // The World's physics: integrate and respond, keeping what lasts between
@@ -279,6 +285,7 @@ class Physics {
   std::vector<ShapeBounds> bounds_;  // by shape id, built on first use
   std::vector<Pose> start_;
   std::vector<const ShapeBounds*> body_bounds_;
+  SweepScratch sweep_scratch_;
   PhysicsReport report_;
 };
 

@@ -167,12 +167,20 @@ void ContactSolver::orderFromTheGround(const std::vector<BodyState>& bodies) {
     row.level = std::min(da, db);
     row.support = da < db ? 1 : (db < da ? 2 : 0);
   }
-  // Stable sort by level through an index (rows are large).
+  // Stable counting sort by level through an index (rows are large; no
+  // allocation once the scratch has grown). Unreached rows go last.
+  int top = 0;
+  for (const Row& row : rows_) {
+    if (row.level != kUnreached) top = std::max(top, row.level);
+  }
+  const auto bucket = [&](const Row& row) {
+    return static_cast<std::size_t>(row.level == kUnreached ? top + 1 : row.level);
+  };
+  level_start_.assign(static_cast<std::size_t>(top) + 3, 0);
+  for (const Row& row : rows_) ++level_start_[bucket(row) + 1];
+  for (std::size_t l = 1; l < level_start_.size(); ++l) level_start_[l] += level_start_[l - 1];
   order_.resize(rows_.size());
-  for (std::uint32_t r = 0; r < rows_.size(); ++r) order_[r] = r;
-  std::stable_sort(order_.begin(), order_.end(), [&](std::uint32_t x, std::uint32_t y) {
-    return rows_[x].level < rows_[y].level;
-  });
+  for (std::uint32_t r = 0; r < rows_.size(); ++r) order_[level_start_[bucket(rows_[r])]++] = r;
   sorted_rows_.resize(rows_.size());
   for (std::size_t r = 0; r < rows_.size(); ++r) sorted_rows_[r] = rows_[order_[r]];
   rows_.swap(sorted_rows_);

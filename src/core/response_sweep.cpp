@@ -119,9 +119,11 @@ struct Sweeper {
 }  // namespace
 
 SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
-                           const std::vector<const ShapeBounds*>& shapes, double threshold) {
+                           const std::vector<const ShapeBounds*>& shapes, double threshold,
+                           SweepScratch* scratch) {
   SweepStats stats;
-  std::vector<std::pair<std::int32_t, std::int32_t>> stack;
+  SweepScratch local;
+  std::vector<std::pair<std::int32_t, std::int32_t>>& stack = (scratch != nullptr ? *scratch : local).stack;
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     BodyState& body = bodies[i];
     const ShapeBounds* fast = shapes[i];
