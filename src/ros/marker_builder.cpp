@@ -120,7 +120,7 @@ Marker& MarkerBuilder::next(visualization_msgs::MarkerArray& out, const std::str
 }
 
 void MarkerBuilder::build(const stc::World& world, const std::unordered_map<stc::EntityId, Rgba>& colors,
-                          const MarkerOptions& options, const std::optional<GazeRay>& gaze,
+                          const MarkerOptions& options, const std::optional<stc::Vec3>& gaze_point,
                           const ros::Time& stamp, visualization_msgs::MarkerArray& out) {
   used_ = 0;
   next_id_ = 0;
@@ -142,6 +142,7 @@ void MarkerBuilder::build(const stc::World& world, const std::unordered_map<stc:
       m.points.assign(g.surface_voxels.begin(), g.surface_voxels.end());
     }
     for (int level : options.levels) {
+      if (!options.static_trees && bodies[i].is_static) break;
       if (level < 0 || static_cast<std::size_t>(level) >= g.levels.size()) continue;
       if (level_ns_.size() <= static_cast<std::size_t>(level)) {
         for (int l = static_cast<int>(level_ns_.size()); l <= level; ++l) level_ns_.push_back("tree_level_" + std::to_string(l));
@@ -156,7 +157,7 @@ void MarkerBuilder::build(const stc::World& world, const std::unordered_map<stc:
     }
   }
   addContacts(world, options, stamp, out);
-  if (gaze) addGaze(*gaze, options, stamp, out);
+  if (gaze_point) addGaze(*gaze_point, options, stamp, out);
   out.markers.resize(used_);
 }
 
@@ -199,18 +200,14 @@ void MarkerBuilder::addContacts(const stc::World& world, const MarkerOptions& op
   used_ = write;
 }
 
-void MarkerBuilder::addGaze(const GazeRay& gaze, const MarkerOptions& options, const ros::Time& stamp,
+// Only the point: in a view matching the camera the ray from the eye would
+// cover the screen.
+void MarkerBuilder::addGaze(const stc::Vec3& gaze_point, const MarkerOptions& options, const ros::Time& stamp,
                             visualization_msgs::MarkerArray& out) {
   Marker& dot = next(out, "gaze", Marker::SPHERE, stamp, options.frame);
-  dot.pose.position = toPointMsg(gaze.point);
+  dot.pose.position = toPointMsg(gaze_point);
   dot.scale.x = dot.scale.y = dot.scale.z = 3.0 * options.contact_size;
   dot.color = kGazeColor;
-  Marker& ray = next(out, "gaze", Marker::LINE_LIST, stamp, options.frame);
-  ray.scale.x = 0.3 * options.contact_size;
-  ray.color = kGazeColor;
-  ray.color.a = 0.4f;
-  ray.points.push_back(toPointMsg(gaze.origin));
-  ray.points.push_back(toPointMsg(gaze.point));
 }
 
 }  // namespace stc_ros

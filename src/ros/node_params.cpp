@@ -2,6 +2,7 @@
 
 #include "sphere_tree_collision/ros/conversions.hpp"
 
+#include <climits>
 #include <cmath>
 #include <set>
 
@@ -13,10 +14,10 @@ using stc::InputError;
 // Every private parameter the node reads; others are reported as unknown.
 const std::set<std::string>& knownParams() {
   static const std::set<std::string> kNames{
-      "scene", "world_frame", "rate", "marker_rate", "marker_levels", "show_voxels", "publish_tf",
+      "scene", "scene_entities", "scene_seed", "entity_size", "world_frame", "rate", "marker_rate", "marker_levels", "show_voxels", "static_tree_markers", "publish_tf",
       "max_contact_markers", "contact_marker_size", "detection_budget", "sphere_test_budget", "scheduler", "queue_count",
       "unresolved_policy", "max_entities", "max_voxels", "tree_levels", "sphere_fit", "gravity",
-      "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame",
+      "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y"};
   return kNames;
 }
@@ -74,6 +75,9 @@ stc::Budget NodeParams::budget() const {
 NodeParams readNodeParams(const ros::NodeHandle& nh) {
   NodeParams p;
   read(nh, "scene", p.scene);
+  p.scene_entities = readIntIn(nh, "scene_entities", p.scene_entities, 0, 1000000);
+  p.scene_seed = static_cast<std::uint32_t>(readIntIn(nh, "scene_seed", static_cast<int>(p.scene_seed), 0, INT_MAX));
+  p.scene_entity_size = readPositive(nh, "entity_size", p.scene_entity_size);
   read(nh, "world_frame", p.world_frame);
   if (p.world_frame.empty()) throw InputError("world_frame", "must not be empty");
   p.rate = readPositive(nh, "rate", p.rate);
@@ -85,6 +89,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
     }
   }
   read(nh, "show_voxels", p.show_voxels);
+  read(nh, "static_tree_markers", p.static_tree_markers);
   read(nh, "publish_tf", p.publish_tf);
   p.max_contact_markers = readIntIn(nh, "max_contact_markers", p.max_contact_markers, 0, 1000000);
   p.contact_marker_size = readPositive(nh, "contact_marker_size", p.contact_marker_size);
@@ -120,8 +125,15 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   p.default_resolution = static_cast<std::uint32_t>(readIntIn(nh, "default_resolution", resolution, 1, 4096));
 
   read(nh, "camera_frame", p.camera.frame);
-  if (auto v = readVec3(nh, "camera_position")) p.camera.position = *v;
-  if (auto v = readVec3(nh, "camera_look_at")) p.camera.look_at = *v;
+  read(nh, "published_camera_frame", p.camera.published_frame);
+  if (auto v = readVec3(nh, "camera_position")) {
+    p.camera.position = *v;
+    p.camera.pose_given = true;
+  }
+  if (auto v = readVec3(nh, "camera_look_at")) {
+    p.camera.look_at = *v;
+    p.camera.pose_given = true;
+  }
   p.camera.width = readIntIn(nh, "camera_width", p.camera.width, 1, 100000);
   p.camera.height = readIntIn(nh, "camera_height", p.camera.height, 1, 100000);
   p.camera.fov_y_deg = readPositive(nh, "camera_fov_y", p.camera.fov_y_deg);

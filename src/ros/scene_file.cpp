@@ -183,7 +183,7 @@ std::string sceneKeyOf(const std::string& field) {
 
 }  // namespace
 
-Scene parseScene(const std::string& yaml_text) {
+Scene parseSceneYaml(const std::string& yaml_text) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -205,12 +205,12 @@ Scene parseScene(const std::string& yaml_text) {
   return scene;
 }
 
-Scene loadSceneFile(const std::string& path) {
+Scene loadSceneYaml(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError("scene", "cannot read file '" + path + "'");
   std::stringstream text;
   text << in.rdbuf();
-  return parseScene(text.str());
+  return parseSceneYaml(text.str());
 }
 
 std::vector<stc::EntityId> addScene(stc::World& world, const Scene& scene) {

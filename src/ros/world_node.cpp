@@ -2,6 +2,7 @@
 
 #include "sphere_tree_collision/ros/conversions.hpp"
 #include "sphere_tree_collision/ros/scene_file.hpp"
+#include "sphere_tree_collision/scenes.hpp"
 
 #include <cmath>
 #include <limits>
@@ -10,6 +11,15 @@ namespace stc_ros {
 namespace {
 
 const char* const kInputTopics[] = {"spawn", "despawn", "gaze", "clicked_point"};
+const Rgba kWallColor{0.55f, 0.57f, 0.6f, 1.0f};
+
+// A path or a .yaml name is a scene file; anything else names a built-in scene.
+bool isSceneFile(const std::string& scene) {
+  const auto endsWith = [&](const std::string& suffix) {
+    return scene.size() >= suffix.size() && scene.compare(scene.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  return scene.find('/') != std::string::npos || endsWith(".yaml") || endsWith(".yml");
+}
 
 stc::Camera cameraAt(const CameraParams& params, const stc::Pose& pose) {
   stc::Camera camera;
@@ -39,41 +49,40 @@ stc::Vec3 gazeTarget(const stc::World& world, const stc::Vec3& origin, const stc
   return origin + 5.0 * dir;
 }
 
+// Unknown names are warned about first: a typo may be why a value is missing.
+NodeParams readParamsWarningUnknown(const ros::NodeHandle& private_nh) {
+  for (const std::string& name : unknownParams(private_nh)) {
+    ROS_WARN("unknown parameter ~%s is ignored", name.c_str());
+  }
+  return readNodeParams(private_nh);
+}
+
 }  // namespace
 
 WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : nh_(nh), pnh_(private_nh), params_(readNodeParams(private_nh)) {
-  for (const std::string& name : unknownParams(pnh_)) {
-    ROS_WARN("unknown parameter ~%s is ignored", name.c_str());
-  }
-  Scene scene;
-  try {
-    scene = params_.scene.empty() ? parseScene(defaultSceneYaml()) : loadSceneFile(params_.scene);
-  } catch (const stc::InputError& e) {
-    throw stc::InputError(e.field() == "scene" ? "scene" : "scene " + e.field(), reasonOf(e));
-  }
-  stc::WorldConfig config = params_.world;
-  config.gravity = params_.gravity ? *params_.gravity : scene.gravity;
-  world_ = stc::World(config);
-  std::vector<stc::EntityId> ids;
-  try {
-    ids = addScene(world_, scene);
-  } catch (const stc::InputError& e) {
-    throw stc::InputError("scene " + e.field(), reasonOf(e));
-  }
-  for (std::size_t i = 0; i < ids.size(); ++i) remember(ids[i], scene.entities[i].request);
-
-  const stc::Pose camera_pose = stc::opticalLookAt(params_.camera.position, params_.camera.look_at);
+    : nh_(nh), pnh_(private_nh), params_(readParamsWarningUnknown(private_nh)) {
+  const stc::Pose camera_pose = loadScene();
   world_.perception().setCamera(cameraAt(params_.camera, camera_pose));
   if (!params_.camera.frame.empty()) {
     tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
+  } else if (!params_.camera.published_frame.empty()) {
+    // Companion nodes (gaze_simulator's follow mode) and users find the camera in tf.
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = ros::Time::now();
+    t.header.frame_id = params_.world_frame;
+    t.child_frame_id = params_.camera.published_frame;
+    t.transform.translation = toVector3Msg(camera_pose.position);
+    t.transform.rotation = toQuaternionMsg(camera_pose.orientation);
+    camera_broadcaster_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
+    camera_broadcaster_->sendTransform(t);
   }
   budget_ = params_.budget();
   dt_ = 1.0 / params_.rate;
   marker_options_.frame = params_.world_frame;
   marker_options_.levels = params_.marker_levels;
   marker_options_.voxels = params_.show_voxels;
+  marker_options_.static_trees = params_.static_tree_markers;
   marker_options_.max_contacts = static_cast<std::size_t>(params_.max_contact_markers);
 
   markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
@@ -96,9 +105,58 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
            params_.sphere_test_budget < 0 ? "no limit" : std::to_string(params_.sphere_test_budget).c_str());
 }
 
-void WorldNode::remember(stc::EntityId id, const EntityRequest& request) {
-  colors_[id] = request.color ? *request.color : paletteColor(id);
-  frames_[id] = entityFrame(id, request.spec.name);
+void WorldNode::remember(stc::EntityId id, const std::string& name, const std::optional<Rgba>& color) {
+  colors_[id] = color ? *color : paletteColor(id);
+  frames_[id] = entityFrame(id, name);
+}
+
+stc::Pose WorldNode::loadScene() {
+  stc::WorldConfig config = params_.world;
+  stc::Pose camera_pose = stc::opticalLookAt(params_.camera.position, params_.camera.look_at);
+  if (params_.scene.empty() || isSceneFile(params_.scene)) {
+    Scene scene;
+    try {
+      scene = params_.scene.empty() ? parseSceneYaml(defaultSceneYaml()) : loadSceneYaml(params_.scene);
+    } catch (const stc::InputError& e) {
+      throw stc::InputError(e.field() == "scene" ? "scene" : "scene " + e.field(), reasonOf(e));
+    }
+    config.gravity = params_.gravity ? *params_.gravity : scene.gravity;
+    world_ = stc::World(config);
+    std::vector<stc::EntityId> ids;
+    try {
+      ids = addScene(world_, scene);
+    } catch (const stc::InputError& e) {
+      throw stc::InputError("scene " + e.field(), reasonOf(e));
+    }
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      remember(ids[i], scene.entities[i].request.spec.name, scene.entities[i].request.color);
+    }
+    return camera_pose;
+  }
+
+  // A built-in scene of the core (scenes.hpp), by name.
+  stc::SceneKind kind{};
+  try {
+    kind = stc::parseScene(params_.scene);
+  } catch (const stc::InputError& e) {
+    throw stc::InputError("scene", reasonOf(e) + ", or a YAML file path");
+  }
+  config.gravity = params_.gravity ? *params_.gravity : stc::sceneGravity(kind);
+  world_ = stc::World(config);
+  stc::SceneParams scene_params;
+  scene_params.entities = params_.scene_entities;
+  scene_params.seed = params_.scene_seed;
+  scene_params.entity_size = params_.scene_entity_size;
+  stc::SceneSpec spec;
+  try {
+    spec = stc::populateScene(world_, kind, scene_params);
+  } catch (const stc::InputError& e) {
+    const std::string field = e.field() == "entities" ? "scene_entities" : e.field() == "entity_size" ? "entity_size" : e.field();
+    throw stc::InputError(field, reasonOf(e) + " (scene " + params_.scene + ")");
+  }
+  for (stc::EntityId id : spec.walls) remember(id, "", kWallColor);
+  for (stc::EntityId id : spec.movers) remember(id, "", std::nullopt);
+  return params_.camera.pose_given ? camera_pose : spec.camera.camera_to_world;
 }
 
 // ---------------------------------------------------------------------------------
@@ -222,11 +280,11 @@ void WorldNode::publishTf(const ros::Time& stamp) {
 void WorldNode::publishMarkers() {
   if (markers_pub_.getNumSubscribers() == 0) return;
   marker_options_.contact_size = params_.contact_marker_size;
-  marker_builder_.build(world_, colors_, marker_options_, gazeRay(), ros::Time::now(), markers_msg_);
+  marker_builder_.build(world_, colors_, marker_options_, gazePoint(), ros::Time::now(), markers_msg_);
   markers_pub_.publish(markers_msg_);
 }
 
-std::optional<GazeRay> WorldNode::gazeRay() const {
+std::optional<stc::Vec3> WorldNode::gazePoint() const {
   const stc::Perception& p = world_.perception();
   if (!p.hasFixation()) return std::nullopt;
   const stc::Camera& camera = p.camera();
@@ -234,7 +292,7 @@ std::optional<GazeRay> WorldNode::gazeRay() const {
   const stc::Vec3 dir_camera((f.x() - 0.5 * camera.width) / p.focalPx(), (f.y() - 0.5 * camera.height) / p.focalPx(), 1.0);
   const stc::Vec3 dir = (camera.camera_to_world.orientation * dir_camera).normalized();
   const stc::Vec3 origin = camera.camera_to_world.position;
-  return GazeRay{origin, gazeTarget(world_, origin, dir)};
+  return gazeTarget(world_, origin, dir);
 }
 
 // ---------------------------------------------------------------------------------
@@ -251,9 +309,10 @@ void WorldNode::onSpawn(const sphere_tree_collision::SpawnEntity& msg) {
   const bool is_preset = !msg.preset.empty();
   try {
     EntityRequest request = toEntityRequest(msg, params_.default_resolution);
-    const EntityRequest kept_for_style{std::string(), {}, std::nullopt, request.spec, request.color};
+    const std::string name = request.spec.name;
+    const std::optional<Rgba> color = request.color;
     const stc::EntityId id = addRequest(world_, std::move(request));
-    remember(id, kept_for_style);
+    remember(id, name, color);
     ROS_DEBUG("spawned entity %u (%s)", id, frames_[id].c_str());
   } catch (const stc::InputError& e) {
     reject(Input::Spawn, spawnFieldOf(e.field(), is_preset), reasonOf(e));

@@ -6,7 +6,7 @@
 //   contacts          SPHERE_LIST per size class: green = resolved at the leaves,
 //                     orange = accepted unresolved; larger = higher perceptual priority
 //   contact_normals   LINE_LIST along each contact normal
-//   gaze              the fixation: a sphere where the gaze ray meets the scene, and the ray
+//   gaze              the fixation: a sphere where the gaze ray first meets the scene
 // The first marker is always DELETEALL, so removed entities vanish.
 // Per-shape geometry is cached; the output's storage is reused between calls.
 #pragma once
@@ -28,20 +28,15 @@ struct MarkerOptions {
   std::string frame = "world";
   std::vector<int> levels{1, 2};  // sphere-tree levels to draw
   bool voxels = true;
+  bool static_trees = true;       // false: no tree levels for static entities (large walls hide the scene)
   std::size_t max_contacts = 2000;
   double contact_size = 0.04;     // metres: diameter of the lowest-priority contact sphere
-};
-
-// The gaze as seen in 3D: the camera position and the point the ray hits.
-struct GazeRay {
-  stc::Vec3 origin;
-  stc::Vec3 point;
 };
 
 class MarkerBuilder {
  public:
   void build(const stc::World& world, const std::unordered_map<stc::EntityId, Rgba>& colors,
-             const MarkerOptions& options, const std::optional<GazeRay>& gaze, const ros::Time& stamp,
+             const MarkerOptions& options, const std::optional<stc::Vec3>& gaze_point, const ros::Time& stamp,
              visualization_msgs::MarkerArray& out);
 
   // Marker count of the last build (DELETEALL included).
@@ -62,7 +57,7 @@ class MarkerBuilder {
                                    int type, const ros::Time& stamp, const std::string& frame);
   void addContacts(const stc::World& world, const MarkerOptions& options, const ros::Time& stamp,
                    visualization_msgs::MarkerArray& out);
-  void addGaze(const GazeRay& gaze, const MarkerOptions& options, const ros::Time& stamp,
+  void addGaze(const stc::Vec3& gaze_point, const MarkerOptions& options, const ros::Time& stamp,
                visualization_msgs::MarkerArray& out);
 
   std::vector<ShapeGeometry> shapes_;  // by ShapeId

@@ -16,18 +16,24 @@ struct CameraParams {
   std::string frame;                                // tf frame (optical: z forward, x right, y down); "" = use pose below
   stc::Vec3 position = stc::Vec3(0.0, -2.6, 1.55);   // world frame, used without a frame or while tf has none
   stc::Vec3 look_at = stc::Vec3(0.0, 0.0, 0.5);
+  std::string published_frame = "perception_camera";  // camera pose on /tf_static when not from tf; "" = off
+  bool pose_given = false;  // camera_position or camera_look_at set: a built-in scene's camera is not used
   int width = 1280;
   int height = 720;
   double fov_y_deg = 60.0;
 };
 
 struct NodeParams {
-  std::string scene;                 // YAML file; "" = embedded default
+  std::string scene;                 // YAML file, built-in scene name, or "" = embedded default
+  int scene_entities = 0;            // built-in scenes: movable entities (0: the scene's default)
+  std::uint32_t scene_seed = 1;      // built-in scenes
+  double scene_entity_size = 0.4;    // built-in scenes: metres
   std::string world_frame = "world";
   double rate = 60.0;                // Hz, ticks
   double marker_rate = 10.0;         // Hz
   std::vector<int> marker_levels{1, 2};
   bool show_voxels = true;
+  bool static_tree_markers = true;
   bool publish_tf = true;
   int max_contact_markers = 2000;
   double contact_marker_size = 0.04;  // m

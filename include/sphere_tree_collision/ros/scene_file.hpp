@@ -40,8 +40,8 @@ struct Scene {
 };
 
 // Throws stc::InputError naming the field, e.g. "entities[2].position".
-Scene parseScene(const std::string& yaml_text);
-Scene loadSceneFile(const std::string& path);
+Scene parseSceneYaml(const std::string& yaml_text);
+Scene loadSceneYaml(const std::string& path);
 
 // The embedded default: a handful of presets spread out on a static floor.
 const std::string& defaultSceneYaml();

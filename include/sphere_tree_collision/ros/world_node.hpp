@@ -19,6 +19,7 @@
 #include <std_msgs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -55,8 +56,11 @@ class WorldNode {
   void setFixation(double x, double y, const ros::Time& stamp, const char* x_field, const char* y_field);
   void updateCameraFromTf();
   void expireGaze(const ros::Time& now);
-  std::optional<GazeRay> gazeRay() const;
-  void remember(stc::EntityId id, const EntityRequest& request);
+  std::optional<stc::Vec3> gazePoint() const;  // where the gaze ray first meets the scene
+  void remember(stc::EntityId id, const std::string& name, const std::optional<Rgba>& color);
+  // Fills world_ from ~scene (YAML file, built-in scene name, or the default);
+  // returns the camera pose to use when no tf frame gives one.
+  stc::Pose loadScene();
 
   void publishStats(const stc::TickReport& report, const ros::Time& stamp);
   void publishContacts(const ros::Time& stamp);
@@ -78,6 +82,7 @@ class WorldNode {
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;  // only with ~camera_frame
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   bool camera_from_tf_ = false;
+  std::unique_ptr<tf2_ros::StaticTransformBroadcaster> camera_broadcaster_;  // without ~camera_frame
 
   // Rejected inputs, total and per topic.
   std::uint64_t rejected_[4] = {0, 0, 0, 0};

@@ -1,0 +1,134 @@
+#include "sphere_tree_collision/ros/gaze_simulator.hpp"
+
+#include "sphere_tree_collision/ros/conversions.hpp"
+#include "sphere_tree_collision/ros/node_params.hpp"
+
+#include <sphere_tree_collision/GazePoint.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace stc_ros {
+namespace {
+
+using stc::InputError;
+
+template <typename T>
+T param(const ros::NodeHandle& nh, const std::string& name, T fallback) {
+  if (!nh.hasParam(name)) return fallback;
+  T value;
+  if (!nh.getParam(name, value)) throw InputError(name, "has the wrong type");
+  return value;
+}
+
+double positive(const ros::NodeHandle& nh, const std::string& name, double fallback) {
+  const double v = param(nh, name, fallback);
+  if (!(v > 0.0) || !std::isfinite(v)) throw InputError(name, "must be finite and > 0");
+  return v;
+}
+
+}  // namespace
+
+GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), start_(ros::WallTime::now()) {
+  // The world node's camera: same image, same defaults, same validation.
+  const std::string world_node = param<std::string>(pnh, "world_node", "collision_world");
+  const NodeParams world = readNodeParams(ros::NodeHandle(world_node));
+  world_frame_ = world.world_frame;
+  camera_frame_ = world.camera.frame.empty() ? world.camera.published_frame : world.camera.frame;
+  camera_.width = world.camera.width;
+  camera_.height = world.camera.height;
+  camera_.fov_y_deg = world.camera.fov_y_deg;
+  const stc::Vec2 centre(0.5 * camera_.width, 0.5 * camera_.height);
+
+  const std::string mode = param<std::string>(pnh, "mode", "saccades");
+  const double rate = positive(pnh, "rate", 30.0);
+  std::vector<double> pixel{centre.x(), centre.y()};
+  if (pnh.hasParam("pixel") && (!pnh.getParam("pixel", pixel) || pixel.size() != 2)) {
+    throw InputError("pixel", "expected [x, y] in pixels");
+  }
+  pixel_ = stc::Vec2(pixel[0], pixel[1]);
+  if (mode == "fixed" || mode == "saccades") {
+    stc::GazeParams gp;
+    gp.mode = mode == "fixed" ? stc::GazeMode::Fixed : stc::GazeMode::Saccades;
+    gp.pixel = pixel_;
+    gp.saccade_period_s = positive(pnh, "saccade_period", gp.saccade_period_s);
+    gp.seed = static_cast<std::uint32_t>(param<int>(pnh, "seed", 1));
+    model_ = std::make_unique<stc::GazeModel>(gp);
+    mode_ = mode == "fixed" ? Mode::Fixed : Mode::Saccades;
+    if (mode_ == Mode::Fixed && !(pixel_.x() >= 0 && pixel_.y() >= 0 && pixel_.x() <= camera_.width &&
+                                  pixel_.y() <= camera_.height)) {
+      throw InputError("pixel", "must lie on the image");
+    }
+  } else if (mode == "circle") {
+    mode_ = Mode::Circle;
+    circle_radius_ = positive(pnh, "circle_radius", 0.3 * camera_.height);
+    circle_period_ = positive(pnh, "circle_period", circle_period_);
+    if (circle_radius_ > 0.5 * std::min(camera_.width, camera_.height)) {
+      throw InputError("circle_radius", "the circle must fit the image");
+    }
+  } else if (mode == "follow") {
+    mode_ = Mode::Follow;
+    target_ = param<std::string>(pnh, "target", "");
+    if (target_.empty()) throw InputError("target", "follow needs the tf frame of an entity");
+    if (camera_frame_.empty()) throw InputError("mode", "follow needs the camera in tf (world node ~published_camera_frame)");
+    tf_ = std::make_unique<tf2_ros::Buffer>();
+    listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_, nh_);
+  } else {
+    throw InputError("mode", "unknown value '" + mode + "' (expected one of: fixed, circle, saccades, follow)");
+  }
+
+  pub_ = nh_.advertise<sphere_tree_collision::GazePoint>("gaze", 10);
+  timer_ = nh_.createSteadyTimer(ros::WallDuration(1.0 / rate), [this](const ros::SteadyTimerEvent&) { publish(); });
+  ROS_INFO("gaze_simulator: %s at %.1f Hz on a %dx%d image", mode.c_str(), rate, camera_.width, camera_.height);
+}
+
+std::optional<stc::Vec2> GazeSimulator::followPixel() {
+  try {
+    const auto cam = tf_->lookupTransform(world_frame_, camera_frame_, ros::Time(0));
+    const auto target = tf_->lookupTransform(world_frame_, target_, ros::Time(0));
+    stc::Camera camera = camera_;
+    camera.camera_to_world.position = toEigen(cam.transform.translation);
+    camera.camera_to_world.orientation = toEigen(cam.transform.rotation).normalized();
+    stc::Perception perception;
+    perception.setCamera(camera);
+    const auto pixel = perception.project(toEigen(target.transform.translation));
+    if (pixel) {
+      last_follow_ = stc::Vec2(std::clamp(pixel->x(), 0.0, static_cast<double>(camera_.width)),
+                               std::clamp(pixel->y(), 0.0, static_cast<double>(camera_.height)));
+    }
+  } catch (const tf2::TransformException& e) {
+    ROS_WARN_THROTTLE(5.0, "gaze_simulator: cannot follow '%s': %s", target_.c_str(), e.what());
+  }
+  return last_follow_;
+}
+
+void GazeSimulator::publish() {
+  const double t = (ros::WallTime::now() - start_).toSec();
+  std::optional<stc::Vec2> pixel;
+  switch (mode_) {
+    case Mode::Fixed:
+    case Mode::Saccades: {
+      static const stc::World kNoWorld;  // fixed and saccades never look at the world
+      pixel = model_->fixationAt(t, kNoWorld);
+      break;
+    }
+    case Mode::Circle: {
+      const double a = 2.0 * M_PI * t / circle_period_;
+      pixel = stc::Vec2(0.5 * camera_.width + circle_radius_ * std::cos(a),
+                        0.5 * camera_.height + circle_radius_ * std::sin(a));
+      break;
+    }
+    case Mode::Follow:
+      pixel = followPixel();
+      break;
+  }
+  if (!pixel) return;
+  sphere_tree_collision::GazePoint msg;
+  msg.header.stamp = ros::Time::now();
+  msg.header.frame_id = camera_frame_;
+  msg.x = pixel->x();
+  msg.y = pixel->y();
+  pub_.publish(msg);
+}
+
+}  // namespace stc_ros
