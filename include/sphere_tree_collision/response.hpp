@@ -1,7 +1,10 @@
 // Response (paper 3.5, 4): contacts from the deepest intersecting sphere pairs
-// of each colliding PairTest, impulses with restitution and Coulomb friction
-// computed for all contacts before they are applied, split-impulse position
-// correction, and a swept test that stops fast bodies at their first contact.
+// of each colliding PairTest; impulses with restitution and Coulomb friction,
+// iterated over all contacts of the tick before the state is committed
+// (sequential impulses by default, the paper's simultaneous Jacobi scheme on
+// request; docs/response.md has the measurements), shock propagation,
+// split-impulse position correction; and a swept test that stops fast bodies
+// at their first contact.
 //
 // Everything here also works without a World: the free functions and classes
 // take flat std::vector<BodyState> / std::vector<Contact> arrays.
@@ -42,7 +45,7 @@ struct ResponseOptions {
   // speculative gap in one or two ticks, and bouncing on that would never settle.
   double restitution_threshold = 0.2;
   double position_correction = 0.2;     // fraction of penetration removed per tick, [0, 1]
-  double allowed_penetration = 0.0;     // metres kept as slop (0: 2% of the contact's leaf radius)
+  double allowed_penetration = 0.0;     // metres kept as slop (0: 2% of the contact's gap bound h_a + h_b)
   SolverKind solver = SolverKind::Sequential;
   bool warm_starting = true;            // start from last tick's impulses of matching contacts
   // After the iterations, one sweep up the contact graph from the static
@@ -62,7 +65,7 @@ struct ResponseOptions {
 void validateResponseOptions(const ResponseOptions& options);
 
 // Two unit vectors completing unit n to a right-handed basis (t1, t2, n);
-// continuous in n away from n = +-x.
+// the same n always gives the same pair (warm-started friction relies on it).
 void tangentBasis(const Vec3& n, Vec3& t1, Vec3& t2);
 
 // ---------------------------------------------------------------------------
@@ -72,9 +75,9 @@ void tangentBasis(const Vec3& n, Vec3& t1, Vec3& t2);
 // lies within r of its centre (up to h inside for a leaf); the voxels whose
 // centres lie in the sphere also bound it by their axis-aligned box (body
 // frame). The surface of the node towards a direction u is then taken at
-// support(u) = min(r, box support): an outer bound (never lets shapes
-// interpenetrate) that is exact for a single-voxel leaf (a cube), and for any
-// leaf face-on, where r alone leaves a gap of up to h.
+// support(u) = min(r, box support): an outer bound of the node's part of the
+// shape, exact for a single-voxel leaf (a cube) and for a box-shaped part
+// face-on, where r alone leaves a gap of up to h.
 struct ShapeBounds {
   const SphereTree* tree = nullptr;
   std::vector<Vec3> box_offset;  // per node: box centre minus sphere centre (body frame)
@@ -111,7 +114,10 @@ struct ContactBuildOptions {
 // radii. With face_normals and ShapeBounds, a face axis of either node's voxel
 // box replaces the line of centres when it separates the two nodes more (the
 // separating-axis rule): face-on, the line of centres of two voxel spheres
-// tilts by up to 45 degrees, making floors bumpy and balls sit in dimples.
+// tilts by up to 45 degrees, making floors bumpy and balls sit in dimples;
+// the point is then the middle of the two boxes' overlap on the face plane,
+// halfway between the surfaces. Only candidates with at least half the
+// deepest sphere overlap are refined so and can represent the pair.
 // Up to max_contacts_per_pair representatives are picked spread out among the
 // deep candidates (deepest corner first, then farthest, then largest
 // triangle); every candidate joins its nearest representative; the cluster's
@@ -152,12 +158,17 @@ struct SolveStats {
 };
 
 // Velocity solve: non-penetration (speculative: a contact with a gap s > 0
-// lets the bodies close at most s/dt this tick), Coulomb friction (circular
-// cone, friction = sqrt(mu_a mu_b)), then restitution (e = max(e_a, e_b)) for
-// contacts that were approaching faster than the threshold and took an
-// impulse. Position correction by split impulse: pseudo-velocities that move
-// the bodies out of penetration and are then discarded, so no kinetic energy
-// is added. Contacts' normal_impulse/friction_impulse are filled in.
+// lets the bodies close at most s/dt this tick) and Coulomb friction
+// (circular cone, friction = sqrt(mu_a mu_b)), iterated with rows ordered up
+// the contact graph from the static bodies; then shock propagation (see
+// ResponseOptions); then restitution (e = max(e_a, e_b)) for contacts that
+// were approaching faster than the threshold and took an impulse (a bounce
+// across a speculative gap also closes the gap, so it starts at the surface).
+// Position correction by split impulse: pseudo-velocities that move the
+// bodies out of penetration beyond the slop and are then discarded, so no
+// kinetic energy is added. Contacts' normal_impulse/friction_impulse are
+// filled in. Warm starting matches contacts by entity pair and the contact
+// point in body A's frame (within half the gap bound).
 class ContactSolver {
  public:
   SolveStats solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
