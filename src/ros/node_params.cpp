@@ -15,7 +15,7 @@ using stc::InputError;
 const std::set<std::string>& knownParams() {
   static const std::set<std::string> kNames{
       "scene", "scene_entities", "scene_seed", "entity_size", "world_frame", "rate", "marker_rate", "marker_levels", "show_voxels", "static_tree_markers", "publish_tf",
-      "max_contact_markers", "contact_marker_size", "detection_budget", "sphere_test_budget", "scheduler", "queue_count",
+      "max_contact_markers", "contact_marker_size", "detection_budget", "sphere_test_budget", "scheduler", "queue_count", "queue_ratio",
       "unresolved_policy", "max_entities", "max_voxels", "tree_levels", "sphere_fit", "gravity",
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y"};
@@ -104,6 +104,8 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   read(nh, "scheduler", name);
   p.world.scheduler.kind = parsed("scheduler", [&] { return stc::parseScheduler(name); });
   p.world.scheduler.queue_count = readIntIn(nh, "queue_count", p.world.scheduler.queue_count, 1, 64);
+  p.world.scheduler.queue_ratio = readPositive(nh, "queue_ratio", p.world.scheduler.queue_ratio);
+  stc::validateSchedulerOptions(p.world.scheduler);  // its fields are named as the parameters
   name = "accept";
   read(nh, "unresolved_policy", name);
   p.world.unresolved_policy = parsed("unresolved_policy", [&] { return stc::parseUnresolvedPolicy(name); });
@@ -119,6 +121,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   p.gravity = readVec3(nh, "gravity");
   read(nh, "response", p.world.response.enabled);
   p.world.response.iterations = readIntIn(nh, "solver_iterations", p.world.response.iterations, 1, 1000);
+  parsed("solver_iterations", [&] { stc::validateResponseOptions(p.world.response); return 0; });
 
   p.gaze_timeout = readPositive(nh, "gaze_timeout", p.gaze_timeout);
   int resolution = static_cast<int>(p.default_resolution);
