@@ -3,7 +3,8 @@
 // momentum measures the tests and the stability bench use.
 //
 // Order inside a tick (World::integrate): positions first with the velocities
-// the last response produced, then velocities (gravity, gyroscopic term). The
+// the last response produced (with the torque-free rotation, which changes w
+// too), then gravity. The
 // response then corrects those velocities at the new poses, and the next tick
 // moves with them: v(n+1) = v(n) + g dt + impulses, x(n+1) = x(n) + v(n+1) dt,
 // i.e. symplectic Euler with the tick boundary between solve and move.
@@ -17,9 +18,9 @@ namespace stc {
 
 struct IntegrationOptions {
   Vec3 gravity = Vec3::Zero();  // zero: no gravity work at all
-  // Implicit-midpoint gyroscopic term (Euler's equations). Off: the world
-  // angular velocity stays constant between contacts (energy still exact,
-  // angular momentum not conserved for asymmetric bodies).
+  // Gyroscopic term (see rotateFreely). Off: the world angular velocity stays
+  // constant between contacts (energy exact; angular momentum of an
+  // asymmetric body not conserved, no tumbling).
   bool gyroscopic = true;
 };
 
@@ -31,16 +32,25 @@ void refreshWorldInertia(BodyState& body);
 // |w| dt of the angle per tick (0.2 rad at 100 rad/s and 60 Hz).
 Quat integrateOrientation(const Quat& q, const Vec3& w, double dt);
 
-// World angular velocity after dt of torque-free motion (Euler's equations
-// I dw/dt + w x I w = 0 in the body frame), solved with the implicit midpoint
-// rule by Newton's method. The midpoint rule conserves both quadratic
-// invariants (kinetic energy and |L|); a final clamp removes the round-off so
-// the rotational energy never grows. Explicit w x Iw gains energy.
-Vec3 gyroscopicStep(const BodyState& body, double dt);
+// Torque-free rotation over dt (Euler's equations I dw/dt + w x I w = 0 in
+// the body frame). Isotropic bodies (cube, sphere) or gyroscopic = false: w is
+// constant and the orientation turns by the exact exponential map. Otherwise
+// the implicit midpoint rule, solved by Newton's method, gives the new body
+// angular velocity, and the orientation turns by the Cayley map of the
+// midpoint angular velocity: that pair conserves the kinetic energy and the
+// world angular momentum exactly (a final clamp keeps round-off from adding
+// energy). An explicit w x Iw term gains energy; the price here is a phase
+// lag at large |w| dt (angle 2 atan(|w| dt / 2) instead of |w| dt per tick).
+struct FreeRotation {
+  Quat orientation;
+  Vec3 angular_velocity;  // world frame
+};
+FreeRotation rotateFreely(const BodyState& body, double dt, bool gyroscopic = true);
 
-// x += v dt, q = exp(w dt) q, refresh world inertia. Static bodies untouched.
-void integratePositions(std::vector<BodyState>& bodies, double dt);
-// v += g dt (movable only), gyroscopic term. Static bodies untouched.
+// x += v dt; orientation and angular velocity by rotateFreely; world inertia
+// refreshed. Static bodies untouched.
+void integratePositions(std::vector<BodyState>& bodies, const IntegrationOptions& options, double dt);
+// v += g dt for movable bodies; nothing at all when gravity is zero.
 void integrateVelocities(std::vector<BodyState>& bodies, const IntegrationOptions& options,
                          double dt);
 

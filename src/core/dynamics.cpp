@@ -41,11 +41,14 @@ Quat integrateOrientation(const Quat& q, const Vec3& w, double dt) {
   return (turn * q).normalized();
 }
 
-Vec3 gyroscopicStep(const BodyState& body, double dt) {
+FreeRotation rotateFreely(const BodyState& body, double dt, bool gyroscopic) {
   const Vec3& w = body.angular_velocity;
-  if (body.is_static || dt <= 0.0 || w.isZero(0.0) || isIsotropic(body.inv_inertia_body)) return w;
+  FreeRotation out{body.pose.orientation, w};
+  if (body.is_static || !(dt > 0.0) || w.isZero(0.0)) return out;
+  out.orientation = integrateOrientation(body.pose.orientation, w, dt);  // w constant: exact
+  if (!gyroscopic || isIsotropic(body.inv_inertia_body)) return out;
   const Mat3 inertia = body.inv_inertia_body.inverse();
-  if (!inertia.allFinite()) return w;
+  if (!inertia.allFinite()) return out;
   const Mat3 r = body.pose.orientation.toRotationMatrix();
   const Vec3 w0 = r.transpose() * w;  // body frame
 
@@ -65,22 +68,31 @@ Vec3 gyroscopicStep(const BodyState& body, double dt) {
       break;
     }
   }
-  // A step too large for Newton (|w| dt of several radians): keep w, which
-  // keeps the energy exactly, rather than accept an unconverged guess.
-  if (!converged || !x.allFinite()) return w;
-
+  // A step too large for Newton: keep w turning about itself (energy exact)
+  // rather than accept an unconverged guess.
+  if (!converged || !x.allFinite()) return out;
   const double e0 = w0.dot(inertia * w0);
   const double e1 = x.dot(inertia * x);
   if (e1 > e0 && e1 > 0.0) x *= std::sqrt(e0 / e1);  // round-off never adds energy
-  return r * x;
+
+  // The midpoint rule is L1 = cay(-dt m) L0 in the body frame; turning the
+  // body by cay(dt m) (quaternion (1, dt m / 2)) keeps R L, the world
+  // angular momentum, exactly.
+  const Vec3 half = 0.5 * dt * (0.5 * (w0 + x));
+  const Quat turn(1.0, half.x(), half.y(), half.z());
+  out.orientation = (body.pose.orientation * turn.normalized()).normalized();
+  out.angular_velocity = out.orientation * x;
+  return out;
 }
 
-void integratePositions(std::vector<BodyState>& bodies, double dt) {
+void integratePositions(std::vector<BodyState>& bodies, const IntegrationOptions& options, double dt) {
   for (BodyState& body : bodies) {
     if (body.is_static) continue;
     body.pose.position += body.linear_velocity * dt;
     if (!body.angular_velocity.isZero(0.0)) {
-      body.pose.orientation = integrateOrientation(body.pose.orientation, body.angular_velocity, dt);
+      const FreeRotation turned = rotateFreely(body, dt, options.gyroscopic);
+      body.pose.orientation = turned.orientation;
+      body.angular_velocity = turned.angular_velocity;
       refreshWorldInertia(body);
     }
   }
@@ -88,12 +100,10 @@ void integratePositions(std::vector<BodyState>& bodies, double dt) {
 
 void integrateVelocities(std::vector<BodyState>& bodies, const IntegrationOptions& options,
                          double dt) {
-  const bool gravity = !options.gravity.isZero(0.0);
+  if (options.gravity.isZero(0.0)) return;
   const Vec3 dv = options.gravity * dt;
   for (BodyState& body : bodies) {
-    if (body.is_static) continue;
-    if (gravity && body.inv_mass > 0.0) body.linear_velocity += dv;
-    if (options.gyroscopic) body.angular_velocity = gyroscopicStep(body, dt);
+    if (!body.is_static && body.inv_mass > 0.0) body.linear_velocity += dv;
   }
 }
 

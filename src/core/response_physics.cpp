@@ -34,16 +34,16 @@ void Physics::integrate(std::vector<BodyState>& bodies, const std::vector<std::u
     start_.resize(bodies.size());
     for (std::size_t i = 0; i < bodies.size(); ++i) start_[i] = bodies[i].pose;
   }
-  integratePositions(bodies, dt);
+  IntegrationOptions integration;
+  integration.gravity = gravity;
+  integration.gyroscopic = options.gyroscopic;
+  integratePositions(bodies, integration, dt);
   if (sweep) {
     for (const std::uint32_t shape : body_shapes) boundsOf(shape, shape_of);  // no resize below
     body_bounds_.resize(bodies.size());
     for (std::size_t i = 0; i < bodies.size(); ++i) body_bounds_[i] = &bounds_[body_shapes[i]];
     report_.sweep = sweepFastBodies(bodies, start_, body_bounds_, options.sweep_threshold, &sweep_scratch_);
   }
-  IntegrationOptions integration;
-  integration.gravity = gravity;
-  integration.gyroscopic = options.gyroscopic;
   integrateVelocities(bodies, integration, dt);
 }
 

@@ -84,17 +84,21 @@ TEST(Stability, ThinRodSpinningAboutItsUnstableAxisNeverGainsEnergy) {
   Scene scene = spinningRod(100.0);
   const std::size_t rod = scene.movers.front();
   const double e0 = kineticEnergy(scene.world->bodies()[rod]);
+  const Vec3 l0 = angularMomentum(scene.world->bodies());
   double highest = e0;
   double min_axis = 1.0;
+  double momentum_drift = 0.0;
   const Metrics m = run(scene, [&](const World& w, int) {
     const BodyState& b = w.bodies()[rod];
     highest = std::max(highest, kineticEnergy(b));
+    momentum_drift = std::max(momentum_drift, (angularMomentum(w.bodies()) - l0).norm() / l0.norm());
     min_axis = std::min(min_axis, (b.pose.orientation.conjugate() * b.angular_velocity).y() / 100.0);
   });
   expectSane(scene, m, 0.0);
   EXPECT_LE(highest, e0 * (1.0 + 1e-9));
   EXPECT_GE(kineticEnergy(scene.world->bodies()[rod]), e0 * (1.0 - 1e-6));  // and keeps it
   EXPECT_LT(min_axis, -0.5);  // it tumbles: the spin about the intermediate axis reverses
+  EXPECT_LE(momentum_drift, 1e-9);  // about a fixed world angular momentum
 }
 
 TEST(Stability, ZeroDetectionBudgetStaysFiniteAndBounded) {
