@@ -210,6 +210,8 @@ class ContactSolver {
   void orderFromTheGround(const std::vector<BodyState>& bodies);
   void warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
                  SolveStats& stats);
+  void commitJacobi(std::vector<Vec3>& v, std::vector<Vec3>& w);
+  static void applyNormal(const Row& row, double impulse, std::vector<Vec3>& v, std::vector<Vec3>& w);
   void solveVelocities(const ResponseOptions& options);
   void propagateShock(const ResponseOptions& options);
   void applyRestitution(const ResponseOptions& options, SolveStats& stats);

@@ -280,6 +280,24 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
   }
 }
 
+// Jacobi: the impulses of one iteration, computed from one state, applied together.
+void ContactSolver::commitJacobi(std::vector<Vec3>& v, std::vector<Vec3>& w) {
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    v[i] += dv_[i];
+    w[i] += dw_[i];
+    dv_[i].setZero();
+    dw_[i].setZero();
+  }
+}
+
+void ContactSolver::applyNormal(const Row& row, double impulse, std::vector<Vec3>& v,
+                                std::vector<Vec3>& w) {
+  v[row.a] -= row.inv_ma * impulse * row.n;
+  v[row.b] += row.inv_mb * impulse * row.n;
+  w[row.a] -= impulse * row.ang_a[0];
+  w[row.b] += impulse * row.ang_b[0];
+}
+
 void ContactSolver::solveVelocities(const ResponseOptions& options) {
   const bool jacobi = options.solver == SolverKind::Jacobi;
   std::vector<Vec3>& out_v = jacobi ? dv_ : v_;
@@ -309,19 +327,9 @@ void ContactSolver::solveVelocities(const ResponseOptions& options) {
           std::max(0.0, row.lambda[0] + row.mass[0] * (-row.speculative - vrel.dot(row.n)));
       const double dn = normal - row.lambda[0];
       row.lambda[0] = normal;
-      out_v[row.a] -= row.inv_ma * dn * row.n;
-      out_v[row.b] += row.inv_mb * dn * row.n;
-      out_w[row.a] -= dn * row.ang_a[0];
-      out_w[row.b] += dn * row.ang_b[0];
+      applyNormal(row, dn, out_v, out_w);
     }
-    if (jacobi) {
-      for (std::size_t i = 0; i < v_.size(); ++i) {
-        v_[i] += dv_[i];
-        w_[i] += dw_[i];
-        dv_[i].setZero();
-        dw_[i].setZero();
-      }
-    }
+    if (jacobi) commitJacobi(v_, w_);
   }
 }
 
@@ -349,19 +357,9 @@ void ContactSolver::applyRestitution(const ResponseOptions& options, SolveStats&
       const double normal = std::max(0.0, row.lambda[0] + row.mass[0] * (target - vrel.dot(row.n)));
       const double delta = normal - row.lambda[0];
       row.lambda[0] = normal;
-      out_v[row.a] -= row.inv_ma * delta * row.n;
-      out_v[row.b] += row.inv_mb * delta * row.n;
-      out_w[row.a] -= delta * row.ang_a[0];
-      out_w[row.b] += delta * row.ang_b[0];
+      applyNormal(row, delta, out_v, out_w);
     }
-    if (jacobi) {
-      for (std::size_t i = 0; i < v_.size(); ++i) {
-        v_[i] += dv_[i];
-        w_[i] += dw_[i];
-        dv_[i].setZero();
-        dw_[i].setZero();
-      }
-    }
+    if (jacobi) commitJacobi(v_, w_);
   }
 }
 
@@ -383,19 +381,9 @@ void ContactSolver::solvePositions(const ResponseOptions& options) {
       const double normal = row.bounced && row.push < 0.0 ? unclamped : std::max(0.0, unclamped);
       const double delta = normal - row.lambda_push;
       row.lambda_push = normal;
-      out_v[row.a] -= row.inv_ma * delta * row.n;
-      out_v[row.b] += row.inv_mb * delta * row.n;
-      out_w[row.a] -= delta * row.ang_a[0];
-      out_w[row.b] += delta * row.ang_b[0];
+      applyNormal(row, delta, out_v, out_w);
     }
-    if (jacobi) {
-      for (std::size_t i = 0; i < pv_.size(); ++i) {
-        pv_[i] += dv_[i];
-        pw_[i] += dw_[i];
-        dv_[i].setZero();
-        dw_[i].setZero();
-      }
-    }
+    if (jacobi) commitJacobi(pv_, pw_);
   }
 }
 
