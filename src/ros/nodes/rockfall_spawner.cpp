@@ -7,9 +7,13 @@
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "rockfall_spawner");
+  // Kept for the whole run: when the last NodeHandle goes, ROS shuts down
+  // (and a start-up error could no longer be logged).
+  ros::NodeHandle nh;
+  ros::NodeHandle pnh("~");
   std::unique_ptr<stc_ros::RockfallSpawner> node;
   try {
-    node = std::make_unique<stc_ros::RockfallSpawner>(ros::NodeHandle(), ros::NodeHandle("~"));
+    node = std::make_unique<stc_ros::RockfallSpawner>(nh, pnh);
   } catch (const stc::InputError& e) {
     ROS_FATAL("rockfall_spawner: invalid ~%s: %s", e.field().c_str(), stc_ros::reasonOf(e).c_str());
     return 1;

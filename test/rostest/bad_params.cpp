@@ -1,0 +1,119 @@
+// Start-up validation: each bad parameter is reported by name (ROS_FATAL
+// "invalid ~<name>") and the process exits with status 1 instead of running
+// on a guess. Parameters are set on the master under a fresh node name per
+// case, then the node is started with that name.
+#include "child_process.hpp"
+#include "rostest_util.hpp"
+
+#include <gtest/gtest.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+XmlRpc::XmlRpcValue list(std::initializer_list<double> values) {
+  XmlRpc::XmlRpcValue v;
+  v.setSize(static_cast<int>(values.size()));
+  int i = 0;
+  for (double x : values) v[i++] = x;
+  return v;
+}
+
+struct Case {
+  std::string program;  // collision_world_node, gaze_simulator, rockfall_spawner
+  std::vector<std::pair<std::string, XmlRpc::XmlRpcValue>> params;
+  std::string field;    // "" for a good set that must keep running
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The package's executables are built next to this test node.
+std::string executable(const std::string& program) {
+  char path[4096];
+  const ssize_t n = readlink("/proc/self/exe", path, sizeof path - 1);
+  std::string self(path, n > 0 ? static_cast<std::size_t>(n) : 0);
+  return self.substr(0, self.rfind('/') + 1) + program;
+}
+
+// Starts `program` under a fresh name with `params`; returns its exit status
+// (nullopt while still running after `seconds`) and its output.
+std::pair<std::optional<int>, std::string> run(const Case& c, int index, double seconds) {
+  const std::string name = "bad_params_case_" + std::to_string(index);
+  for (const auto& [key, value] : c.params) ros::param::set("/" + name + "/" + key, value);
+  const std::string log = "/tmp/stc_bad_params_" + std::to_string(getpid()) + "_" + std::to_string(index) + ".log";
+  std::optional<int> status;
+  {
+    stc_test::Child child({executable(c.program), "__name:=" + name}, {}, log);
+    EXPECT_TRUE(child.started()) << "cannot start " << c.program << ": " << std::strerror(child.spawnError());
+    stc_test::spinUntil([&] { return !child.running(); }, seconds);
+    status = child.exitStatus();
+  }
+  std::string output = slurp(log);
+  std::remove(log.c_str());
+  ros::param::del("/" + name);
+  return {status, output};
+}
+
+TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
+  const std::string bad_scene = "/tmp/stc_bad_scene_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(bad_scene) << "entities:\n  - {preset: cube, position: [0, 0]}\n";
+  const std::string world = "collision_world_node";
+  const std::vector<Case> cases{
+      {world, {{"rate", -1.0}}, "rate"},
+      {world, {{"rate", "fast"}}, "rate"},
+      {world, {{"scheduler", "fifo"}}, "scheduler"},
+      {world, {{"unresolved_policy", "maybe"}}, "unresolved_policy"},
+      {world, {{"sphere_test_budget", -5}}, "sphere_test_budget"},
+      {world, {{"marker_levels", list({1, 9})}}, "marker_levels"},
+      {world, {{"camera_position", list({1, 2, 3})}, {"camera_look_at", list({1, 2, 3})}}, "camera_look_at"},
+      {world, {{"camera_fov_y", 200.0}}, "camera_fov_y"},
+      {world, {{"gravity", list({0, 0})}}, "gravity"},
+      {world, {{"queue_ratio", 0.5}}, "queue_ratio"},
+      {world, {{"tree_levels", 12}}, "tree_levels"},
+      {world, {{"max_entities", 0}}, "max_entities"},
+      {world, {{"scene", "/nonexistent/scene.yaml"}}, "scene"},
+      {world, {{"scene", bad_scene}}, "scene entities[0].position"},
+      {world, {{"scene", "rockfal"}}, "scene"},
+      {world, {{"scene", "rockfall"}, {"scene_entities", 30000}}, "scene_entities"},
+      {"gaze_simulator", {{"mode", "blink"}}, "mode"},
+      {"gaze_simulator", {{"mode", "follow"}}, "target"},
+      {"rockfall_spawner", {{"rate", 0.0}}, "rate"},
+      {"rockfall_spawner", {{"region_min", list({0, 0, 5})}, {"region_max", list({1, 1, 4})}}, "region_max"},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const Case& c = cases[i];
+    SCOPED_TRACE(c.program + " ~" + c.field);
+    const auto [status, output] = run(c, static_cast<int>(i), 20.0);
+    ASSERT_TRUE(status.has_value()) << "still running with a bad ~" << c.field;
+    EXPECT_EQ(*status, 1);
+    EXPECT_NE(output.find("invalid ~" + c.field + ":"), std::string::npos) << "output:\n" << output;
+  }
+  std::remove(bad_scene.c_str());
+}
+
+TEST(BadParams, AGoodSetKeepsRunning) {
+  const Case good{"collision_world_node",
+                  {{"rate", 30}, {"scheduler", "round_robin"}, {"marker_levels", list({0, 3})},
+                   {"camera_position", list({0, -3, 1})}, {"camera_look_at", list({0, 0, 0.5})}},
+                  ""};
+  const auto [status, output] = run(good, 1000, 3.0);
+  EXPECT_FALSE(status.has_value()) << "exited with " << status.value_or(-1) << ":\n" << output;
+  EXPECT_EQ(output.find("FATAL"), std::string::npos) << output;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "bad_params_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
