@@ -16,7 +16,7 @@ constexpr double kRadiusGroupRatio = 1.03;
 // Coarse levels fainter than fine ones, so two levels drawn together both read.
 float levelAlpha(int level) { return level <= 1 ? 0.3f : 0.5f; }
 constexpr double kVoxelFill = 0.94;  // cubes a little smaller than the voxel: the grid shows
-constexpr int kContactClasses = 4;   // contact sphere sizes, by priority relative to the tick's largest
+constexpr int kMaxGroups = 512;      // radius groups per level and entity (marker id = entity id * 512 + group)
 
 std_msgs::ColorRGBA rgba(float r, float g, float b, float a) {
   std_msgs::ColorRGBA c;
@@ -56,6 +56,12 @@ int contactClass(double priority, double max_priority) {
   return ratio > 0.5 ? 3 : ratio > 0.2 ? 2 : ratio > 0.05 ? 1 : 0;
 }
 
+int groupId(stc::EntityId id, std::size_t group) {
+  return static_cast<int>((static_cast<std::uint64_t>(id) * kMaxGroups + group) & 0x7fffffffu);
+}
+
+const std::string kContactsNs = "contacts", kNormalsNs = "contact_normals", kGazeNs = "gaze", kVoxelsNs = "voxels";
+
 }  // namespace
 
 const MarkerBuilder::ShapeGeometry& MarkerBuilder::geometry(const stc::World& world, stc::ShapeId id) {
@@ -85,7 +91,8 @@ const MarkerBuilder::ShapeGeometry& MarkerBuilder::geometry(const stc::World& wo
     double group_smallest = 0.0;
     for (std::int32_t n : nodes) {
       const stc::SphereNode& node = tree.node(n);
-      if (groups.empty() || node.radius > group_smallest * kRadiusGroupRatio) {
+      const bool room = groups.size() < static_cast<std::size_t>(kMaxGroups);  // else the last group widens
+      if (groups.empty() || (room && node.radius > group_smallest * kRadiusGroupRatio)) {
         groups.emplace_back();
         group_smallest = node.radius;
       }
@@ -97,14 +104,26 @@ const MarkerBuilder::ShapeGeometry& MarkerBuilder::geometry(const stc::World& wo
   return g;
 }
 
-Marker& MarkerBuilder::next(visualization_msgs::MarkerArray& out, const std::string& ns, int type,
+const std::string& MarkerBuilder::levelNamespace(int level) {
+  while (level_ns_.size() <= static_cast<std::size_t>(level)) {
+    level_ns_.push_back("tree_level_" + std::to_string(level_ns_.size()));
+  }
+  return level_ns_[static_cast<std::size_t>(level)];
+}
+
+bool MarkerBuilder::drawsLevel(const ShapeGeometry& g, int level, bool is_static, const MarkerOptions& options) const {
+  if (is_static && !options.static_trees) return false;
+  return level >= 0 && static_cast<std::size_t>(level) < g.levels.size();
+}
+
+Marker& MarkerBuilder::next(visualization_msgs::MarkerArray& out, const std::string& ns, int id, int type,
                             const ros::Time& stamp, const std::string& frame) {
   if (out.markers.size() <= used_) out.markers.resize(used_ + 1);
   Marker& m = out.markers[used_++];
   m.header.stamp = stamp;
   m.header.frame_id = frame;
   m.ns = ns;
-  m.id = next_id_++;
+  m.id = id;
   m.type = type;
   m.action = Marker::ADD;
   m.pose = geometry_msgs::Pose();
@@ -119,95 +138,131 @@ Marker& MarkerBuilder::next(visualization_msgs::MarkerArray& out, const std::str
   return m;
 }
 
-void MarkerBuilder::build(const stc::World& world, const std::unordered_map<stc::EntityId, Rgba>& colors,
-                          const MarkerOptions& options, const std::optional<stc::Vec3>& gaze_point,
-                          const ros::Time& stamp, visualization_msgs::MarkerArray& out) {
+void MarkerBuilder::begin(visualization_msgs::MarkerArray& out) {
   used_ = 0;
-  next_id_ = 0;
-  next(out, "", Marker::CUBE, stamp, options.frame).action = Marker::DELETEALL;
-
-  const auto& ids = world.entityIds();
-  const auto& bodies = world.bodies();
-  const auto& shape_ids = world.bodyShapes();
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    const ShapeGeometry& g = geometry(world, shape_ids[i]);
-    const double voxel = world.shape(shape_ids[i]).voxels.voxelSize();
-    if (options.voxels) {
-      Marker& m = next(out, "voxels", Marker::CUBE_LIST, stamp, options.frame);
-      setPose(m, bodies[i].pose);
-      m.scale.x = m.scale.y = m.scale.z = voxel * kVoxelFill;
-      const auto c = colors.find(ids[i]);
-      const Rgba color = c != colors.end() ? c->second : paletteColor(ids[i]);
-      m.color = rgba(color[0], color[1], color[2], color[3]);
-      m.points.assign(g.surface_voxels.begin(), g.surface_voxels.end());
-    }
-    for (int level : options.levels) {
-      if (!options.static_trees && bodies[i].is_static) break;
-      if (level < 0 || static_cast<std::size_t>(level) >= g.levels.size()) continue;
-      if (level_ns_.size() <= static_cast<std::size_t>(level)) {
-        for (int l = static_cast<int>(level_ns_.size()); l <= level; ++l) level_ns_.push_back("tree_level_" + std::to_string(l));
-      }
-      for (const RadiusGroup& group : g.levels[static_cast<std::size_t>(level)]) {
-        Marker& m = next(out, level_ns_[static_cast<std::size_t>(level)], Marker::SPHERE_LIST, stamp, options.frame);
-        setPose(m, bodies[i].pose);
-        m.scale.x = m.scale.y = m.scale.z = 2.0 * group.radius;
-        m.color = levelColor(level);
-        m.points.assign(group.centres.begin(), group.centres.end());
-      }
-    }
-  }
-  addContacts(world, options, stamp, out);
-  if (gaze_point) addGaze(*gaze_point, options, stamp, out);
-  out.markers.resize(used_);
+  (void)out;
 }
 
-void MarkerBuilder::addContacts(const stc::World& world, const MarkerOptions& options, const ros::Time& stamp,
-                                visualization_msgs::MarkerArray& out) {
+void MarkerBuilder::end(visualization_msgs::MarkerArray& out) { out.markers.resize(used_); }
+
+void MarkerBuilder::deleteAll(const MarkerOptions& options, visualization_msgs::MarkerArray& out) {
+  next(out, "", 0, Marker::CUBE, ros::Time(0), options.frame).action = Marker::DELETEALL;
+}
+
+void MarkerBuilder::addEntity(const stc::World& world, std::size_t index, const Rgba& color,
+                              const std::string& entity_frame, bool frame_locked, const MarkerOptions& options,
+                              const ros::Time& stamp, visualization_msgs::MarkerArray& out) {
+  const stc::EntityId id = world.entityIds()[index];
+  const stc::BodyState& body = world.bodies()[index];
+  const stc::ShapeId shape = world.bodyShapes()[index];
+  const ShapeGeometry& g = geometry(world, shape);
+  const std::string& frame = frame_locked ? entity_frame : options.frame;
+  const ros::Time when = frame_locked ? ros::Time(0) : stamp;  // frame-locked: rviz uses the latest tf
+  const auto place = [&](Marker& m) {
+    m.frame_locked = frame_locked;
+    if (!frame_locked) setPose(m, body.pose);
+  };
+  if (options.voxels) {
+    Marker& m = next(out, kVoxelsNs, static_cast<int>(id & 0x7fffffffu), Marker::CUBE_LIST, when, frame);
+    place(m);
+    m.scale.x = m.scale.y = m.scale.z = world.shape(shape).voxels.voxelSize() * kVoxelFill;
+    m.color = rgba(color[0], color[1], color[2], color[3]);
+    m.points.assign(g.surface_voxels.begin(), g.surface_voxels.end());
+  }
+  for (int level : options.levels) {
+    if (!drawsLevel(g, level, body.is_static, options)) continue;
+    const auto& groups = g.levels[static_cast<std::size_t>(level)];
+    for (std::size_t k = 0; k < groups.size(); ++k) {
+      Marker& m = next(out, levelNamespace(level), groupId(id, k), Marker::SPHERE_LIST, when, frame);
+      place(m);
+      m.scale.x = m.scale.y = m.scale.z = 2.0 * groups[k].radius;
+      m.color = levelColor(level);
+      m.points.assign(groups[k].centres.begin(), groups[k].centres.end());
+    }
+  }
+}
+
+void MarkerBuilder::deleteEntity(const stc::World& world, stc::EntityId id, stc::ShapeId shape, bool is_static,
+                                 const MarkerOptions& options, visualization_msgs::MarkerArray& out) {
+  const ShapeGeometry& g = geometry(world, shape);
+  if (options.voxels) {
+    next(out, kVoxelsNs, static_cast<int>(id & 0x7fffffffu), Marker::CUBE_LIST, ros::Time(0), options.frame).action =
+        Marker::DELETE;
+  }
+  for (int level : options.levels) {
+    if (!drawsLevel(g, level, is_static, options)) continue;
+    for (std::size_t k = 0; k < g.levels[static_cast<std::size_t>(level)].size(); ++k) {
+      next(out, levelNamespace(level), groupId(id, k), Marker::SPHERE_LIST, ros::Time(0), options.frame).action =
+          Marker::DELETE;
+    }
+  }
+}
+
+void MarkerBuilder::addDynamic(const stc::World& world, const MarkerOptions& options,
+                               const std::optional<stc::Vec3>& gaze_point, const ros::Time& stamp, bool track,
+                               visualization_msgs::MarkerArray& out) {
   const auto& contacts = world.contacts();
   const std::size_t n = std::min(contacts.size(), options.max_contacts);
-  if (n == 0) return;
   double max_priority = 0.0;
   for (std::size_t i = 0; i < n; ++i) max_priority = std::max(max_priority, contacts[i].priority);
+  std::array<std::size_t, kContactClasses> per_class{};
+  for (std::size_t i = 0; i < n; ++i) ++per_class[static_cast<std::size_t>(contactClass(contacts[i].priority, max_priority))];
 
-  // Pointers into out.markers below: size it first so next() cannot reallocate.
-  if (out.markers.size() < used_ + kContactClasses + 1) out.markers.resize(used_ + kContactClasses + 1);
+  // A slot with content is (re)added; an empty one that was drawn is deleted
+  // (rviz rejects empty point lists, and a stale one would stay on screen).
+  const auto slot = [&](int index, bool has_content, const std::string& ns, int id, int type) -> Marker* {
+    bool& live = live_[static_cast<std::size_t>(index)];
+    if (!has_content) {
+      if (track && live) next(out, ns, id, type, stamp, options.frame).action = Marker::DELETE;
+      if (track) live = false;
+      return nullptr;
+    }
+    if (track) live = true;
+    return &next(out, ns, id, type, stamp, options.frame);
+  };
+  // Pointers into out.markers: size it first so next() cannot reallocate under them.
+  if (out.markers.size() < used_ + kSlots) out.markers.resize(used_ + kSlots);
   std::array<Marker*, kContactClasses> classes{};
   for (int k = 0; k < kContactClasses; ++k) {
-    Marker& m = next(out, "contacts", Marker::SPHERE_LIST, stamp, options.frame);
-    m.scale.x = m.scale.y = m.scale.z = options.contact_size * (1.0 + 0.7 * k);
-    m.color = kResolvedColor;  // per-point colours below
-    classes[static_cast<std::size_t>(k)] = &m;
+    Marker* m = slot(k, per_class[static_cast<std::size_t>(k)] > 0, kContactsNs, k, Marker::SPHERE_LIST);
+    if (m) {
+      m->scale.x = m->scale.y = m->scale.z = options.contact_size * (1.0 + 0.7 * k);
+      m->color = kResolvedColor;  // per-point colours below
+    }
+    classes[static_cast<std::size_t>(k)] = m;
   }
-  Marker& normals = next(out, "contact_normals", Marker::LINE_LIST, stamp, options.frame);
-  normals.scale.x = 0.25 * options.contact_size;
-  normals.color = rgba(1.0f, 1.0f, 1.0f, 0.8f);
+  Marker* normals = slot(kContactClasses, n > 0, kNormalsNs, 0, Marker::LINE_LIST);
+  if (normals) {
+    normals->scale.x = 0.25 * options.contact_size;
+    normals->color = rgba(1.0f, 1.0f, 1.0f, 0.8f);
+  }
   const double normal_length = 3.0 * options.contact_size;
   for (std::size_t i = 0; i < n; ++i) {
     const stc::Contact& c = contacts[i];
     Marker& m = *classes[static_cast<std::size_t>(contactClass(c.priority, max_priority))];
     m.points.push_back(toPointMsg(c.point));
     m.colors.push_back(c.resolved ? kResolvedColor : kUnresolvedColor);
-    normals.points.push_back(toPointMsg(c.point));
-    normals.points.push_back(toPointMsg(c.point + normal_length * c.normal));
+    normals->points.push_back(toPointMsg(c.point));
+    normals->points.push_back(toPointMsg(c.point + normal_length * c.normal));
   }
-  // rviz rejects empty lists: drop the classes nothing fell into.
-  std::size_t write = used_ - kContactClasses - 1;
-  for (std::size_t read = write; read < used_; ++read) {
-    if (out.markers[read].points.empty()) continue;
-    if (read != write) std::swap(out.markers[read], out.markers[write]);
-    ++write;
+  if (Marker* dot = slot(kContactClasses + 1, gaze_point.has_value(), kGazeNs, 0, Marker::SPHERE)) {
+    dot->pose.position = toPointMsg(*gaze_point);
+    dot->scale.x = dot->scale.y = dot->scale.z = 3.0 * options.contact_size;
+    dot->color = kGazeColor;
   }
-  used_ = write;
 }
 
-// Only the point: in a view matching the camera the ray from the eye would
-// cover the screen.
-void MarkerBuilder::addGaze(const stc::Vec3& gaze_point, const MarkerOptions& options, const ros::Time& stamp,
-                            visualization_msgs::MarkerArray& out) {
-  Marker& dot = next(out, "gaze", Marker::SPHERE, stamp, options.frame);
-  dot.pose.position = toPointMsg(gaze_point);
-  dot.scale.x = dot.scale.y = dot.scale.z = 3.0 * options.contact_size;
-  dot.color = kGazeColor;
+void MarkerBuilder::buildFull(const stc::World& world, const std::vector<Rgba>& colors_by_index,
+                              const MarkerOptions& options, const std::optional<stc::Vec3>& gaze_point,
+                              const ros::Time& stamp, visualization_msgs::MarkerArray& out) {
+  begin(out);
+  deleteAll(options, out);
+  forgetDynamic();
+  for (std::size_t i = 0; i < world.entityCount(); ++i) {
+    addEntity(world, i, colors_by_index[i], options.frame, false, options, stamp, out);
+  }
+  addDynamic(world, options, gaze_point, stamp, true, out);
+  end(out);
 }
 
 }  // namespace stc_ros

@@ -14,7 +14,7 @@ using stc::InputError;
 // Every private parameter the node reads; others are reported as unknown.
 const std::set<std::string>& knownParams() {
   static const std::set<std::string> kNames{
-      "scene", "scene_entities", "scene_seed", "entity_size", "world_frame", "rate", "marker_rate", "marker_levels", "show_voxels", "static_tree_markers", "publish_tf",
+      "scene", "scene_entities", "scene_seed", "entity_size", "world_frame", "rate", "marker_rate", "marker_levels", "marker_mode", "marker_keyframe_period", "show_voxels", "static_tree_markers", "publish_tf",
       "max_contact_markers", "contact_marker_size", "detection_budget", "sphere_test_budget", "scheduler", "queue_count", "queue_ratio",
       "unresolved_policy", "max_entities", "max_voxels", "tree_levels", "sphere_fit", "gravity",
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
@@ -91,6 +91,20 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   read(nh, "show_voxels", p.show_voxels);
   read(nh, "static_tree_markers", p.static_tree_markers);
   read(nh, "publish_tf", p.publish_tf);
+  read(nh, "marker_keyframe_period", p.marker_keyframe_period);
+  if (!(p.marker_keyframe_period >= 0.0) || !std::isfinite(p.marker_keyframe_period)) {
+    throw InputError("marker_keyframe_period", "must be finite and >= 0");
+  }
+  std::string mode = "auto";
+  read(nh, "marker_mode", mode);
+  if (mode == "full" || (mode == "auto" && !p.publish_tf)) {
+    p.marker_mode = NodeParams::MarkerMode::Full;
+  } else if (mode == "incremental" || mode == "auto") {
+    if (!p.publish_tf) throw InputError("marker_mode", "incremental markers move with tf: it needs ~publish_tf");
+    p.marker_mode = NodeParams::MarkerMode::Incremental;
+  } else {
+    throw InputError("marker_mode", "unknown value '" + mode + "' (expected one of: auto, incremental, full)");
+  }
   p.max_contact_markers = readIntIn(nh, "max_contact_markers", p.max_contact_markers, 0, 1000000);
   p.contact_marker_size = readPositive(nh, "contact_marker_size", p.contact_marker_size);
 

@@ -85,7 +85,13 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   marker_options_.static_trees = params_.static_tree_markers;
   marker_options_.max_contacts = static_cast<std::size_t>(params_.max_contact_markers);
 
-  markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
+  marker_options_.contact_size = params_.contact_marker_size;
+  if (params_.marker_mode == NodeParams::MarkerMode::Incremental) {
+    markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>(
+        "markers", 100, [this](const ros::SingleSubscriberPublisher& s) { sendMarkerSnapshot(s); });
+  } else {
+    markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
+  }
   contacts_pub_ = nh_.advertise<sphere_tree_collision::ContactArray>("contacts", 10);
   stats_pub_ = nh_.advertise<sphere_tree_collision::TickStats>("tick_stats", 10);
   if (params_.publish_tf) tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
@@ -278,10 +284,76 @@ void WorldNode::publishTf(const ros::Time& stamp) {
 }
 
 void WorldNode::publishMarkers() {
-  if (markers_pub_.getNumSubscribers() == 0) return;
-  marker_options_.contact_size = params_.contact_marker_size;
-  marker_builder_.build(world_, colors_, marker_options_, gazePoint(), ros::Time::now(), markers_msg_);
+  if (markers_pub_.getNumSubscribers() == 0) {
+    // Nobody to keep up to date: the next subscriber starts from a snapshot.
+    markers_sent_.clear();
+    markers_removed_.clear();
+    markers_cleared_ = false;
+    return;
+  }
+  const ros::Time now = ros::Time::now();
+  if (params_.marker_mode == NodeParams::MarkerMode::Full) {
+    colors_by_index_.resize(world_.entityCount());
+    for (std::size_t i = 0; i < world_.entityCount(); ++i) colors_by_index_[i] = colors_[world_.entityIds()[i]];
+    marker_builder_.buildFull(world_, colors_by_index_, marker_options_, gazePoint(), now, markers_msg_);
+    markers_pub_.publish(markers_msg_);
+    return;
+  }
+  // A keyframe now and then repairs what a subscriber dropped (its queue may
+  // overflow while rviz renders slowly); in between, only what changed.
+  const ros::WallTime wall = ros::WallTime::now();
+  if (params_.marker_keyframe_period > 0.0 && (wall - last_keyframe_).toSec() >= params_.marker_keyframe_period) {
+    last_keyframe_ = wall;
+    buildMarkerSnapshot(now, true, markers_msg_);
+    markers_pub_.publish(markers_msg_);
+    return;
+  }
+  marker_builder_.begin(markers_msg_);
+  if (markers_cleared_) {
+    marker_builder_.deleteAll(marker_options_, markers_msg_);
+    marker_builder_.forgetDynamic();
+    markers_cleared_ = false;
+  }
+  for (const Removed& r : markers_removed_) {
+    marker_builder_.deleteEntity(world_, r.id, r.shape, r.is_static, marker_options_, markers_msg_);
+  }
+  markers_removed_.clear();
+  const auto& ids = world_.entityIds();
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (!markers_sent_.insert(ids[i]).second) continue;
+    marker_builder_.addEntity(world_, i, colors_[ids[i]], frames_[ids[i]], true, marker_options_, now, markers_msg_);
+  }
+  marker_builder_.addDynamic(world_, marker_options_, gazePoint(), now, true, markers_msg_);
+  marker_builder_.end(markers_msg_);
   markers_pub_.publish(markers_msg_);
+}
+
+void WorldNode::buildMarkerSnapshot(const ros::Time& now, bool for_everyone, visualization_msgs::MarkerArray& out) {
+  MarkerBuilder& b = marker_builder_;
+  b.begin(out);
+  b.deleteAll(marker_options_, out);
+  if (for_everyone) b.forgetDynamic();
+  const auto& ids = world_.entityIds();
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    b.addEntity(world_, i, colors_[ids[i]], frames_[ids[i]], true, marker_options_, now, out);
+  }
+  b.addDynamic(world_, marker_options_, gazePoint(), now, for_everyone, out);
+  b.end(out);
+  if (for_everyone) {  // every subscriber now has exactly this
+    markers_sent_.clear();
+    markers_sent_.insert(ids.begin(), ids.end());
+    markers_removed_.clear();
+    markers_cleared_ = false;
+  }
+}
+
+void WorldNode::sendMarkerSnapshot(const ros::SingleSubscriberPublisher& subscriber) {
+  // Alone, the newcomer defines what subscribers have. With others, the shared
+  // state stays theirs and the next array brings the newcomer what is pending
+  // as well (twice is harmless: an ADD replaces).
+  visualization_msgs::MarkerArray snapshot;
+  buildMarkerSnapshot(ros::Time::now(), markers_pub_.getNumSubscribers() <= 1, snapshot);
+  subscriber.publish(snapshot);
 }
 
 std::optional<stc::Vec3> WorldNode::gazePoint() const {
@@ -327,7 +399,12 @@ void WorldNode::onDespawn(const sphere_tree_collision::Despawn& msg) {
   } else {
     id = msg.id;
   }
-  if (!world_.removeEntity(*id)) return reject(Input::Despawn, "id", "no entity with id " + std::to_string(msg.id));
+  const auto index = world_.indexOf(*id);
+  if (!index) return reject(Input::Despawn, "id", "no entity with id " + std::to_string(msg.id));
+  if (markers_sent_.erase(*id) != 0) {
+    markers_removed_.push_back({*id, world_.bodyShapes()[*index], world_.bodies()[*index].is_static});
+  }
+  world_.removeEntity(*id);
   colors_.erase(*id);
   frames_.erase(*id);
 }
@@ -337,6 +414,9 @@ void WorldNode::onClear(const std_msgs::Empty&) {
   world_.clear();
   colors_.clear();
   frames_.clear();
+  markers_sent_.clear();
+  markers_removed_.clear();
+  markers_cleared_ = true;
 }
 
 void WorldNode::setFixation(double x, double y, const ros::Time& stamp, const char* x_field, const char* y_field) {

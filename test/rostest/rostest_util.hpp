@@ -4,7 +4,10 @@
 
 #include <ros/ros.h>
 
+#include <visualization_msgs/MarkerArray.h>
+
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -55,6 +58,33 @@ class Recorder {
   std::vector<ros::WallTime> arrivals;
   bool keep_all = false;
   std::vector<Msg> all;
+  ros::Subscriber sub_;
+};
+
+// What rviz would hold after the marker arrays received so far: DELETEALL
+// empties it, DELETE removes one (ns, id), ADD sets one.
+class MarkerState {
+ public:
+  MarkerState(ros::NodeHandle& nh, const std::string& topic) {
+    sub_ = nh.subscribe<visualization_msgs::MarkerArray>(topic, 1000, [this](const auto& a) {
+      ++arrays;
+      if (first.markers.empty() && arrays == 1) first = *a;
+      for (const auto& m : a->markers) {
+        if (m.action == visualization_msgs::Marker::DELETEALL) markers.clear();
+        if (m.action == visualization_msgs::Marker::DELETE) markers.erase({m.ns, m.id});
+        if (m.action == visualization_msgs::Marker::ADD) markers[{m.ns, m.id}] = m;
+      }
+    });
+  }
+  int count(const std::string& ns) const {
+    int n = 0;
+    for (const auto& [key, m] : markers) n += key.first == ns ? 1 : 0;
+    return n;
+  }
+
+  std::map<std::pair<std::string, int>, visualization_msgs::Marker> markers;
+  visualization_msgs::MarkerArray first;  // the first array received (a snapshot)
+  std::size_t arrays = 0;
   ros::Subscriber sub_;
 };
 

@@ -45,37 +45,43 @@ TEST(Smoke, AdvertisedTypes) {
 TEST(Smoke, MarkersAtConfiguredRate) {
   ros::NodeHandle nh;
   const double expected = param("marker_rate");
+  stc_test::MarkerState state(nh, "/markers");
   Recorder<visualization_msgs::MarkerArray> markers(nh, "/markers", 10);
   ASSERT_TRUE(markers.waitFor(1, 10.0)) << "no marker array within 10 s";
   markers.clear();
   stc_test::spinFor(kWindow);
   EXPECT_NEAR(markers.rate(), expected, kRateTolerance * expected);
 
-  // Content of the last array.
-  const auto& m = markers.last.markers;
-  ASSERT_FALSE(m.empty());
-  EXPECT_EQ(m.front().action, Marker::DELETEALL) << "the first marker clears removed entities";
-  std::map<std::string, int> per_ns;
-  for (std::size_t i = 1; i < m.size(); ++i) {
-    ++per_ns[m[i].ns];
-    EXPECT_EQ(m[i].action, Marker::ADD);
-    EXPECT_EQ(m[i].header.frame_id, "world");
-    EXPECT_FALSE(m[i].points.empty()) << m[i].ns << "/" << m[i].id;
-    if (m[i].type == Marker::SPHERE_LIST) {
-      EXPECT_GT(m[i].scale.x, 0.0);
-      EXPECT_EQ(m[i].scale.x, m[i].scale.y);
-      EXPECT_EQ(m[i].scale.x, m[i].scale.z);
-      EXPECT_LT(m[i].color.a, 1.0f) << "tree levels are semi-transparent";
+  // A new subscriber first gets the whole scene, DELETEALL first.
+  const auto& first = state.first.markers;
+  ASSERT_FALSE(first.empty());
+  EXPECT_EQ(first.front().action, Marker::DELETEALL) << "a snapshot starts from a clean slate";
+
+  // What rviz holds: every entity's voxels and the configured tree levels,
+  // frame-locked in the entity's tf frame (incremental mode, the default).
+  const std::vector<std::string> frames = entityFrames();
+  const std::set<std::string> frame_set(frames.begin(), frames.end());
+  EXPECT_EQ(state.count("voxels"), static_cast<int>(frames.size())) << "one CUBE_LIST per entity";
+  EXPECT_GT(state.count("tree_level_1"), 0);
+  EXPECT_GT(state.count("tree_level_2"), 0);
+  EXPECT_EQ(state.count("tree_level_0"), 0) << "only the levels of ~marker_levels";
+  EXPECT_EQ(state.count("tree_level_3"), 0);
+  for (const auto& [key, m] : state.markers) {
+    EXPECT_FALSE(m.points.empty()) << key.first << "/" << key.second;
+    if (key.first == "voxels" || key.first.rfind("tree_level_", 0) == 0) {
+      EXPECT_TRUE(m.frame_locked) << key.first << "/" << key.second;
+      EXPECT_EQ(frame_set.count(m.header.frame_id), 1u) << "in an entity frame, not " << m.header.frame_id;
+    }
+    if (m.type == Marker::SPHERE_LIST) {
+      EXPECT_GT(m.scale.x, 0.0);
+      EXPECT_EQ(m.scale.x, m.scale.y);
+      EXPECT_EQ(m.scale.x, m.scale.z);
+      if (key.first != "contacts") EXPECT_LT(m.color.a, 1.0f) << "tree levels are semi-transparent";
     }
   }
-  EXPECT_EQ(per_ns["voxels"], static_cast<int>(entityFrames().size())) << "one CUBE_LIST per entity";
-  EXPECT_GT(per_ns["tree_level_1"], 0);
-  EXPECT_GT(per_ns["tree_level_2"], 0);
-  EXPECT_EQ(per_ns.count("tree_level_0"), 0u) << "only the levels of ~marker_levels";
-  EXPECT_EQ(per_ns.count("tree_level_3"), 0u);
-  // Marker ids are unique within a namespace (rviz would drop duplicates).
+  // Unique (ns, id) within the snapshot: rviz would warn and drop duplicates.
   std::set<std::pair<std::string, int>> ids;
-  for (const Marker& marker : m) EXPECT_TRUE(ids.insert({marker.ns, marker.id}).second);
+  for (const Marker& marker : first) EXPECT_TRUE(ids.insert({marker.ns, marker.id}).second);
 }
 
 TEST(Smoke, TfFrameForEveryEntity) {

@@ -36,7 +36,7 @@ class SpawnAndGaze : public testing::Test {
         gaze_(nh_.advertise<sphere_tree_collision::GazePoint>("/gaze", 10)),
         stats_(nh_, "/tick_stats"),
         contacts_(nh_, "/contacts"),
-        markers_(nh_, "/markers", 5),
+        markers_(nh_, "/markers"),
         listener_(tf_, nh_, false) {
     EXPECT_TRUE(stc_test::spinUntil(
         [&] { return spawn_.getNumSubscribers() > 0 && clear_.getNumSubscribers() > 0 && stats_.count() > 0; }, 15.0));
@@ -96,16 +96,10 @@ class SpawnAndGaze : public testing::Test {
   ros::Publisher spawn_, despawn_, clear_, gaze_;
   Recorder<sphere_tree_collision::TickStats> stats_;
   Recorder<sphere_tree_collision::ContactArray> contacts_;
-  Recorder<visualization_msgs::MarkerArray> markers_;
+  stc_test::MarkerState markers_;
   tf2_ros::Buffer tf_;
   tf2_ros::TransformListener listener_;
 };
-
-int voxelMarkers(const visualization_msgs::MarkerArray& array) {
-  int n = 0;
-  for (const auto& m : array.markers) n += m.ns == "voxels" ? 1 : 0;
-  return n;
-}
 
 TEST_F(SpawnAndGaze, SpawnedEntityGetsTfFrameAndMarkers) {
   SpawnEntity probe = rock("probe", 0.4, 0.9, 0.0);
@@ -117,14 +111,12 @@ TEST_F(SpawnAndGaze, SpawnedEntityGetsTfFrameAndMarkers) {
   EXPECT_NEAR(t.transform.translation.x, 0.4, 1e-9);
   EXPECT_NEAR(t.transform.translation.z, 0.9, 1e-9);
 
-  // The next marker array draws it: one voxel list, posed at the entity.
-  markers_.clear();
-  ASSERT_TRUE(markers_.waitFor(2, 10.0));
-  ASSERT_EQ(voxelMarkers(markers_.last), 1);
-  for (const auto& m : markers_.last.markers) {
-    if (m.ns != "voxels") continue;
-    EXPECT_NEAR(m.pose.position.x, 0.4, 1e-9);
-    EXPECT_NEAR(m.pose.position.z, 0.9, 1e-9);
+  // The markers draw it: one voxel list, frame-locked in its frame.
+  ASSERT_TRUE(stc_test::spinUntil([&] { return markers_.count("voxels") == 1; }, 10.0));
+  for (const auto& [key, m] : markers_.markers) {
+    if (key.first != "voxels") continue;
+    EXPECT_EQ(m.header.frame_id, "probe");
+    EXPECT_TRUE(m.frame_locked);
     EXPECT_GT(m.points.size(), 10u);
   }
 
@@ -226,11 +218,15 @@ TEST_F(SpawnAndGaze, DespawnByNameAndIdThenClear) {
   ASSERT_TRUE(waitForEntities(2));
   EXPECT_EQ(stats_.last.rejected_spawn, 0u);
 
+  ASSERT_TRUE(stc_test::spinUntil([&] { return markers_.count("voxels") == 2; }, 10.0))
+      << "despawned entities' markers are deleted, the others stay";
+  EXPECT_GT(markers_.count("tree_level_1"), 0);
+
   clear_.publish(std_msgs::Empty());
   ASSERT_TRUE(waitForEntities(0));
-  markers_.clear();
-  ASSERT_TRUE(markers_.waitFor(2, 10.0));
-  EXPECT_EQ(voxelMarkers(markers_.last), 0) << "cleared entities leave no markers";
+  EXPECT_TRUE(stc_test::spinUntil(
+      [&] { return markers_.count("voxels") == 0 && markers_.count("tree_level_1") == 0; }, 10.0))
+      << "cleared entities leave no markers";
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// MarkerBuilder: the World as rviz markers, all in the world frame so they need
-// no tf. Namespaces (switch them in rviz's MarkerArray display):
+// MarkerBuilder: the World as rviz markers. Namespaces (switch them in rviz's
+// MarkerArray display):
 //   voxels            one CUBE_LIST per entity (surface voxels only: the inside is hidden)
 //   tree_level_<L>    sphere-tree level L, semi-transparent; SPHERE_LIST draws one
 //                     radius per marker, so each level's spheres are grouped by radius
@@ -7,8 +7,11 @@
 //                     orange = accepted unresolved; larger = higher perceptual priority
 //   contact_normals   LINE_LIST along each contact normal
 //   gaze              the fixation: a sphere where the gaze ray first meets the scene
-// The first marker is always DELETEALL, so removed entities vanish.
-// Per-shape geometry is cached; the output's storage is reused between calls.
+// Entity geometry is either frame-locked in the entity's tf frame (sent once:
+// rviz moves it with tf) or posed in the world frame (sent every time). Ids are
+// stable: voxels id = entity id, tree groups id = entity id * 512 + group,
+// contacts / normals / gaze fixed slots, so arrays can add and delete piecewise.
+// Per-shape geometry is cached; the output's storage is reused between arrays.
 #pragma once
 
 #include "sphere_tree_collision/ros/entity_request.hpp"
@@ -17,9 +20,9 @@
 #include <ros/time.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <array>
 #include <optional>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 namespace stc_ros {
@@ -35,12 +38,31 @@ struct MarkerOptions {
 
 class MarkerBuilder {
  public:
-  void build(const stc::World& world, const std::unordered_map<stc::EntityId, Rgba>& colors,
-             const MarkerOptions& options, const std::optional<stc::Vec3>& gaze_point, const ros::Time& stamp,
-             visualization_msgs::MarkerArray& out);
+  // An array is begin(), any of the add/delete calls, end().
+  void begin(visualization_msgs::MarkerArray& out);
+  void end(visualization_msgs::MarkerArray& out);
 
-  // Marker count of the last build (DELETEALL included).
-  std::size_t lastMarkerCount() const { return used_; }
+  void deleteAll(const MarkerOptions& options, visualization_msgs::MarkerArray& out);
+  // Entity `index` of the world. frame_locked: in `entity_frame` at identity,
+  // moved by rviz with tf; else in options.frame at the body pose, stamped.
+  void addEntity(const stc::World& world, std::size_t index, const Rgba& color, const std::string& entity_frame,
+                 bool frame_locked, const MarkerOptions& options, const ros::Time& stamp,
+                 visualization_msgs::MarkerArray& out);
+  // The markers addEntity made for an entity of `shape` (it may be gone from the world).
+  void deleteEntity(const stc::World& world, stc::EntityId id, stc::ShapeId shape, bool is_static,
+                    const MarkerOptions& options, visualization_msgs::MarkerArray& out);
+  // Contacts and gaze. track: this array goes to every subscriber, so slots
+  // drawn by the previous tracked array and empty now are deleted; untracked
+  // (a snapshot after DELETEALL for one new subscriber) leaves that state alone.
+  void addDynamic(const stc::World& world, const MarkerOptions& options, const std::optional<stc::Vec3>& gaze_point,
+                  const ros::Time& stamp, bool track, visualization_msgs::MarkerArray& out);
+  // After a tracked DELETEALL: nothing dynamic is drawn any more.
+  void forgetDynamic() { live_.fill(false); }
+
+  // Everything in the world frame, DELETEALL first (the "full" marker mode).
+  void buildFull(const stc::World& world, const std::vector<Rgba>& colors_by_index, const MarkerOptions& options,
+                 const std::optional<stc::Vec3>& gaze_point, const ros::Time& stamp,
+                 visualization_msgs::MarkerArray& out);
 
  private:
   struct RadiusGroup {
@@ -50,20 +72,22 @@ class MarkerBuilder {
   struct ShapeGeometry {
     bool built = false;
     std::vector<geometry_msgs::Point> surface_voxels;  // voxel centres, body frame
-    std::vector<std::vector<RadiusGroup>> levels;      // [level][group]
+    std::vector<std::vector<RadiusGroup>> levels;      // [level][group], at most kMaxGroups per level
   };
   const ShapeGeometry& geometry(const stc::World& world, stc::ShapeId id);
-  visualization_msgs::Marker& next(visualization_msgs::MarkerArray& out, const std::string& ns,
+  const std::string& levelNamespace(int level);
+  bool drawsLevel(const ShapeGeometry& g, int level, bool is_static, const MarkerOptions& options) const;
+  visualization_msgs::Marker& next(visualization_msgs::MarkerArray& out, const std::string& ns, int id,
                                    int type, const ros::Time& stamp, const std::string& frame);
-  void addContacts(const stc::World& world, const MarkerOptions& options, const ros::Time& stamp,
-                   visualization_msgs::MarkerArray& out);
-  void addGaze(const stc::Vec3& gaze_point, const MarkerOptions& options, const ros::Time& stamp,
-               visualization_msgs::MarkerArray& out);
+
+  // Dynamic slots: contact size classes 0..3, normals, gaze.
+  static constexpr int kContactClasses = 4;
+  static constexpr int kSlots = kContactClasses + 2;
+  std::array<bool, kSlots> live_{};
 
   std::vector<ShapeGeometry> shapes_;  // by ShapeId
   std::vector<std::string> level_ns_;  // "tree_level_<L>", built once
   std::size_t used_ = 0;
-  int next_id_ = 0;
 };
 
 }  // namespace stc_ros

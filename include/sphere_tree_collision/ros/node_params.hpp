@@ -32,6 +32,11 @@ struct NodeParams {
   double rate = 60.0;                // Hz, ticks
   double marker_rate = 10.0;         // Hz
   std::vector<int> marker_levels{1, 2};
+  // incremental: entity geometry sent once per entity, frame-locked in its tf
+  // frame (new subscribers get a snapshot); full: everything re-sent in the
+  // world frame at every marker tick. auto = incremental when ~publish_tf.
+  enum class MarkerMode { Incremental, Full } marker_mode = MarkerMode::Incremental;
+  double marker_keyframe_period = 2.0;  // s, incremental mode: full snapshot this often (0: never)
   bool show_voxels = true;
   bool static_tree_markers = true;
   bool publish_tf = true;

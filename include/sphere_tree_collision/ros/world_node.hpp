@@ -27,6 +27,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace stc_ros {
 
@@ -39,6 +40,11 @@ class WorldNode {
   // One tick: camera, gaze expiry, World::step, tick_stats / contacts / tf.
   void tick();
   void publishMarkers();
+  // Incremental marker mode: the whole scene (DELETEALL first), to one new
+  // subscriber or, as a keyframe, to every subscriber (then it resets what is
+  // pending).
+  void sendMarkerSnapshot(const ros::SingleSubscriberPublisher& subscriber);
+  void buildMarkerSnapshot(const ros::Time& now, bool for_everyone, visualization_msgs::MarkerArray& out);
 
   const stc::World& world() const { return world_; }
   std::uint64_t tickCount() const { return tick_; }
@@ -90,6 +96,18 @@ class WorldNode {
 
   MarkerBuilder marker_builder_;
   MarkerOptions marker_options_;
+  // Incremental marker mode: entities whose geometry every subscriber has,
+  // removals not yet sent, and a clear not yet sent.
+  struct Removed {
+    stc::EntityId id;
+    stc::ShapeId shape;
+    bool is_static;
+  };
+  std::unordered_set<stc::EntityId> markers_sent_;
+  std::vector<Removed> markers_removed_;
+  bool markers_cleared_ = false;
+  ros::WallTime last_keyframe_;
+  std::vector<Rgba> colors_by_index_;  // full mode: scratch
   // Reused message buffers: no allocation per tick once warm.
   visualization_msgs::MarkerArray markers_msg_;
   sphere_tree_collision::ContactArray contacts_msg_;
