@@ -1,0 +1,69 @@
+// Camera from tf: while the frame ~camera_frame is missing the node projects
+// clicked points with the camera of its parameters (looking +y); once the
+// frame appears (here at y = 5 looking -y) it uses that one. A point at
+// y = 6 is in front of the first camera and behind the second.
+#include "rostest_util.hpp"
+
+#include "sphere_tree_collision/perception.hpp"
+#include "sphere_tree_collision/ros/conversions.hpp"
+
+#include <geometry_msgs/PointStamped.h>
+#include <gtest/gtest.h>
+#include <sphere_tree_collision/TickStats.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+namespace {
+
+geometry_msgs::PointStamped click(double x, double y, double z) {
+  geometry_msgs::PointStamped p;
+  p.header.frame_id = "world";
+  p.header.stamp = ros::Time::now();
+  p.point.x = x;
+  p.point.y = y;
+  p.point.z = z;
+  return p;
+}
+
+TEST(CameraTf, ParametersUntilTheFrameExistsThenTf) {
+  ros::NodeHandle nh;
+  ros::Publisher clicked = nh.advertise<geometry_msgs::PointStamped>("/clicked_point", 10);
+  stc_test::Recorder<sphere_tree_collision::TickStats> stats(nh, "/tick_stats");
+  ASSERT_TRUE(stc_test::spinUntil([&] { return clicked.getNumSubscribers() > 0 && stats.count() > 0; }, 15.0));
+
+  // No test_camera in tf yet: the parameter camera sees the point.
+  clicked.publish(click(0.0, 6.0, 0.5));
+  ASSERT_TRUE(stc_test::spinUntil([&] { return stats.last.gaze_active; }, 5.0))
+      << "last rejection: " << stats.last.last_rejection;
+  EXPECT_EQ(stats.last.rejected_clicked_point, 0u);
+
+  // The camera appears in tf, across the scene and facing back.
+  tf2_ros::StaticTransformBroadcaster broadcaster;
+  const stc::Pose pose = stc::opticalLookAt(stc::Vec3(0.0, 5.0, 1.0), stc::Vec3(0.0, 0.0, 1.0));
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = ros::Time::now();
+  t.header.frame_id = "world";
+  t.child_frame_id = "test_camera";
+  t.transform.translation = stc_ros::toVector3Msg(pose.position);
+  t.transform.rotation = stc_ros::toQuaternionMsg(pose.orientation);
+  broadcaster.sendTransform(t);
+  stc_test::spinFor(1.0);  // a few ticks: the node looks the frame up every tick
+
+  clicked.publish(click(0.0, 6.0, 0.5));
+  ASSERT_TRUE(stc_test::spinUntil([&] { return stats.last.rejected_clicked_point == 1u; }, 5.0));
+  EXPECT_EQ(stats.last.last_rejection.rfind("clicked_point: point: behind the camera", 0), 0u)
+      << stats.last.last_rejection;
+  // And a point in front of the tf camera is taken.
+  clicked.publish(click(0.0, 0.0, 1.0));
+  stc_test::spinFor(0.5);
+  EXPECT_EQ(stats.last.rejected_clicked_point, 1u) << stats.last.last_rejection;
+  EXPECT_TRUE(stats.last.gaze_active);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "camera_tf_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
