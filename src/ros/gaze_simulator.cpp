@@ -1,6 +1,7 @@
 #include "sphere_tree_collision/ros/gaze_simulator.hpp"
 
 #include "sphere_tree_collision/ros/conversions.hpp"
+#include "sphere_tree_collision/ros/param_reading.hpp"
 #include "sphere_tree_collision/ros/node_params.hpp"
 
 #include <sphere_tree_collision/GazePoint.h>
@@ -13,25 +14,11 @@ namespace {
 
 using stc::InputError;
 
-template <typename T>
-T param(const ros::NodeHandle& nh, const std::string& name, T fallback) {
-  if (!nh.hasParam(name)) return fallback;
-  T value;
-  if (!nh.getParam(name, value)) throw InputError(name, "has the wrong type");
-  return value;
-}
-
-double positive(const ros::NodeHandle& nh, const std::string& name, double fallback) {
-  const double v = param(nh, name, fallback);
-  if (!(v > 0.0) || !std::isfinite(v)) throw InputError(name, "must be finite and > 0");
-  return v;
-}
-
 }  // namespace
 
 GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), start_(ros::WallTime::now()) {
   // The world node's camera: same image, same defaults, same validation.
-  const std::string world_node = param<std::string>(pnh, "world_node", "collision_world");
+  const std::string world_node = paramOr<std::string>(pnh, "world_node", "collision_world");
   const NodeParams world = readNodeParams(ros::NodeHandle(world_node));
   world_frame_ = world.world_frame;
   camera_frame_ = world.camera.frame.empty() ? world.camera.published_frame : world.camera.frame;
@@ -40,8 +27,8 @@ GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh),
   camera_.fov_y_deg = world.camera.fov_y_deg;
   const stc::Vec2 centre(0.5 * camera_.width, 0.5 * camera_.height);
 
-  const std::string mode = param<std::string>(pnh, "mode", "saccades");
-  const double rate = positive(pnh, "rate", 30.0);
+  const std::string mode = paramOr<std::string>(pnh, "mode", "saccades");
+  const double rate = positiveParam(pnh, "rate", 30.0);
   std::vector<double> pixel{centre.x(), centre.y()};
   if (pnh.hasParam("pixel") && (!pnh.getParam("pixel", pixel) || pixel.size() != 2)) {
     throw InputError("pixel", "expected [x, y] in pixels");
@@ -51,8 +38,8 @@ GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh),
     stc::GazeParams gp;
     gp.mode = mode == "fixed" ? stc::GazeMode::Fixed : stc::GazeMode::Saccades;
     gp.pixel = pixel_;
-    gp.saccade_period_s = positive(pnh, "saccade_period", gp.saccade_period_s);
-    gp.seed = static_cast<std::uint32_t>(param<int>(pnh, "seed", 1));
+    gp.saccade_period_s = positiveParam(pnh, "saccade_period", gp.saccade_period_s);
+    gp.seed = static_cast<std::uint32_t>(paramOr<int>(pnh, "seed", 1));
     model_ = std::make_unique<stc::GazeModel>(gp);
     mode_ = mode == "fixed" ? Mode::Fixed : Mode::Saccades;
     if (mode_ == Mode::Fixed && !(pixel_.x() >= 0 && pixel_.y() >= 0 && pixel_.x() <= camera_.width &&
@@ -61,14 +48,14 @@ GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh),
     }
   } else if (mode == "circle") {
     mode_ = Mode::Circle;
-    circle_radius_ = positive(pnh, "circle_radius", 0.3 * camera_.height);
-    circle_period_ = positive(pnh, "circle_period", circle_period_);
+    circle_radius_ = positiveParam(pnh, "circle_radius", 0.3 * camera_.height);
+    circle_period_ = positiveParam(pnh, "circle_period", circle_period_);
     if (circle_radius_ > 0.5 * std::min(camera_.width, camera_.height)) {
       throw InputError("circle_radius", "the circle must fit the image");
     }
   } else if (mode == "follow") {
     mode_ = Mode::Follow;
-    target_ = param<std::string>(pnh, "target", "");
+    target_ = paramOr<std::string>(pnh, "target", "");
     if (target_.empty()) throw InputError("target", "follow needs the tf frame of an entity");
     if (camera_frame_.empty()) throw InputError("mode", "follow needs the camera in tf (world node ~published_camera_frame)");
     tf_ = std::make_unique<tf2_ros::Buffer>();

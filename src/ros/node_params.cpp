@@ -1,6 +1,7 @@
 #include "sphere_tree_collision/ros/node_params.hpp"
 
 #include "sphere_tree_collision/ros/conversions.hpp"
+#include "sphere_tree_collision/ros/param_reading.hpp"
 
 #include <climits>
 #include <cmath>
@@ -20,37 +21,6 @@ const std::set<std::string>& knownParams() {
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y"};
   return kNames;
-}
-
-// Reads `name` when set; a value of the wrong type is an error, not a default.
-template <typename T>
-bool read(const ros::NodeHandle& nh, const std::string& name, T& out) {
-  if (!nh.hasParam(name)) return false;
-  if (!nh.getParam(name, out)) throw InputError(name, "has the wrong type");
-  return true;
-}
-
-double readPositive(const ros::NodeHandle& nh, const std::string& name, double value) {
-  read(nh, name, value);
-  if (!(value > 0.0) || !std::isfinite(value)) throw InputError(name, "must be finite and > 0");
-  return value;
-}
-
-int readIntIn(const ros::NodeHandle& nh, const std::string& name, int value, int lo, int hi) {
-  read(nh, name, value);
-  if (value < lo || value > hi) {
-    throw InputError(name, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-  }
-  return value;
-}
-
-std::optional<stc::Vec3> readVec3(const ros::NodeHandle& nh, const std::string& name) {
-  std::vector<double> v;
-  if (!read(nh, name, v)) return std::nullopt;
-  if (v.size() != 3) throw InputError(name, "expected a list of 3 numbers");
-  const stc::Vec3 out(v[0], v[1], v[2]);
-  if (!out.allFinite()) throw InputError(name, "not finite");
-  return out;
 }
 
 // Re-raises a core parse error under the parameter's own name.
@@ -74,29 +44,29 @@ stc::Budget NodeParams::budget() const {
 
 NodeParams readNodeParams(const ros::NodeHandle& nh) {
   NodeParams p;
-  read(nh, "scene", p.scene);
-  p.scene_entities = readIntIn(nh, "scene_entities", p.scene_entities, 0, 1000000);
-  p.scene_seed = static_cast<std::uint32_t>(readIntIn(nh, "scene_seed", static_cast<int>(p.scene_seed), 0, INT_MAX));
-  p.scene_entity_size = readPositive(nh, "entity_size", p.scene_entity_size);
-  read(nh, "world_frame", p.world_frame);
+  readParam(nh, "scene", p.scene);
+  p.scene_entities = intParamIn(nh, "scene_entities", p.scene_entities, 0, 1000000);
+  p.scene_seed = static_cast<std::uint32_t>(intParamIn(nh, "scene_seed", static_cast<int>(p.scene_seed), 0, INT_MAX));
+  p.scene_entity_size = positiveParam(nh, "entity_size", p.scene_entity_size);
+  readParam(nh, "world_frame", p.world_frame);
   if (p.world_frame.empty()) throw InputError("world_frame", "must not be empty");
-  p.rate = readPositive(nh, "rate", p.rate);
+  p.rate = positiveParam(nh, "rate", p.rate);
   if (p.rate > 10000.0) throw InputError("rate", "must be <= 10000 Hz");
-  p.marker_rate = readPositive(nh, "marker_rate", p.marker_rate);
-  if (read(nh, "marker_levels", p.marker_levels)) {
+  p.marker_rate = positiveParam(nh, "marker_rate", p.marker_rate);
+  if (readParam(nh, "marker_levels", p.marker_levels)) {
     for (int level : p.marker_levels) {
       if (level < 0 || level > 7) throw InputError("marker_levels", "levels must be in [0, 7]");
     }
   }
-  read(nh, "show_voxels", p.show_voxels);
-  read(nh, "static_tree_markers", p.static_tree_markers);
-  read(nh, "publish_tf", p.publish_tf);
-  read(nh, "marker_keyframe_period", p.marker_keyframe_period);
+  readParam(nh, "show_voxels", p.show_voxels);
+  readParam(nh, "static_tree_markers", p.static_tree_markers);
+  readParam(nh, "publish_tf", p.publish_tf);
+  readParam(nh, "marker_keyframe_period", p.marker_keyframe_period);
   if (!(p.marker_keyframe_period >= 0.0) || !std::isfinite(p.marker_keyframe_period)) {
     throw InputError("marker_keyframe_period", "must be finite and >= 0");
   }
   std::string mode = "auto";
-  read(nh, "marker_mode", mode);
+  readParam(nh, "marker_mode", mode);
   if (mode == "full" || (mode == "auto" && !p.publish_tf)) {
     p.marker_mode = NodeParams::MarkerMode::Full;
   } else if (mode == "incremental" || mode == "auto") {
@@ -105,55 +75,55 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   } else {
     throw InputError("marker_mode", "unknown value '" + mode + "' (expected one of: auto, incremental, full)");
   }
-  p.max_contact_markers = readIntIn(nh, "max_contact_markers", p.max_contact_markers, 0, 1000000);
-  p.contact_marker_size = readPositive(nh, "contact_marker_size", p.contact_marker_size);
+  p.max_contact_markers = intParamIn(nh, "max_contact_markers", p.max_contact_markers, 0, 1000000);
+  p.contact_marker_size = positiveParam(nh, "contact_marker_size", p.contact_marker_size);
 
-  read(nh, "detection_budget", p.detection_budget_ms);
+  readParam(nh, "detection_budget", p.detection_budget_ms);
   if (std::isnan(p.detection_budget_ms)) throw InputError("detection_budget", "is NaN");
   int sphere_tests = -1;
-  if (read(nh, "sphere_test_budget", sphere_tests)) p.sphere_test_budget = sphere_tests;
+  if (readParam(nh, "sphere_test_budget", sphere_tests)) p.sphere_test_budget = sphere_tests;
   if (p.sphere_test_budget < -1) throw InputError("sphere_test_budget", "must be >= 0, or -1 for none");
 
   std::string name = "priority_queues";
-  read(nh, "scheduler", name);
+  readParam(nh, "scheduler", name);
   p.world.scheduler.kind = parsed("scheduler", [&] { return stc::parseScheduler(name); });
-  p.world.scheduler.queue_count = readIntIn(nh, "queue_count", p.world.scheduler.queue_count, 1, 64);
-  p.world.scheduler.queue_ratio = readPositive(nh, "queue_ratio", p.world.scheduler.queue_ratio);
+  p.world.scheduler.queue_count = intParamIn(nh, "queue_count", p.world.scheduler.queue_count, 1, 64);
+  p.world.scheduler.queue_ratio = positiveParam(nh, "queue_ratio", p.world.scheduler.queue_ratio);
   stc::validateSchedulerOptions(p.world.scheduler);  // its fields are named as the parameters
   name = "accept";
-  read(nh, "unresolved_policy", name);
+  readParam(nh, "unresolved_policy", name);
   p.world.unresolved_policy = parsed("unresolved_policy", [&] { return stc::parseUnresolvedPolicy(name); });
   name = "tight";
-  read(nh, "sphere_fit", name);
+  readParam(nh, "sphere_fit", name);
   p.world.tree.fit = parsed("sphere_fit", [&] { return stc::parseSphereFit(name); });
-  p.world.tree.max_levels = readIntIn(nh, "tree_levels", p.world.tree.max_levels, 1, 8);
+  p.world.tree.max_levels = intParamIn(nh, "tree_levels", p.world.tree.max_levels, 1, 8);
 
   p.world.max_entities = static_cast<std::size_t>(
-      readIntIn(nh, "max_entities", static_cast<int>(p.world.max_entities), 1, 10000000));
+      intParamIn(nh, "max_entities", static_cast<int>(p.world.max_entities), 1, 10000000));
   int max_voxels = static_cast<int>(p.world.voxel_limits.max_voxels);
-  p.world.voxel_limits.max_voxels = readIntIn(nh, "max_voxels", max_voxels, 1, 1 << 30);
-  p.gravity = readVec3(nh, "gravity");
-  read(nh, "response", p.world.response.enabled);
-  p.world.response.iterations = readIntIn(nh, "solver_iterations", p.world.response.iterations, 1, 1000);
+  p.world.voxel_limits.max_voxels = intParamIn(nh, "max_voxels", max_voxels, 1, 1 << 30);
+  p.gravity = vec3Param(nh, "gravity");
+  readParam(nh, "response", p.world.response.enabled);
+  p.world.response.iterations = intParamIn(nh, "solver_iterations", p.world.response.iterations, 1, 1000);
   parsed("solver_iterations", [&] { stc::validateResponseOptions(p.world.response); return 0; });
 
-  p.gaze_timeout = readPositive(nh, "gaze_timeout", p.gaze_timeout);
+  p.gaze_timeout = positiveParam(nh, "gaze_timeout", p.gaze_timeout);
   int resolution = static_cast<int>(p.default_resolution);
-  p.default_resolution = static_cast<std::uint32_t>(readIntIn(nh, "default_resolution", resolution, 1, 4096));
+  p.default_resolution = static_cast<std::uint32_t>(intParamIn(nh, "default_resolution", resolution, 1, 4096));
 
-  read(nh, "camera_frame", p.camera.frame);
-  read(nh, "published_camera_frame", p.camera.published_frame);
-  if (auto v = readVec3(nh, "camera_position")) {
+  readParam(nh, "camera_frame", p.camera.frame);
+  readParam(nh, "published_camera_frame", p.camera.published_frame);
+  if (auto v = vec3Param(nh, "camera_position")) {
     p.camera.position = *v;
     p.camera.pose_given = true;
   }
-  if (auto v = readVec3(nh, "camera_look_at")) {
+  if (auto v = vec3Param(nh, "camera_look_at")) {
     p.camera.look_at = *v;
     p.camera.pose_given = true;
   }
-  p.camera.width = readIntIn(nh, "camera_width", p.camera.width, 1, 100000);
-  p.camera.height = readIntIn(nh, "camera_height", p.camera.height, 1, 100000);
-  p.camera.fov_y_deg = readPositive(nh, "camera_fov_y", p.camera.fov_y_deg);
+  p.camera.width = intParamIn(nh, "camera_width", p.camera.width, 1, 100000);
+  p.camera.height = intParamIn(nh, "camera_height", p.camera.height, 1, 100000);
+  p.camera.fov_y_deg = positiveParam(nh, "camera_fov_y", p.camera.fov_y_deg);
   if (p.camera.fov_y_deg >= 180.0) throw InputError("camera_fov_y", "must be < 180 degrees");
   parsed("camera_look_at", [&] { return stc::opticalLookAt(p.camera.position, p.camera.look_at); });
   return p;

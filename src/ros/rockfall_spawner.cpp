@@ -1,6 +1,7 @@
 #include "sphere_tree_collision/ros/rockfall_spawner.hpp"
 
 #include "sphere_tree_collision/ros/conversions.hpp"
+#include "sphere_tree_collision/ros/param_reading.hpp"
 
 #include <sphere_tree_collision/Despawn.h>
 #include <sphere_tree_collision/SpawnEntity.h>
@@ -12,28 +13,6 @@ namespace {
 
 using stc::InputError;
 
-template <typename T>
-T param(const ros::NodeHandle& nh, const std::string& name, T fallback) {
-  if (!nh.hasParam(name)) return fallback;
-  T value;
-  if (!nh.getParam(name, value)) throw InputError(name, "has the wrong type");
-  return value;
-}
-
-stc::Vec3 vec3(const ros::NodeHandle& nh, const std::string& name, const stc::Vec3& fallback) {
-  const auto v = param<std::vector<double>>(nh, name, {fallback.x(), fallback.y(), fallback.z()});
-  if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
-    throw InputError(name, "expected a list of 3 finite numbers");
-  }
-  return {v[0], v[1], v[2]};
-}
-
-double positive(const ros::NodeHandle& nh, const std::string& name, double fallback) {
-  const double v = param(nh, name, fallback);
-  if (!(v > 0.0) || !std::isfinite(v)) throw InputError(name, "must be finite and > 0");
-  return v;
-}
-
 // The built-in rockfall scene with 0.4 m rocks: ravine floor through (0, 0,
 // 5.07) sloping down +x at 25 degrees, 2.4 m wide. Drop above its upper part.
 const stc::Vec3 kRegionMin(0.6, -0.7, 5.6);
@@ -43,26 +22,23 @@ const stc::Vec3 kDownhill(std::cos(25.0 * M_PI / 180.0), 0.0, -std::sin(25.0 * M
 }  // namespace
 
 RockfallSpawner::RockfallSpawner(ros::NodeHandle nh, ros::NodeHandle pnh) {
-  const double rate = positive(pnh, "rate", 2.0);
-  region_min_ = vec3(pnh, "region_min", kRegionMin);
-  region_max_ = vec3(pnh, "region_max", kRegionMax);
+  const double rate = positiveParam(pnh, "rate", 2.0);
+  region_min_ = vec3Param(pnh, "region_min").value_or(kRegionMin);
+  region_max_ = vec3Param(pnh, "region_max").value_or(kRegionMax);
   if ((region_max_ - region_min_).minCoeff() < 0.0) throw InputError("region_max", "must be >= region_min");
-  direction_ = vec3(pnh, "direction", kDownhill);
+  direction_ = vec3Param(pnh, "direction").value_or(kDownhill);
   if (!(direction_.norm() > 0.0)) throw InputError("direction", "must not be zero");
   direction_.normalize();
-  speed_ = param(pnh, "speed", speed_);
+  speed_ = paramOr(pnh, "speed", speed_);
   if (!(speed_ >= 0.0) || !std::isfinite(speed_)) throw InputError("speed", "must be finite and >= 0");
-  size_ = positive(pnh, "size", size_);
-  resolution_ = param(pnh, "resolution", resolution_);
-  if (resolution_ < 2 || resolution_ > 64) throw InputError("resolution", "must be in [2, 64]");
-  shape_count_ = param(pnh, "shape_count", shape_count_);
-  if (shape_count_ < 1) throw InputError("shape_count", "must be >= 1");
-  max_rocks_ = param(pnh, "max_rocks", max_rocks_);
-  if (max_rocks_ < 1) throw InputError("max_rocks", "must be >= 1");
-  density_ = positive(pnh, "density", density_);
-  restitution_ = param(pnh, "restitution", restitution_);
-  friction_ = param(pnh, "friction", friction_);  // the world validates both, by name
-  seed_ = static_cast<std::uint32_t>(param(pnh, "seed", 1));
+  size_ = positiveParam(pnh, "size", size_);
+  resolution_ = intParamIn(pnh, "resolution", resolution_, 2, 64);
+  shape_count_ = intParamIn(pnh, "shape_count", shape_count_, 1, 1000);
+  max_rocks_ = intParamIn(pnh, "max_rocks", max_rocks_, 1, 1000000);
+  density_ = positiveParam(pnh, "density", density_);
+  restitution_ = paramOr(pnh, "restitution", restitution_);
+  friction_ = paramOr(pnh, "friction", friction_);  // the world validates both, by name
+  seed_ = static_cast<std::uint32_t>(paramOr(pnh, "seed", 1));
   random_.seed(seed_);
 
   spawn_ = nh.advertise<sphere_tree_collision::SpawnEntity>("spawn", 100);

@@ -210,9 +210,4 @@ TEST_F(BadInput, EveryMalformedKindIsRejectedByFieldAndNothingChanges) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "bad_input_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}
+int main(int argc, char** argv) { return stc_test::runTests(argc, argv, "bad_input_test"); }

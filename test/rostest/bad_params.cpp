@@ -111,9 +111,4 @@ TEST(BadParams, AGoodSetKeepsRunning) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "bad_params_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}
+int main(int argc, char** argv) { return stc_test::runTests(argc, argv, "bad_params_test"); }

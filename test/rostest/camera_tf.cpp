@@ -61,9 +61,4 @@ TEST(CameraTf, ParametersUntilTheFrameExistsThenTf) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "camera_tf_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}
+int main(int argc, char** argv) { return stc_test::runTests(argc, argv, "camera_tf_test"); }

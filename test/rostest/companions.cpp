@@ -150,9 +150,4 @@ TEST(Companions, RockfallDropsValidRocksAndKeepsAtMostMaxRocks) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "companions_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}
+int main(int argc, char** argv) { return stc_test::runTests(argc, argv, "companions_test"); }

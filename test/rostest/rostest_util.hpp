@@ -2,6 +2,7 @@
 // condition holds, measure a message rate.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <visualization_msgs/MarkerArray.h>
@@ -96,6 +97,14 @@ inline std::string topicType(const std::string& topic) {
     if (t.name == topic) return t.datatype;
   }
   return "";
+}
+
+// main() of a rostest gtest node.
+inline int runTests(int argc, char** argv, const char* node_name) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, node_name);
+  ros::NodeHandle nh;  // keeps ROS up while the tests run
+  return RUN_ALL_TESTS();
 }
 
 }  // namespace stc_test

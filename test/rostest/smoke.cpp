@@ -115,9 +115,4 @@ TEST(Smoke, TickStatsAndContactsAtTickRate) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "smoke_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}
+int main(int argc, char** argv) { return stc_test::runTests(argc, argv, "smoke_test"); }

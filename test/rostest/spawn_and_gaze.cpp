@@ -231,9 +231,4 @@ TEST_F(SpawnAndGaze, DespawnByNameAndIdThenClear) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "spawn_and_gaze_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}
+int main(int argc, char** argv) { return stc_test::runTests(argc, argv, "spawn_and_gaze_test"); }
