@@ -16,7 +16,7 @@ using stc::InputError;
 
 }  // namespace
 
-GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), start_(ros::WallTime::now()) {
+GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   // The world node's camera: same image, same defaults, same validation.
   const std::string world_node = paramOr<std::string>(pnh, "world_node", "collision_world");
   const NodeParams world = readNodeParams(ros::NodeHandle(world_node));
@@ -80,6 +80,7 @@ std::optional<stc::Vec2> GazeSimulator::followPixel() {
     perception.setCamera(camera);
     const auto pixel = perception.project(toEigen(target.transform.translation));
     if (pixel) {
+      follow_stamp_ = target.header.stamp;
       last_follow_ = stc::Vec2(std::clamp(pixel->x(), 0.0, static_cast<double>(camera_.width)),
                                std::clamp(pixel->y(), 0.0, static_cast<double>(camera_.height)));
     }
@@ -90,7 +91,11 @@ std::optional<stc::Vec2> GazeSimulator::followPixel() {
 }
 
 void GazeSimulator::publish() {
-  const double t = (ros::WallTime::now() - start_).toSec();
+  // The pixel is a function of the stamp the message carries (time since the
+  // first message), so a subscriber can check the motion from stamps alone.
+  const ros::Time stamp = ros::Time::now();
+  if (start_.isZero()) start_ = stamp;
+  const double t = (stamp - start_).toSec();
   std::optional<stc::Vec2> pixel;
   switch (mode_) {
     case Mode::Fixed:
@@ -111,7 +116,8 @@ void GazeSimulator::publish() {
   }
   if (!pixel) return;
   sphere_tree_collision::GazePoint msg;
-  msg.header.stamp = ros::Time::now();
+  // Follow: the instant the target was where the viewer looks (its tf stamp).
+  msg.header.stamp = mode_ == Mode::Follow ? follow_stamp_ : stamp;
   msg.header.frame_id = camera_frame_;
   msg.x = pixel->x();
   msg.y = pixel->y();

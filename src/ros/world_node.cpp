@@ -4,6 +4,7 @@
 #include "sphere_tree_collision/ros/scene_file.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -101,9 +102,10 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   gaze_sub_ = nh_.subscribe("gaze", 10, &WorldNode::onGaze, this);
   clicked_sub_ = nh_.subscribe("/clicked_point", 10, &WorldNode::onClickedPoint, this);
 
+  // Markers are published from the tick, every ticks_per_marker_ ticks, so that
+  // each array shows the state of one tick and carries that tick's stamp.
+  ticks_per_marker_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(params_.rate / params_.marker_rate)));
   tick_timer_ = nh_.createSteadyTimer(ros::WallDuration(dt_), [this](const ros::SteadyTimerEvent&) { tick(); });
-  marker_timer_ = nh_.createSteadyTimer(ros::WallDuration(1.0 / params_.marker_rate),
-                                        [this](const ros::SteadyTimerEvent&) { publishMarkers(); });
   ROS_INFO("collision_world_node: %zu entities from %s, %.1f Hz, scheduler %s, budget %s ms / %s sphere tests",
            world_.entityCount(), params_.scene.empty() ? "the default scene" : params_.scene.c_str(),
            params_.rate, stc::toString(params_.world.scheduler.kind),
@@ -177,6 +179,7 @@ void WorldNode::tick() {
   publishStats(report, now);
   publishContacts(now);
   publishTf(now);
+  if (tick_ % ticks_per_marker_ == 0) publishMarkers(now);
   ROS_INFO_THROTTLE(1.0,
                     "tick %llu: %zu entities, %zu broad pairs, %zu colliding, %zu unresolved (%zu accepted), "
                     "%lld sphere tests, %zu contacts, %.2f ms, gaze %s, %llu rejected inputs",
@@ -283,7 +286,7 @@ void WorldNode::publishTf(const ros::Time& stamp) {
   if (!ids.empty()) tf_pub_.publish(tf_msg_);
 }
 
-void WorldNode::publishMarkers() {
+void WorldNode::publishMarkers(const ros::Time& now) {
   if (markers_pub_.getNumSubscribers() == 0) {
     // Nobody to keep up to date: the next subscriber starts from a snapshot.
     markers_sent_.clear();
@@ -291,7 +294,6 @@ void WorldNode::publishMarkers() {
     markers_cleared_ = false;
     return;
   }
-  const ros::Time now = ros::Time::now();
   if (params_.marker_mode == NodeParams::MarkerMode::Full) {
     colors_by_index_.resize(world_.entityCount());
     for (std::size_t i = 0; i < world_.entityCount(); ++i) colors_by_index_[i] = colors_[world_.entityIds()[i]];
@@ -325,7 +327,7 @@ void WorldNode::publishMarkers() {
   }
   marker_builder_.addDynamic(world_, marker_options_, gazePoint(), now, true, markers_msg_);
   marker_builder_.end(markers_msg_);
-  markers_pub_.publish(markers_msg_);
+  if (!markers_msg_.markers.empty()) markers_pub_.publish(markers_msg_);  // nothing changed: nothing to send
 }
 
 void WorldNode::buildMarkerSnapshot(const ros::Time& now, bool for_everyone, visualization_msgs::MarkerArray& out) {

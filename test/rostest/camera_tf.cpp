@@ -28,11 +28,11 @@ TEST(CameraTf, ParametersUntilTheFrameExistsThenTf) {
   ros::NodeHandle nh;
   ros::Publisher clicked = nh.advertise<geometry_msgs::PointStamped>("/clicked_point", 10);
   stc_test::Recorder<sphere_tree_collision::TickStats> stats(nh, "/tick_stats");
-  ASSERT_TRUE(stc_test::spinUntil([&] { return clicked.getNumSubscribers() > 0 && stats.count() > 0; }, 15.0));
+  ASSERT_TRUE(stc_test::spinUntil([&] { return clicked.getNumSubscribers() > 0 && stats.count() > 0; }, stc_test::kLivenessSeconds));
 
   // No test_camera in tf yet: the parameter camera sees the point.
   clicked.publish(click(0.0, 6.0, 0.5));
-  ASSERT_TRUE(stc_test::spinUntil([&] { return stats.last.gaze_active; }, 5.0))
+  ASSERT_TRUE(stc_test::spinUntil([&] { return stats.last.gaze_active; }, stc_test::kLivenessSeconds))
       << "last rejection: " << stats.last.last_rejection;
   EXPECT_EQ(stats.last.rejected_clicked_point, 0u);
 
@@ -46,17 +46,26 @@ TEST(CameraTf, ParametersUntilTheFrameExistsThenTf) {
   t.transform.translation = stc_ros::toVector3Msg(pose.position);
   t.transform.rotation = stc_ros::toQuaternionMsg(pose.orientation);
   broadcaster.sendTransform(t);
-  stc_test::spinFor(1.0);  // a few ticks: the node looks the frame up every tick
-
-  clicked.publish(click(0.0, 6.0, 0.5));
-  ASSERT_TRUE(stc_test::spinUntil([&] { return stats.last.rejected_clicked_point == 1u; }, 5.0));
+  // The node looks the frame up every tick; until it has it, the parameter
+  // camera still sees the point. Click until the tf camera rejects it.
+  ros::SteadyTimer clicker = nh.createSteadyTimer(ros::WallDuration(0.1), [&](const ros::SteadyTimerEvent&) {
+    clicked.publish(click(0.0, 6.0, 0.5));
+  });
+  ASSERT_TRUE(stc_test::spinUntil([&] { return stats.last.rejected_clicked_point >= 1u; }, stc_test::kLivenessSeconds));
+  clicker.stop();
   EXPECT_EQ(stats.last.last_rejection.rfind("clicked_point: point: behind the camera", 0), 0u)
       << stats.last.last_rejection;
+  const auto ticksLater = [&](std::uint64_t n) {
+    const std::uint64_t tick = stats.last.tick;
+    return stc_test::spinUntil([&] { return stats.last.tick >= tick + n; }, stc_test::kLivenessSeconds);
+  };
+  ASSERT_TRUE(ticksLater(10));  // clicks still in flight are counted by now
+  const std::uint64_t rejected = stats.last.rejected_clicked_point;
   // And a point in front of the tf camera is taken.
   clicked.publish(click(0.0, 0.0, 1.0));
-  stc_test::spinFor(0.5);
-  EXPECT_EQ(stats.last.rejected_clicked_point, 1u) << stats.last.last_rejection;
-  EXPECT_TRUE(stats.last.gaze_active);
+  ASSERT_TRUE(stc_test::spinUntil([&] { return stats.last.gaze_active; }, stc_test::kLivenessSeconds));
+  ASSERT_TRUE(ticksLater(10));
+  EXPECT_EQ(stats.last.rejected_clicked_point, rejected) << stats.last.last_rejection;
 }
 
 }  // namespace

@@ -14,6 +14,11 @@
 
 namespace stc_test {
 
+// Wall-clock bound of a wait that only guards against a hung node: tests
+// assert stamps and states, never how soon something arrives, so this is
+// generous enough for a fully loaded machine.
+constexpr double kLivenessSeconds = 60.0;
+
 // Spins the default callback queue until `done()` or `timeout_s` of wall time.
 inline bool spinUntil(const std::function<bool()>& done, double timeout_s) {
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);

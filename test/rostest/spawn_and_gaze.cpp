@@ -39,7 +39,7 @@ class SpawnAndGaze : public testing::Test {
         markers_(nh_, "/markers"),
         listener_(tf_, nh_, false) {
     EXPECT_TRUE(stc_test::spinUntil(
-        [&] { return spawn_.getNumSubscribers() > 0 && clear_.getNumSubscribers() > 0 && stats_.count() > 0; }, 15.0));
+        [&] { return spawn_.getNumSubscribers() > 0 && clear_.getNumSubscribers() > 0 && stats_.count() > 0; }, stc_test::kLivenessSeconds));
     // Start empty. Topics are not ordered against each other, so a clear is
     // sent only when there is something to clear, and awaited.
     if (stats_.last.entities > 0) {
@@ -49,7 +49,7 @@ class SpawnAndGaze : public testing::Test {
   }
 
   testing::AssertionResult waitForEntities(std::uint32_t n) {
-    if (stc_test::spinUntil([&] { return stats_.count() > 0 && stats_.last.entities == n; }, 10.0)) {
+    if (stc_test::spinUntil([&] { return stats_.count() > 0 && stats_.last.entities == n; }, stc_test::kLivenessSeconds)) {
       return testing::AssertionSuccess();
     }
     return testing::AssertionFailure() << "world holds " << stats_.last.entities << " entities, not " << n
@@ -76,20 +76,28 @@ class SpawnAndGaze : public testing::Test {
     return m;
   }
 
-  // Deepest level reached by the contacts of each pair (by nearest pair x), over a few ticks.
-  std::map<int, int> deepestLevelPerPair(double seconds) {
+  // Deepest level reached by the contacts of each pair (by nearest pair x),
+  // over the next `messages` contact arrays (ticks).
+  std::map<int, int> deepestLevelPerPair(std::size_t messages) {
     std::map<int, int> deepest;
-    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+    contacts_.keep_all = true;
     contacts_.clear();
-    while (ros::WallTime::now() < end) {
-      stc_test::spinFor(0.05);
-      for (const auto& c : contacts_.last.contacts) {
+    EXPECT_TRUE(contacts_.waitFor(messages, stc_test::kLivenessSeconds));
+    for (const auto& array : contacts_.all) {
+      for (const auto& c : array.contacts) {
         const int pair = static_cast<int>(std::lround((c.point.x + 0.5 * (kPairs - 1) * kPairSpacing) / kPairSpacing));
         if (pair < 0 || pair >= kPairs) continue;
         deepest[pair] = std::max(deepest.count(pair) ? deepest[pair] : -1, static_cast<int>(c.level));
       }
     }
+    contacts_.keep_all = false;
     return deepest;
+  }
+
+  // Waits until the node has ticked n more times (judged by tick numbers).
+  bool ticksLater(std::uint64_t n) {
+    const std::uint64_t tick = stats_.last.tick;
+    return stc_test::spinUntil([&] { return stats_.last.tick >= tick + n; }, stc_test::kLivenessSeconds);
   }
 
   ros::NodeHandle nh_;
@@ -106,13 +114,13 @@ TEST_F(SpawnAndGaze, SpawnedEntityGetsTfFrameAndMarkers) {
   probe.preset = "L";
   spawn_.publish(probe);
   ASSERT_TRUE(waitForEntities(1));
-  ASSERT_TRUE(stc_test::spinUntil([&] { return tf_.canTransform("world", "probe", ros::Time(0)); }, 10.0));
+  ASSERT_TRUE(stc_test::spinUntil([&] { return tf_.canTransform("world", "probe", ros::Time(0)); }, stc_test::kLivenessSeconds));
   const auto t = tf_.lookupTransform("world", "probe", ros::Time(0));
   EXPECT_NEAR(t.transform.translation.x, 0.4, 1e-9);
   EXPECT_NEAR(t.transform.translation.z, 0.9, 1e-9);
 
   // The markers draw it: one voxel list, frame-locked in its frame.
-  ASSERT_TRUE(stc_test::spinUntil([&] { return markers_.count("voxels") == 1; }, 10.0));
+  ASSERT_TRUE(stc_test::spinUntil([&] { return markers_.count("voxels") == 1; }, stc_test::kLivenessSeconds));
   for (const auto& [key, m] : markers_.markers) {
     if (key.first != "voxels") continue;
     EXPECT_EQ(m.header.frame_id, "probe");
@@ -131,8 +139,7 @@ TEST_F(SpawnAndGaze, SpawnedEntityGetsTfFrameAndMarkers) {
           if (f.rfind("entity_", 0) == 0) return true;
         }
         return false;
-      },
-      10.0));
+      }, stc_test::kLivenessSeconds));
 }
 
 TEST_F(SpawnAndGaze, ContactsNearTheGazeReachDeeperLevels) {
@@ -166,9 +173,9 @@ TEST_F(SpawnAndGaze, ContactsNearTheGazeReachDeeperLevels) {
       g.y = pixel->y();
       gaze_.publish(g);
     });
-    ASSERT_TRUE(stc_test::spinUntil([&] { return stats_.last.gaze_active && stats_.last.perception_used; }, 10.0));
-    stc_test::spinFor(0.3);
-    const std::map<int, int> deepest = deepestLevelPerPair(1.5);
+    ASSERT_TRUE(stc_test::spinUntil([&] { return stats_.last.gaze_active && stats_.last.perception_used; }, stc_test::kLivenessSeconds));
+    ASSERT_TRUE(ticksLater(5));  // gaze messages in flight have arrived
+    const std::map<int, int> deepest = deepestLevelPerPair(20);
     gaze_timer.stop();
     ASSERT_EQ(deepest.size(), static_cast<std::size_t>(kPairs)) << "every pair reports contacts";
     EXPECT_TRUE(stats_.last.interrupted) << "the budget must be tight for this test to mean anything";
@@ -180,7 +187,7 @@ TEST_F(SpawnAndGaze, ContactsNearTheGazeReachDeeperLevels) {
   }
 
   // Without gaze the scheduler says so, and no pair is favoured by position.
-  ASSERT_TRUE(stc_test::spinUntil([&] { return !stats_.last.gaze_active && !stats_.last.perception_used; }, 5.0));
+  ASSERT_TRUE(stc_test::spinUntil([&] { return !stats_.last.gaze_active && !stats_.last.perception_used; }, stc_test::kLivenessSeconds));
 }
 
 TEST_F(SpawnAndGaze, DespawnByNameAndIdThenClear) {
@@ -205,8 +212,7 @@ TEST_F(SpawnAndGaze, DespawnByNameAndIdThenClear) {
           if (f.rfind("entity_", 0) == 0) id = std::max(id, std::stol(f.substr(7)));
         }
         return id >= 0;
-      },
-      10.0));
+      }, stc_test::kLivenessSeconds));
   sphere_tree_collision::Despawn by_id;
   by_id.id = static_cast<std::uint32_t>(id);
   despawn_.publish(by_id);
@@ -218,14 +224,14 @@ TEST_F(SpawnAndGaze, DespawnByNameAndIdThenClear) {
   ASSERT_TRUE(waitForEntities(2));
   EXPECT_EQ(stats_.last.rejected_spawn, 0u);
 
-  ASSERT_TRUE(stc_test::spinUntil([&] { return markers_.count("voxels") == 2; }, 10.0))
+  ASSERT_TRUE(stc_test::spinUntil([&] { return markers_.count("voxels") == 2; }, stc_test::kLivenessSeconds))
       << "despawned entities' markers are deleted, the others stay";
   EXPECT_GT(markers_.count("tree_level_1"), 0);
 
   clear_.publish(std_msgs::Empty());
   ASSERT_TRUE(waitForEntities(0));
   EXPECT_TRUE(stc_test::spinUntil(
-      [&] { return markers_.count("voxels") == 0 && markers_.count("tree_level_1") == 0; }, 10.0))
+      [&] { return markers_.count("voxels") == 0 && markers_.count("tree_level_1") == 0; }, stc_test::kLivenessSeconds))
       << "cleared entities leave no markers";
 }
 

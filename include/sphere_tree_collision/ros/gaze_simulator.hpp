@@ -41,7 +41,8 @@ class GazeSimulator {
   double circle_radius_ = 0.0, circle_period_ = 4.0;
   std::unique_ptr<stc::GazeModel> model_;  // fixed and saccades
   std::optional<stc::Vec2> last_follow_;
-  ros::WallTime start_;
+  ros::Time follow_stamp_;  // tf stamp of the target pose last_follow_ projects
+  ros::Time start_;  // stamp of the first message
   std::unique_ptr<tf2_ros::Buffer> tf_;
   std::unique_ptr<tf2_ros::TransformListener> listener_;
   ros::Publisher pub_;

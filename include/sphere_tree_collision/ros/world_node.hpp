@@ -37,9 +37,10 @@ class WorldNode {
   // reports it and exits non-zero rather than run on a guess.
   WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
 
-  // One tick: camera, gaze expiry, World::step, tick_stats / contacts / tf.
+  // One tick: camera, gaze expiry, World::step, tick_stats / contacts / tf,
+  // and markers every ticks_per_marker_ ticks (~rate / ~marker_rate).
   void tick();
-  void publishMarkers();
+  void publishMarkers(const ros::Time& stamp);
   // Incremental marker mode: the whole scene (DELETEALL first), to one new
   // subscriber or, as a keyframe, to every subscriber (then it resets what is
   // pending).
@@ -78,6 +79,7 @@ class WorldNode {
   stc::Budget budget_;
   double dt_ = 0.0;
   std::uint64_t tick_ = 0;
+  std::uint64_t ticks_per_marker_ = 1;
 
   // Per entity, by id: what the World does not keep.
   std::unordered_map<stc::EntityId, Rgba> colors_;
@@ -115,7 +117,7 @@ class WorldNode {
 
   ros::Publisher markers_pub_, contacts_pub_, stats_pub_, tf_pub_;
   ros::Subscriber spawn_sub_, despawn_sub_, clear_sub_, gaze_sub_, clicked_sub_;
-  ros::SteadyTimer tick_timer_, marker_timer_;
+  ros::SteadyTimer tick_timer_;
 };
 
 }  // namespace stc_ros
