@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libfcl-dev libgtest-dev googletest
   python3-matplotlib
   rviz xvfb xauth imagemagick x11-utils
+  catkin-lint
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -13,4 +13,8 @@ source "$STC_BUILD/devel/setup.bash"
 set -u
 # run_tests exits 0 even when a test fails: the result files decide.
 make -C "$STC_BUILD" run_tests -j1 2>&1 | tee "$STC_BUILD/run_tests.log" | grep -E "^\[ *(RUN|  OK|  FAILED|  PASSED) |^\[ROSTEST\]|FAILURE|Error|error:" || true
+# Checks that are scripts, recorded as test cases beside the gtests and rostests.
+check() { /usr/bin/python3 "$STC_ROOT/scripts/run_check.py" "$STC_BUILD/test_results" "$@" || true; }
+check catkin_lint -- /usr/bin/catkin_lint --strict --skip-path build "$STC_ROOT"
+check installed_demo -- bash "$STC_ROOT/scripts/check_install.sh"
 /usr/bin/python3 "$STC_ROOT/scripts/count_results.py" "$STC_BUILD/test_results"
