@@ -240,6 +240,8 @@ SolveStats solveContacts(std::vector<BodyState>& bodies, std::vector<Contact>& c
 struct SweepStats {
   std::size_t fast_bodies = 0;
   std::size_t clamped = 0;  // moved back to their first contact
+  std::size_t pairs = 0;    // pairs swept (relative motion fast)
+  std::size_t leaf_tests = 0;  // leaf box pairs tested
 };
 
 // A fast body's earliest hit of the tick.
@@ -268,7 +270,8 @@ std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vect
 
 // Sweeps each fast body (scratch.fast, from markFastBodies) against its
 // partners in pairs[0..pair_count) (dense body indices: the broad phase's
-// pairs, found with swept boxes), never against all bodies. Both bodies of a
+// pairs, found with swept boxes), never against all bodies, and only where
+// the pair's relative motion is fast by the same threshold. Both bodies of a
 // pair move along their chords from start to end pose; the leaves' voxel boxes
 // are tested in that relative motion (hierarchy pruned by ShapeBounds::reach).
 // A hit is the first instant a pair of leaf boxes overlaps deeper than a
@@ -284,7 +287,7 @@ std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vect
 SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
                            const std::vector<const ShapeBounds*>& shapes,
                            const std::vector<std::array<std::uint32_t, 2>>& pairs, std::size_t pair_count,
-                           SweepScratch& scratch);
+                           double threshold, SweepScratch& scratch);
 
 // ---------------------------------------------------------------------------
 // The World's physics: integrate and respond, keeping what lasts between

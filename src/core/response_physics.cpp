@@ -50,7 +50,8 @@ void Physics::sweep(std::vector<BodyState>& bodies, const std::vector<std::array
                     std::size_t count, const ResponseOptions& options) {
   sweep_scratch_.clamped.clear();
   if (report_.sweep.fast_bodies == 0 || !options.continuous || !options.enabled) return;
-  report_.sweep = sweepFastBodies(bodies, start_, body_bounds_, pair_bodies, count, sweep_scratch_);
+  report_.sweep = sweepFastBodies(bodies, start_, body_bounds_, pair_bodies, count, options.sweep_threshold,
+                                  sweep_scratch_);
 }
 
 void Physics::respond(const std::vector<PairTest>& tests, std::size_t count,

@@ -24,14 +24,16 @@ double firstTouch(const Vec3& d0, const Vec3& v, double reach, double t_max) {
 }
 
 struct Sweeper {
-  const ShapeBounds& fast;
-  const ShapeBounds& other;
-  Mat3 r0, r1, ro0, ro1;  // fast body at start and end, other body at start and end
+  const ShapeBounds& first;   // the pair's bodies
+  const ShapeBounds& second;
+  Mat3 r0, r1, ro0, ro1;  // first body at start and end, second body at start and end
   Vec3 x0, x1, xo0, xo1;
   double best;            // earliest hit so far, fraction of the tick
   std::vector<std::pair<std::int32_t, std::int32_t>>& stack;
-  Vec3 normal = Vec3::UnitZ();  // of the earliest hit, from the fast body towards the other
+  Mat3 relative_abs = (ro1.transpose() * r1).cwiseAbs();  // |cosines| between the end axes
+  Vec3 normal = Vec3::UnitZ();  // of the earliest hit, from the first body towards the second
   Vec3 point = Vec3::Zero();
+  std::size_t leaf_tests = 0;
 
   // First instant the two leaves' voxel boxes overlap deeper than a quarter
   // of the thinner box's half extent on all six face axes, in their relative
@@ -42,39 +44,46 @@ struct Sweeper {
   // sliding over a floor would keep running into the spheres ahead.
   // A hit that the discrete step handles is not one: while the boxes overlap
   // this tick they never get deeper than the thinner box's half extent (its
-  // centre does not cross the other's face). A body grazing a wall or sliding
+  // centre does not cross the other box.s face). A body grazing a wall or sliding
   // over a tiled floor keeps its motion; only one that would pass through or
   // sink in is held back. The depth (shallowest axis) is concave in t: taken
   // at the middle and the end of the overlap.
   double leafEntry(std::int32_t nf, std::int32_t no, int& axis, double& side) const {
     const std::size_t f = static_cast<std::size_t>(nf);
     const std::size_t o = static_cast<std::size_t>(no);
-    const Vec3 local_f = fast.tree->node(nf).centre + fast.box_offset[f];
-    const Vec3 local_o = other.tree->node(no).centre + other.box_offset[o];
-    const Vec3 d0 = ro0 * local_o + xo0 - (r0 * local_f + x0);  // other's box centre from the fast one's
+    const Vec3 local_f = first.tree->node(nf).centre + first.box_offset[f];
+    const Vec3 local_o = second.tree->node(no).centre + second.box_offset[o];
+    const Vec3 d0 = ro0 * local_o + xo0 - (r0 * local_f + x0);  // second's box centre from the first's
     const Vec3 d1 = ro1 * local_o + xo1 - (r1 * local_f + x1);
-    const Vec3& hf = fast.box_half[f];
-    const Vec3& ho = other.box_half[o];
+    const Vec3& hf = first.box_half[f];
+    const Vec3& ho = second.box_half[o];
     const double thinner = std::min(hf.minCoeff(), ho.minCoeff());
     const double tolerance = 0.25 * thinner;
+    // Axes 0-2: the first box's faces, 3-5: the second's; offsets along them.
+    const Vec3 d0_f = r1.transpose() * d0, d1_f = r1.transpose() * d1;
+    const Vec3 d0_o = ro1.transpose() * d0, d1_o = ro1.transpose() * d1;
     double lo = -std::numeric_limits<double>::infinity();
     double hi = std::numeric_limits<double>::infinity();
-    double full[6], x0[6], dx[6];  // per axis: overlap extent, centre offset at start, its change
+    double full[6], offset[6], change[6];  // per axis: overlap extent, centre offset at start, its change
     int entry_axis = 0;
     for (int k = 0; k < 6; ++k) {
-      const Vec3 u = k < 3 ? Vec3(r1.col(k)) : Vec3(ro1.col(k - 3));
-      full[k] = hf.dot((r1.transpose() * u).cwiseAbs()) + ho.dot((ro1.transpose() * u).cwiseAbs());
+      if (k < 3) {
+        full[k] = hf[k] + ho.dot(relative_abs.col(k));
+        offset[k] = d0_f[k];
+        change[k] = d1_f[k] - d0_f[k];
+      } else {
+        full[k] = hf.dot(relative_abs.row(k - 3)) + ho[k - 3];
+        offset[k] = d0_o[k - 3];
+        change[k] = d1_o[k - 3] - d0_o[k - 3];
+      }
       const double reach = full[k] - tolerance;
       if (reach <= 0.0) return -1.0;
-      x0[k] = d0.dot(u);
-      dx[k] = d1.dot(u) - x0[k];
-      const double x0u = x0[k];
-      if (dx[k] == 0.0) {
-        if (std::abs(x0u) >= reach) return -1.0;
+      if (change[k] == 0.0) {
+        if (std::abs(offset[k]) >= reach) return -1.0;
         continue;
       }
-      const double t1 = (-reach - x0u) / dx[k];
-      const double t2 = (reach - x0u) / dx[k];
+      const double t1 = (-reach - offset[k]) / change[k];
+      const double t2 = (reach - offset[k]) / change[k];
       const double enter = std::min(t1, t2);
       if (enter > lo) {
         lo = enter;
@@ -86,14 +95,13 @@ struct Sweeper {
     if (lo <= 0.0 || lo > best) return -1.0;  // overlapping at the start, never, or later
     const auto depth = [&](double t) {
       double d = std::numeric_limits<double>::infinity();
-      for (int k = 0; k < 6; ++k) d = std::min(d, full[k] - std::abs(x0[k] + t * dx[k]));
+      for (int k = 0; k < 6; ++k) d = std::min(d, full[k] - std::abs(offset[k] + t * change[k]));
       return d;
     };
     const double last = std::min(hi, 1.0);
     if (std::max(depth(0.5 * (lo + last)), depth(last)) <= thinner) return -1.0;  // a graze
     axis = entry_axis;
-    const Vec3 u = axis < 3 ? Vec3(r1.col(axis)) : Vec3(ro1.col(axis - 3));
-    side = (d0 + lo * (d1 - d0)).dot(u) >= 0.0 ? 1.0 : -1.0;
+    side = offset[axis] + lo * change[axis] >= 0.0 ? 1.0 : -1.0;
     return lo;
   }
 
@@ -104,8 +112,8 @@ struct Sweeper {
     while (!stack.empty()) {
       const auto [nf, no] = stack.back();
       stack.pop_back();
-      const SphereNode& f = fast.tree->node(nf);
-      const SphereNode& o = other.tree->node(no);
+      const SphereNode& f = first.tree->node(nf);
+      const SphereNode& o = second.tree->node(no);
       const Vec3 a0 = r0 * f.centre + x0;
       const Vec3 a1 = r1 * f.centre + x1;
       const Vec3 b0 = ro0 * o.centre + xo0;
@@ -115,6 +123,7 @@ struct Sweeper {
       if (f_leaf && o_leaf) {
         int axis = 0;
         double side = 1.0;
+        ++leaf_tests;
         const double t = leafEntry(nf, no, axis, side);
         if (t >= 0.0 && t < best) {
           best = t;
@@ -124,12 +133,12 @@ struct Sweeper {
         }
         continue;
       }
-      const double bound = fast.reach[static_cast<std::size_t>(nf)] + other.reach[static_cast<std::size_t>(no)];
+      const double bound = first.reach[static_cast<std::size_t>(nf)] + second.reach[static_cast<std::size_t>(no)];
       if (firstTouch(a0 - b0, (a1 - b1) - (a0 - b0), bound, best) < 0.0) continue;
       // Open the node with the larger reach (a leaf cannot be opened).
-      const bool open_fast = !f_leaf && (o_leaf || fast.reach[static_cast<std::size_t>(nf)] >=
-                                                       other.reach[static_cast<std::size_t>(no)]);
-      if (open_fast) {
+      const bool open_first = !f_leaf && (o_leaf || first.reach[static_cast<std::size_t>(nf)] >=
+                                                       second.reach[static_cast<std::size_t>(no)]);
+      if (open_first) {
         for (std::int32_t c = f.first_child; c < f.first_child + f.child_count; ++c) stack.emplace_back(c, no);
       } else {
         for (std::int32_t c = o.first_child; c < o.first_child + o.child_count; ++c) stack.emplace_back(nf, c);
@@ -168,7 +177,7 @@ std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vect
 SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
                            const std::vector<const ShapeBounds*>& shapes,
                            const std::vector<std::array<std::uint32_t, 2>>& pairs, std::size_t pair_count,
-                           SweepScratch& scratch) {
+                           double threshold, SweepScratch& scratch) {
   SweepStats stats;
   scratch.hits.assign(bodies.size(), SweepHit{});
   scratch.clamped.clear();
@@ -177,24 +186,43 @@ SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pos
   if (stats.fast_bodies == 0) return stats;
   // Every pair sees the end poses of this integration: the result does not
   // depend on the pair order.
+  // Each pair is swept once, in the relative motion of its two bodies; the hit
+  // holds back whichever of them is fast.
   for (std::size_t k = 0; k < pair_count; ++k) {
-    for (int side = 0; side < 2; ++side) {
-      const std::uint32_t i = pairs[k][static_cast<std::size_t>(side)];
-      const std::uint32_t j = pairs[k][static_cast<std::size_t>(1 - side)];
-      if (!scratch.fast[i] || shapes[j] == nullptr || shapes[j]->tree == nullptr) continue;
+    const std::uint32_t a = pairs[k][0];
+    const std::uint32_t b = pairs[k][1];
+    if (!scratch.fast[a] && !scratch.fast[b]) continue;
+    if (shapes[a] == nullptr || shapes[a]->tree == nullptr || shapes[b] == nullptr || shapes[b]->tree == nullptr) {
+      continue;
+    }
+    const Pose& p0 = start[a];
+    const Pose& p1 = bodies[a].pose;
+    const Pose& q0 = start[b];
+    const Pose& q1 = bodies[b].pose;
+    // Bodies falling side by side are fast but not towards each other: the
+    // pair is swept only when its relative motion is fast.
+    const double relative = ((p1.position - p0.position) - (q1.position - q0.position)).norm() +
+                            p0.orientation.angularDistance(p1.orientation) * shapes[a]->bound_radius +
+                            q0.orientation.angularDistance(q1.orientation) * shapes[b]->bound_radius;
+    const double finest = std::min(scratch.fast[a] ? shapes[a]->min_leaf_radius : shapes[b]->min_leaf_radius,
+                                   scratch.fast[b] ? shapes[b]->min_leaf_radius : shapes[a]->min_leaf_radius);
+    if (!(relative > threshold * finest)) continue;
+    // Only a hit earlier than a fast body's earliest so far matters.
+    const double latest = std::max(scratch.fast[a] ? scratch.hits[a].t : 0.0, scratch.fast[b] ? scratch.hits[b].t : 0.0);
+    Sweeper s{*shapes[a], *shapes[b], p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(),
+              q0.orientation.toRotationMatrix(), q1.orientation.toRotationMatrix(),
+              p0.position, p1.position, q0.position, q1.position, latest, scratch.stack};
+    ++stats.pairs;
+    const bool found = s.run();
+    stats.leaf_tests += s.leaf_tests;
+    if (!found) continue;
+    for (const std::uint32_t i : {a, b}) {
       SweepHit& hit = scratch.hits[i];
-      const Pose& p0 = start[i];
-      const Pose& p1 = bodies[i].pose;
-      const Pose& q0 = start[j];
-      const Pose& q1 = bodies[j].pose;
-      Sweeper s{*shapes[i], *shapes[j], p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(),
-                q0.orientation.toRotationMatrix(), q1.orientation.toRotationMatrix(),
-                p0.position, p1.position, q0.position, q1.position, hit.t, scratch.stack};
-      if (!s.run()) continue;
+      if (!scratch.fast[i] || !(s.best < hit.t)) continue;
       hit.t = s.best;
       hit.pair = static_cast<std::uint32_t>(k);
       hit.point = s.point;
-      hit.normal = side == 0 ? s.normal : Vec3(-s.normal);  // from pairs[k][0] towards pairs[k][1]
+      hit.normal = s.normal;  // from a (the sweeper's first body) towards b
     }
   }
   for (std::size_t i = 0; i < bodies.size(); ++i) {

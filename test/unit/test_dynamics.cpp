@@ -389,7 +389,7 @@ TEST(Sweep, AFastSmallBodyIsStoppedAtAThinPlateAndSlowOrSlidingOnesAreNot) {
   SweepScratch scratch;
   const auto sweep = [&] {
     markFastBodies(bodies, start, shapes, 0.5, scratch.fast);
-    return sweepFastBodies(bodies, start, shapes, pairs, pairs.size(), scratch);
+    return sweepFastBodies(bodies, start, shapes, pairs, pairs.size(), 0.5, scratch);
   };
   start[1].position = Vec3(0.01, 0.02, 0.5);
   bodies[1].pose.position = Vec3(0.01, 0.02, -1.0);  // straight through the plate in one tick
@@ -408,7 +408,7 @@ TEST(Sweep, AFastSmallBodyIsStoppedAtAThinPlateAndSlowOrSlidingOnesAreNot) {
   // Not among its pairs: never swept against it (the broad phase culls).
   bodies[1].pose.position = Vec3(0.01, 0.02, -1.0);
   markFastBodies(bodies, start, shapes, 0.5, scratch.fast);
-  stats = sweepFastBodies(bodies, start, shapes, pairs, 0, scratch);
+  stats = sweepFastBodies(bodies, start, shapes, pairs, 0, 0.5, scratch);
   EXPECT_EQ(stats.clamped, 0u);
 
   // Slow: moved less than half its smallest leaf radius -> not swept.
@@ -443,7 +443,7 @@ TEST(Sweep, AFastSmallBodyIsStoppedAtAThinPlateAndSlowOrSlidingOnesAreNot) {
   markFastBodies(bodies, start, shapes, 0.5, scratch.fast);
   scratch.fast[0] = 0;  // only the ball is swept
   scratch.fast[1] = 1;
-  stats = sweepFastBodies(bodies, start, shapes, pairs, pairs.size(), scratch);
+  stats = sweepFastBodies(bodies, start, shapes, pairs, pairs.size(), 0.5, scratch);
   EXPECT_EQ(stats.clamped, 1u);
   EXPECT_GT(bodies[1].pose.position.z(), 0.3 - 0.1 * voxel);
 }
