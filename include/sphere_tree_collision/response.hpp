@@ -161,8 +161,9 @@ struct SolveStats {
 // lets the bodies close at most s/dt this tick) and Coulomb friction
 // (circular cone, friction = sqrt(mu_a mu_b)), iterated with rows ordered up
 // the contact graph from the static bodies; then shock propagation (see
-// ResponseOptions); then restitution (e = max(e_a, e_b)) for contacts that
-// were approaching faster than the threshold and took an impulse (a bounce
+// ResponseOptions); then restitution (e = max(e_a, e_b)) in its own pass for
+// contacts that were approaching faster than the threshold before the solve
+// and took an impulse in it, every other contact still holding (a bounce
 // across a speculative gap also closes the gap, so it starts at the surface).
 // Position correction by split impulse: pseudo-velocities that move the
 // bodies out of penetration beyond the slop and are then discarded, so no
