@@ -189,14 +189,14 @@ TEST(Continuous, CubeGrazingAFrictionlessWallKeepsFalling) {
   spec.shape = preset(w, "cube");
   spec.material = frictionless;
   spec.pose.position = Vec3(0.2 + 0.001, 0.0, 1.0);  // 1 mm off the wall
-  spec.linear_velocity = Vec3(-0.3, 0.0, -20.0);
+  spec.linear_velocity = Vec3(-1.0, 0.0, -20.0);  // 0.3 voxel into the wall in its first tick
   const std::size_t index = *w.indexOf(w.addEntity(spec));
   const int steps = 20;
   for (int s = 0; s < steps; ++s) w.step(kDt, Budget::unlimited());
   const BodyState& b = w.bodies()[index];
   EXPECT_NEAR(b.linear_velocity.z(), -20.0 - kG * steps * kDt, 1e-9);
   EXPECT_NEAR(b.linear_velocity.x(), 0.0, 1e-6);  // stopped by the wall
-  EXPECT_GT(b.pose.position.x(), 0.2 - 0.1 * kVoxel);  // and not in it
+  EXPECT_GT(b.pose.position.x(), 0.2 - 0.25 * kVoxel);  // and not through it (a quarter voxel, as the fast sphere of test_stability)
   const double fallen = -20.0 * steps * kDt - kG * kDt * kDt * steps * (steps - 1) / 2.0;
   EXPECT_NEAR(b.pose.position.z() - 1.0, fallen, 1e-9);
 }
