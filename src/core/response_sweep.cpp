@@ -181,6 +181,7 @@ SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pos
   SweepStats stats;
   scratch.hits.assign(bodies.size(), SweepHit{});
   scratch.clamped.clear();
+  scratch.clamped.reserve(bodies.size());  // grows with the bodies only
   if (scratch.fast.size() != bodies.size()) return stats;  // markFastBodies not run on these bodies
   for (const std::uint8_t f : scratch.fast) stats.fast_bodies += f;
   if (stats.fast_bodies == 0) return stats;
