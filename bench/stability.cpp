@@ -93,6 +93,24 @@ int main(int argc, char** argv) {
     rows.push_back({"thin rod at 100 rad/s about its intermediate axis",
                     fmt("kinetic energy max rise %.1e; spin axis flips (min w_y/w0 %.2f)", worst, min_axis), m});
   }
+  {
+    Scene scene = newtonsCradle(5, 2.0);
+    const std::vector<BodyState>& b = scene.world->bodies();
+    double e0 = 0.0;
+    for (const std::size_t i : scene.movers) e0 += kineticEnergy(b[i]);
+    const Vec3 p0 = linearMomentum(b);
+    const Metrics m = run(scene);
+    double e = 0.0;
+    std::string speeds;
+    for (const std::size_t i : scene.movers) {
+      e += kineticEnergy(b[i]);
+      speeds += (speeds.empty() ? "" : ", ") + fmt("%.2f", b[i].linear_velocity.x());
+    }
+    rows.push_back({"Newton's cradle of 5 touching balls, e = 1, 1 m/s",
+                    fmt("kinetic energy kept %.4f, momentum change %.1e; final speeds ", e / e0,
+                        (linearMomentum(b) - p0).norm() / p0.norm()) + speeds + " m/s",
+                    m});
+  }
   rows.push_back(stackRow("stack of 10, 1 mm voxels", stack(10, 0.001, 1.0 / 60.0, 10.0 * t, 2.0 * t)));
   rows.push_back(stackRow("stack of 10, 100 m voxels", stack(10, 100.0, 1.0 / 60.0, 10.0 * t, 2.0 * t)));
   rows.push_back(stackRow("stack of 10, dt = 1e-4", stack(10, 0.05, 1e-4, 2.0 * t, 0.5 * t)));

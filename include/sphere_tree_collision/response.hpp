@@ -161,8 +161,9 @@ struct SolveStats {
 // lets the bodies close at most s/dt this tick) and Coulomb friction
 // (circular cone, friction = sqrt(mu_a mu_b)), iterated with rows ordered up
 // the contact graph from the static bodies; then shock propagation (see
-// ResponseOptions); then restitution (e = max(e_a, e_b)) for contacts that
-// were approaching faster than the threshold and took an impulse (a bounce
+// ResponseOptions); then restitution (e = max(e_a, e_b)) in its own pass for
+// contacts that were approaching faster than the threshold before the solve
+// and took an impulse in it, every other contact still holding (a bounce
 // across a speculative gap also closes the gap, so it starts at the surface).
 // Position correction by split impulse: pseudo-velocities that move the
 // bodies out of penetration beyond the slop and are then discarded, so no
@@ -235,30 +236,59 @@ SolveStats solveContacts(std::vector<BodyState>& bodies, std::vector<Contact>& c
 
 // ---------------------------------------------------------------------------
 // Anti-tunnelling: swept test of fast bodies (paper: backtrack to the instant
-// of collision)
+// of collision), after the broad phase
 
 struct SweepStats {
   std::size_t fast_bodies = 0;
   std::size_t clamped = 0;  // moved back to their first contact
+  std::size_t pairs = 0;    // pairs swept (relative motion fast)
+  std::size_t leaf_tests = 0;  // leaf box pairs tested
 };
 
-// Bodies moved from start[i] to bodies[i].pose this tick. A fast body (see
-// ResponseOptions::sweep_threshold) has its leaves' voxel boxes swept along
-// the chord from their start to their end position against the leaves of
-// every other body at its end pose (hierarchy pruned by ShapeBounds::reach).
-// At the first instant a pair of boxes overlaps deeper than a quarter of the
-// thinner box (the full spheres then overlap, so the narrow phase reports the
-// contact) the body is put back there (position lerp, orientation slerp).
-// Pairs already overlapping at the start are resting contacts, left to the
-// solver. The velocity is kept: the response of this same tick turns it.
-// shapes[i] may be nullptr (the body is never hit).
-// Node-pair stack of the sweep, kept between calls so a tick allocates nothing.
-struct SweepScratch {
-  std::vector<std::pair<std::int32_t, std::int32_t>> stack;
+// A fast body's earliest hit of the tick.
+struct SweepHit {
+  double t = 1.0;              // fraction of the tick at the hit; 1: none
+  std::uint32_t pair = 0;      // index into the candidate pairs
+  Vec3 point = Vec3::Zero();   // between the two leaf boxes at the hit
+  Vec3 normal = Vec3::UnitZ(); // face axis the boxes met on, from pairs[pair][0] towards [1]
 };
-SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
+
+// Kept between ticks so a tick allocates nothing.
+struct SweepScratch {
+  std::vector<std::pair<std::int32_t, std::int32_t>> stack;  // node pairs of one sweep
+  std::vector<std::uint8_t> fast;        // per body: moved far enough to be swept
+  std::vector<SweepHit> hits;            // per body
+  std::vector<std::uint32_t> clamped;    // bodies put back this tick
+};
+
+// Bodies moved from start[i] to bodies[i].pose this tick. A body is fast when
+// it moved (rotation counted at its farthest leaf) more than `threshold` of
+// its smallest leaf radius (ResponseOptions::sweep_threshold). Static bodies
+// and shapes[i] == nullptr never are. Fills `fast`, returns the count.
+std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vector<Pose>& start,
                            const std::vector<const ShapeBounds*>& shapes, double threshold,
-                           SweepScratch* scratch = nullptr);
+                           std::vector<std::uint8_t>& fast);
+
+// Sweeps each fast body (scratch.fast, from markFastBodies) against its
+// partners in pairs[0..pair_count) (dense body indices: the broad phase's
+// pairs, found with swept boxes), never against all bodies, and only where
+// the pair's relative motion is fast by the same threshold. Both bodies of a
+// pair move along their chords from start to end pose; the leaves' voxel boxes
+// are tested in that relative motion (hierarchy pruned by ShapeBounds::reach).
+// A hit is the first instant a pair of leaf boxes overlaps deeper than a
+// quarter of the thinner box, when at the end they would have passed through
+// each other or sunk in deeper than the thinner box's half extent (a graze
+// the discrete step resolves is left to it). The body is put back at its
+// earliest hit (position lerp, orientation slerp). Its velocity is kept: the
+// narrow phase of the same tick finds the contact there, and the response
+// turns the approach (Physics::respond adds the hit as a contact when the
+// narrow phase gave that pair none). scratch.hits and scratch.clamped say
+// where. Pairs already overlapping at the start are resting contacts, left to
+// the solver.
+SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
+                           const std::vector<const ShapeBounds*>& shapes,
+                           const std::vector<std::array<std::uint32_t, 2>>& pairs, std::size_t pair_count,
+                           double threshold, SweepScratch& scratch);
 
 // ---------------------------------------------------------------------------
 // The World's physics: integrate and respond, keeping what lasts between
@@ -274,12 +304,23 @@ class Physics {
   // Voxels, tree and body origin of a shape id; called once per new shape.
   using ShapeOf = std::function<const ShapeInfo&(std::uint32_t shape)>;
 
-  // Tick phase 1: positions, sweep of fast bodies, velocities.
+  // Tick phase 1: positions, velocities (gravity), and which bodies are fast.
   void integrate(std::vector<BodyState>& bodies, const std::vector<std::uint32_t>& body_shapes,
                  const ShapeOf& shape_of, const Vec3& gravity, const ResponseOptions& options,
                  double dt);
+  // After integrate: fast bodies need swept boxes in the broad phase, from
+  // their start pose of the tick to their pose now.
+  bool isFast(std::size_t body) const {
+    return body < sweep_scratch_.fast.size() && sweep_scratch_.fast[body] != 0;
+  }
+  const Pose& startPose(std::size_t body) const { return start_[body]; }
+  // Tick phase 2b, after the broad phase: sweep of the fast bodies against
+  // their broad-phase partners pair_bodies[0..count) (sweepFastBodies).
+  void sweep(std::vector<BodyState>& bodies, const std::vector<std::array<std::uint32_t, 2>>& pair_bodies,
+             std::size_t count, const ResponseOptions& options);
   // Tick phase 4: contacts of tests[0..count) (pair_bodies: dense indices of
-  // each test's bodies), then impulses when options.enabled.
+  // each test's bodies; the same pairs the sweep saw), plus the sweep's hit
+  // for a pair whose test gave no contact, then impulses when options.enabled.
   void respond(const std::vector<PairTest>& tests, std::size_t count,
                const std::vector<std::array<std::uint32_t, 2>>& pair_bodies,
                const std::vector<double>& priorities, bool accept_unresolved,
@@ -299,6 +340,7 @@ class Physics {
   std::vector<Pose> start_;
   std::vector<const ShapeBounds*> body_bounds_;
   SweepScratch sweep_scratch_;
+  std::vector<std::int32_t> sweep_hit_of_pair_;  // body whose sweep hit that pair, or -1
   PhysicsReport report_;
 };
 

@@ -60,6 +60,7 @@ struct EntitySpec {
 struct TickReport {
   // Phase wall times, seconds.
   double integrate_s = 0.0, broad_s = 0.0, narrow_s = 0.0, response_s = 0.0, total_s = 0.0;
+  double sweep_s = 0.0;  // continuous collision of fast bodies, between broad and narrow phase
   double scheduling_overhead_s = 0.0;  // part of narrow_s spent deciding, not testing
   std::size_t entities = 0;
   std::size_t broad_pairs = 0;
@@ -135,10 +136,12 @@ class World {
  private:
   // Phases, in tick order.
   void integrate(double dt, TickReport& report);
-  void broadPhase(TickReport& report);
+  void broadPhase(TickReport& report);   // also sets up the pair tests of its pairs
+  void continuousCollision(TickReport& report);
   void narrowPhase(const Budget& budget, TickReport& report);
   void response(double dt, TickReport& report);
   Aabb boxOf(std::size_t index) const;
+  Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
 
   WorldConfig config_;

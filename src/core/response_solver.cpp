@@ -333,13 +333,22 @@ void ContactSolver::solveVelocities(const ResponseOptions& options) {
   }
 }
 
+// Restitution in its own pass after the solve (as Box2D v3): a contact that
+// approached faster than the threshold before the solve (row.approach) and
+// took an impulse in it is driven to separate at e times that approach. Every
+// other contact keeps its non-penetration constraint in the same pass: a
+// bounce may not push a body into a neighbour it rests against. In a row of
+// touching balls the struck ball's bounce then moves the whole row instead of
+// driving the second ball into the third (which would meet it next tick,
+// inelastically, losing energy at each link).
 void ContactSolver::applyRestitution(const ResponseOptions& options, SolveStats& stats) {
   const bool jacobi = options.solver == SolverKind::Jacobi;
   std::vector<Vec3>& out_v = jacobi ? dv_ : v_;
   std::vector<Vec3>& out_w = jacobi ? dw_ : w_;
   bool any = false;
-  for (const Row& row : rows_) {
-    if (row.approach < -options.restitution_threshold && row.restitution > 0.0 && row.lambda[0] > 0.0) {
+  for (Row& row : rows_) {
+    row.bounced = row.approach < -options.restitution_threshold && row.restitution > 0.0 && row.lambda_main > 0.0;
+    if (row.bounced) {
       any = true;
       ++stats.bounced;
     }
@@ -347,13 +356,8 @@ void ContactSolver::applyRestitution(const ResponseOptions& options, SolveStats&
   if (!any) return;
   for (int it = 0; it < options.iterations; ++it) {
     for (Row& row : rows_) {
-      if (!(row.approach < -options.restitution_threshold && row.restitution > 0.0 &&
-            row.lambda_main > 0.0)) {
-        continue;
-      }
       const Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
-      row.bounced = true;
-      const double target = -row.restitution * row.approach;
+      const double target = row.bounced ? -row.restitution * row.approach : -row.speculative;
       const double normal = std::max(0.0, row.lambda[0] + row.mass[0] * (target - vrel.dot(row.n)));
       const double delta = normal - row.lambda[0];
       row.lambda[0] = normal;

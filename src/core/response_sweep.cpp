@@ -23,60 +23,86 @@ double firstTouch(const Vec3& d0, const Vec3& v, double reach, double t_max) {
   return t <= t_max ? t : -1.0;
 }
 
-// Distance from point p to the segment [s0, s1].
-double segmentDistance(const Vec3& p, const Vec3& s0, const Vec3& s1) {
-  const Vec3 d = s1 - s0;
-  const double len2 = d.squaredNorm();
-  const double t = len2 > 0.0 ? std::clamp((p - s0).dot(d) / len2, 0.0, 1.0) : 0.0;
-  return (s0 + t * d - p).norm();
-}
-
 struct Sweeper {
-  const ShapeBounds& fast;
-  const ShapeBounds& other;
-  Mat3 r0, r1, ro;  // fast body at start and end, other body
-  Vec3 x0, x1, xo;
-  double best;      // earliest hit so far, fraction of the tick
+  const ShapeBounds& first;   // the pair's bodies
+  const ShapeBounds& second;
+  Mat3 r0, r1, ro0, ro1;  // first body at start and end, second body at start and end
+  Vec3 x0, x1, xo0, xo1;
+  double best;            // earliest hit so far, fraction of the tick
   std::vector<std::pair<std::int32_t, std::int32_t>>& stack;
+  Mat3 relative_abs = (ro1.transpose() * r1).cwiseAbs();  // |cosines| between the end axes
+  Vec3 normal = Vec3::UnitZ();  // of the earliest hit, from the first body towards the second
+  Vec3 point = Vec3::Zero();
+  std::size_t leaf_tests = 0;
 
   // First instant the two leaves' voxel boxes overlap deeper than a quarter
-  // of the thinner box's half extent on all six face axes (the slab test of
-  // a box moving along a line, the fast box kept at its end orientation);
-  // -1 when they do not, or when they already do at the start (a resting
-  // contact: the solver's). Penetration tested on boxes, not spheres: a flat
-  // leaf's sphere reaches far beyond its voxels, and a body sliding over a
-  // floor would keep running into the spheres ahead.
-  double leafEntry(std::int32_t nf, std::int32_t no) const {
+  // of the thinner box's half extent on all six face axes, in their relative
+  // motion (slab test of two boxes moving along lines, each kept at its end
+  // orientation); -1 when they do not, or when they already do at the start
+  // (a resting contact: the solver's). Penetration tested on boxes, not
+  // spheres: a flat leaf's sphere reaches far beyond its voxels, and a body
+  // sliding over a floor would keep running into the spheres ahead.
+  // A hit that the discrete step handles is not one: while the boxes overlap
+  // this tick they never get deeper than the thinner box's half extent (its
+  // centre does not cross the other box.s face). A body grazing a wall or sliding
+  // over a tiled floor keeps its motion; only one that would pass through or
+  // sink in is held back. The depth (shallowest axis) is concave in t: taken
+  // at the middle and the end of the overlap.
+  double leafEntry(std::int32_t nf, std::int32_t no, int& axis, double& side) const {
     const std::size_t f = static_cast<std::size_t>(nf);
     const std::size_t o = static_cast<std::size_t>(no);
-    const Vec3 local_f = fast.tree->node(nf).centre + fast.box_offset[f];
-    const Vec3 pa0 = r0 * local_f + x0;
-    const Vec3 pa1 = r1 * local_f + x1;
-    const Vec3 pb = ro * (other.tree->node(no).centre + other.box_offset[o]) + xo;
-    const Vec3& hf = fast.box_half[f];
-    const Vec3& ho = other.box_half[o];
-    const double tolerance = 0.25 * std::min(hf.minCoeff(), ho.minCoeff());
+    const Vec3 local_f = first.tree->node(nf).centre + first.box_offset[f];
+    const Vec3 local_o = second.tree->node(no).centre + second.box_offset[o];
+    const Vec3 d0 = ro0 * local_o + xo0 - (r0 * local_f + x0);  // second's box centre from the first's
+    const Vec3 d1 = ro1 * local_o + xo1 - (r1 * local_f + x1);
+    const Vec3& hf = first.box_half[f];
+    const Vec3& ho = second.box_half[o];
+    const double thinner = std::min(hf.minCoeff(), ho.minCoeff());
+    const double tolerance = 0.25 * thinner;
+    // Axes 0-2: the first box's faces, 3-5: the second's; offsets along them.
+    const Vec3 d0_f = r1.transpose() * d0, d1_f = r1.transpose() * d1;
+    const Vec3 d0_o = ro1.transpose() * d0, d1_o = ro1.transpose() * d1;
     double lo = -std::numeric_limits<double>::infinity();
     double hi = std::numeric_limits<double>::infinity();
+    double full[6], offset[6], change[6];  // per axis: overlap extent, centre offset at start, its change
+    int entry_axis = 0;
     for (int k = 0; k < 6; ++k) {
-      const Vec3 u = k < 3 ? Vec3(r1.col(k)) : Vec3(ro.col(k - 3));
-      const double reach = hf.dot((r1.transpose() * u).cwiseAbs()) +
-                           ho.dot((ro.transpose() * u).cwiseAbs()) - tolerance;
+      if (k < 3) {
+        full[k] = hf[k] + ho.dot(relative_abs.col(k));
+        offset[k] = d0_f[k];
+        change[k] = d1_f[k] - d0_f[k];
+      } else {
+        full[k] = hf.dot(relative_abs.row(k - 3)) + ho[k - 3];
+        offset[k] = d0_o[k - 3];
+        change[k] = d1_o[k - 3] - d0_o[k - 3];
+      }
+      const double reach = full[k] - tolerance;
       if (reach <= 0.0) return -1.0;
-      const double x0u = (pb - pa0).dot(u);
-      const double dx = (pb - pa1).dot(u) - x0u;
-      if (dx == 0.0) {
-        if (std::abs(x0u) >= reach) return -1.0;
+      if (change[k] == 0.0) {
+        if (std::abs(offset[k]) >= reach) return -1.0;
         continue;
       }
-      const double t1 = (-reach - x0u) / dx;
-      const double t2 = (reach - x0u) / dx;
-      lo = std::max(lo, std::min(t1, t2));
+      const double t1 = (-reach - offset[k]) / change[k];
+      const double t2 = (reach - offset[k]) / change[k];
+      const double enter = std::min(t1, t2);
+      if (enter > lo) {
+        lo = enter;
+        entry_axis = k;
+      }
       hi = std::min(hi, std::max(t1, t2));
       if (lo >= hi) return -1.0;
     }
-    if (lo <= 0.0) return -1.0;  // overlapping at the start, or never
-    return lo <= best ? lo : -1.0;
+    if (lo <= 0.0 || lo > best) return -1.0;  // overlapping at the start, never, or later
+    const auto depth = [&](double t) {
+      double d = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < 6; ++k) d = std::min(d, full[k] - std::abs(offset[k] + t * change[k]));
+      return d;
+    };
+    const double last = std::min(hi, 1.0);
+    if (std::max(depth(0.5 * (lo + last)), depth(last)) <= thinner) return -1.0;  // a graze
+    axis = entry_axis;
+    side = offset[axis] + lo * change[axis] >= 0.0 ? 1.0 : -1.0;
+    return lo;
   }
 
   bool run() {
@@ -86,27 +112,33 @@ struct Sweeper {
     while (!stack.empty()) {
       const auto [nf, no] = stack.back();
       stack.pop_back();
-      const SphereNode& f = fast.tree->node(nf);
-      const SphereNode& o = other.tree->node(no);
+      const SphereNode& f = first.tree->node(nf);
+      const SphereNode& o = second.tree->node(no);
       const Vec3 a0 = r0 * f.centre + x0;
       const Vec3 a1 = r1 * f.centre + x1;
-      const Vec3 b = ro * o.centre + xo;
+      const Vec3 b0 = ro0 * o.centre + xo0;
+      const Vec3 b1 = ro1 * o.centre + xo1;
       const bool f_leaf = f.child_count == 0;
       const bool o_leaf = o.child_count == 0;
       if (f_leaf && o_leaf) {
-        const double t = leafEntry(nf, no);
+        int axis = 0;
+        double side = 1.0;
+        ++leaf_tests;
+        const double t = leafEntry(nf, no, axis, side);
         if (t >= 0.0 && t < best) {
           best = t;
           hit = true;
+          normal = side * (axis < 3 ? Vec3(r1.col(axis)) : Vec3(ro1.col(axis - 3)));
+          point = 0.5 * (a0 + t * (a1 - a0) + b0 + t * (b1 - b0));
         }
         continue;
       }
-      const double bound = fast.reach[static_cast<std::size_t>(nf)] + other.reach[static_cast<std::size_t>(no)];
-      if (firstTouch(a0 - b, a1 - a0, bound, best) < 0.0) continue;
+      const double bound = first.reach[static_cast<std::size_t>(nf)] + second.reach[static_cast<std::size_t>(no)];
+      if (firstTouch(a0 - b0, (a1 - b1) - (a0 - b0), bound, best) < 0.0) continue;
       // Open the node with the larger reach (a leaf cannot be opened).
-      const bool open_fast = !f_leaf && (o_leaf || fast.reach[static_cast<std::size_t>(nf)] >=
-                                                       other.reach[static_cast<std::size_t>(no)]);
-      if (open_fast) {
+      const bool open_first = !f_leaf && (o_leaf || first.reach[static_cast<std::size_t>(nf)] >=
+                                                       second.reach[static_cast<std::size_t>(no)]);
+      if (open_first) {
         for (std::int32_t c = f.first_child; c < f.first_child + f.child_count; ++c) stack.emplace_back(c, no);
       } else {
         for (std::int32_t c = o.first_child; c < o.first_child + o.child_count; ++c) stack.emplace_back(nf, c);
@@ -116,49 +148,94 @@ struct Sweeper {
   }
 };
 
+bool sweepable(const BodyState& body, const ShapeBounds* shape) {
+  return shape != nullptr && shape->tree != nullptr && !body.is_static;
+}
+
 }  // namespace
 
-SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
+std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vector<Pose>& start,
                            const std::vector<const ShapeBounds*>& shapes, double threshold,
-                           SweepScratch* scratch) {
-  SweepStats stats;
-  SweepScratch local;
-  std::vector<std::pair<std::int32_t, std::int32_t>>& stack = (scratch != nullptr ? *scratch : local).stack;
+                           std::vector<std::uint8_t>& fast) {
+  fast.assign(bodies.size(), 0);
+  std::size_t count = 0;
   for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const ShapeBounds* shape = shapes[i];
+    if (!sweepable(bodies[i], shape)) continue;
+    const Pose& p0 = start[i];
+    const Pose& p1 = bodies[i].pose;
+    const double moved = (p1.position - p0.position).norm() +
+                         p0.orientation.angularDistance(p1.orientation) * shape->bound_radius;
+    if (moved > threshold * shape->min_leaf_radius) {
+      fast[i] = 1;
+      ++count;
+    }
+  }
+  return count;
+}
+
+SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
+                           const std::vector<const ShapeBounds*>& shapes,
+                           const std::vector<std::array<std::uint32_t, 2>>& pairs, std::size_t pair_count,
+                           double threshold, SweepScratch& scratch) {
+  SweepStats stats;
+  scratch.hits.assign(bodies.size(), SweepHit{});
+  scratch.clamped.clear();
+  scratch.clamped.reserve(bodies.size());  // grows with the bodies only
+  if (scratch.fast.size() != bodies.size()) return stats;  // markFastBodies not run on these bodies
+  for (const std::uint8_t f : scratch.fast) stats.fast_bodies += f;
+  if (stats.fast_bodies == 0) return stats;
+  // Every pair sees the end poses of this integration: the result does not
+  // depend on the pair order.
+  // Each pair is swept once, in the relative motion of its two bodies; the hit
+  // holds back whichever of them is fast.
+  for (std::size_t k = 0; k < pair_count; ++k) {
+    const std::uint32_t a = pairs[k][0];
+    const std::uint32_t b = pairs[k][1];
+    if (!scratch.fast[a] && !scratch.fast[b]) continue;
+    if (shapes[a] == nullptr || shapes[a]->tree == nullptr || shapes[b] == nullptr || shapes[b]->tree == nullptr) {
+      continue;
+    }
+    const Pose& p0 = start[a];
+    const Pose& p1 = bodies[a].pose;
+    const Pose& q0 = start[b];
+    const Pose& q1 = bodies[b].pose;
+    // Bodies falling side by side are fast but not towards each other: the
+    // pair is swept only when its relative motion is fast.
+    const double relative = ((p1.position - p0.position) - (q1.position - q0.position)).norm() +
+                            p0.orientation.angularDistance(p1.orientation) * shapes[a]->bound_radius +
+                            q0.orientation.angularDistance(q1.orientation) * shapes[b]->bound_radius;
+    const double finest = std::min(scratch.fast[a] ? shapes[a]->min_leaf_radius : shapes[b]->min_leaf_radius,
+                                   scratch.fast[b] ? shapes[b]->min_leaf_radius : shapes[a]->min_leaf_radius);
+    if (!(relative > threshold * finest)) continue;
+    // Only a hit earlier than a fast body's earliest so far matters.
+    const double latest = std::max(scratch.fast[a] ? scratch.hits[a].t : 0.0, scratch.fast[b] ? scratch.hits[b].t : 0.0);
+    Sweeper s{*shapes[a], *shapes[b], p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(),
+              q0.orientation.toRotationMatrix(), q1.orientation.toRotationMatrix(),
+              p0.position, p1.position, q0.position, q1.position, latest, scratch.stack};
+    ++stats.pairs;
+    const bool found = s.run();
+    stats.leaf_tests += s.leaf_tests;
+    if (!found) continue;
+    for (const std::uint32_t i : {a, b}) {
+      SweepHit& hit = scratch.hits[i];
+      if (!scratch.fast[i] || !(s.best < hit.t)) continue;
+      hit.t = s.best;
+      hit.pair = static_cast<std::uint32_t>(k);
+      hit.point = s.point;
+      hit.normal = s.normal;  // from a (the sweeper's first body) towards b
+    }
+  }
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const double t = scratch.hits[i].t;
+    if (!(t < 1.0)) continue;
     BodyState& body = bodies[i];
-    const ShapeBounds* fast = shapes[i];
-    if (body.is_static || fast == nullptr || fast->tree == nullptr) continue;
     const Pose& p0 = start[i];
     const Pose p1 = body.pose;
-    const double moved = (p1.position - p0.position).norm() +
-                         p0.orientation.angularDistance(p1.orientation) * fast->bound_radius;
-    if (!(moved > threshold * fast->min_leaf_radius)) continue;
-    ++stats.fast_bodies;
-
-    Sweeper sweeper{*fast, *fast, p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(),
-                    Mat3::Identity(), p0.position, p1.position, Vec3::Zero(), 1.0, stack};
-    bool hit = false;
-    for (std::size_t j = 0; j < bodies.size(); ++j) {
-      const ShapeBounds* other = shapes[j];
-      if (j == i || other == nullptr || other->tree == nullptr) continue;
-      const BodyState& o = bodies[j];
-      // Cull: the other body's ball against the fast body's swept ball.
-      if (segmentDistance(o.pose.position, p0.position, p1.position) >
-          fast->bound_radius + other->bound_radius) {
-        continue;
-      }
-      Sweeper s{*fast, *other, sweeper.r0, sweeper.r1, o.pose.orientation.toRotationMatrix(),
-                p0.position, p1.position, o.pose.position, sweeper.best, stack};
-      if (s.run()) {
-        sweeper.best = s.best;
-        hit = true;
-      }
-    }
-    if (!hit) continue;
-    const double t = sweeper.best;
     body.pose.position = p0.position + t * (p1.position - p0.position);
     body.pose.orientation = p0.orientation.slerp(t, p1.orientation).normalized();
     refreshWorldInertia(body);
+    scratch.clamped.push_back(static_cast<std::uint32_t>(i));
     ++stats.clamped;
   }
   return stats;

@@ -255,20 +255,23 @@ TickReport World::step(double dt, const Budget& budget) {
   const auto t1 = Clock::now();
   broadPhase(report);
   const auto t2 = Clock::now();
+  continuousCollision(report);
+  const auto t2s = Clock::now();
   narrowPhase(budget, report);
   const auto t3 = Clock::now();
   response(dt, report);
   const auto t4 = Clock::now();
   report.integrate_s = secondsBetween(t0, t1);
   report.broad_s = secondsBetween(t1, t2);
-  report.narrow_s = secondsBetween(t2, t3);
+  report.sweep_s = secondsBetween(t2, t2s);
+  report.narrow_s = secondsBetween(t2s, t3);
   report.response_s = secondsBetween(t3, t4);
   report.total_s = secondsBetween(t0, t4);
   report.contacts = contacts_.size();
   return report;
 }
 
-// Semi-implicit Euler with a swept test for fast bodies (response.hpp).
+// Semi-implicit Euler; marks the fast bodies (response.hpp).
 void World::integrate(double dt, TickReport& /*report*/) {
   physics_.integrate(bodies_, body_shapes_, [this](ShapeId s) -> const ShapeInfo& { return shapes_[s]; },
                      config_.gravity, config_.response, dt);
@@ -302,15 +305,27 @@ Aabb World::boxOf(std::size_t index) const {
   return box;
 }
 
+// A fast body's box covers its whole path of the tick (the cube that holds it
+// in any orientation, at its start and at its end), so its sweep partners
+// are among its broad-phase pairs.
+Aabb World::sweptBoxOf(std::size_t index) const {
+  const double radius = shapes_[body_shapes_[index]].bounding_radius;
+  const Vec3 start = physics_.startPose(index).position;
+  const Vec3 end = bodies_[index].pose.position;
+  Aabb box;
+  box.min = start.cwiseMin(end) - Vec3::Constant(radius);
+  box.max = start.cwiseMax(end) + Vec3::Constant(radius);
+  return box;
+}
+
 void World::broadPhase(TickReport& report) {
   for (std::size_t i = 0; i < ids_.size(); ++i) {
-    if (!bodies_[i].is_static) broad_phase_.setBox(ids_[i], boxOf(i));
+    if (bodies_[i].is_static) continue;
+    broad_phase_.setBox(ids_[i], physics_.isFast(i) ? sweptBoxOf(i) : boxOf(i));
   }
   broad_phase_.update();
   report.broad_pairs = broad_phase_.pairs().size();
-}
 
-void World::narrowPhase(const Budget& budget, TickReport& report) {
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
   if (pair_tests_.size() < pairs.size()) {  // pool grows only
     pair_tests_.resize(pairs.size());
@@ -330,7 +345,15 @@ void World::narrowPhase(const Budget& budget, TickReport& report) {
     pair_bodies_[pair_count_] = {static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib)};
     ++pair_count_;
   }
+}
 
+// Fast bodies put back at their first contact with a broad-phase partner
+// (response.hpp, sweepFastBodies); the pair tests read the poses when they run.
+void World::continuousCollision(TickReport& /*report*/) {
+  physics_.sweep(bodies_, pair_bodies_, pair_count_, config_.response);
+}
+
+void World::narrowPhase(const Budget& budget, TickReport& report) {
   const bool gaze = perception_.hasFixation();
   BudgetTracker tracker(budget);
   const ScheduleStats stats =

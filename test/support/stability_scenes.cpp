@@ -141,6 +141,30 @@ Scene spinningRod(double spin, double seconds, const ResponseOptions& response) 
   return scene;
 }
 
+Scene newtonsCradle(int count, double seconds, const ResponseOptions& response) {
+  Scene scene;
+  scene.name = "Newton's cradle of " + std::to_string(count);
+  scene.world = makeWorld(Vec3::Zero(), response);
+  scene.steps = static_cast<int>(std::lround(seconds / scene.dt));
+  scene.settle_steps = scene.steps;  // outcome: speeds, not drift
+  World& world = *scene.world;
+  PresetParams params;
+  params.resolution = kCubeVoxels;
+  params.voxel_size = scene.voxel;
+  const ShapeId ball = world.addShape("cradle_ball", makePreset("sphere", params));
+  const double diameter = kCubeVoxels * scene.voxel;
+  for (int k = 0; k < count; ++k) {
+    EntitySpec spec;
+    spec.shape = ball;
+    spec.pose.position = Vec3(diameter * k, 0.0, 0.0);  // touching
+    spec.linear_velocity = Vec3(k == 0 ? 1.0 : 0.0, 0.0, 0.0);
+    spec.material = Material{1.0, 0.0};
+    addMover(world, scene, spec);
+  }
+  scene.speed_bound = 1.1;
+  return scene;
+}
+
 Scene cornerPile(int count, int resolution, double seconds, const Budget& budget,
                  const ResponseOptions& response) {
   Scene scene;

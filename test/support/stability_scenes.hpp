@@ -42,6 +42,10 @@ Scene fastSphere(double speed = 100.0, double seconds = 0.5,
 // at `spin` rad/s about its intermediate axis, slightly perturbed, no gravity.
 Scene spinningRod(double spin = 100.0, double seconds = 10.0,
                   const ResponseOptions& response = ResponseOptions{});
+// `count` touching balls (8 voxels across) in a row along x, restitution 1,
+// friction 0, no gravity; the first one at 1 m/s towards the others.
+Scene newtonsCradle(int count = 5, double seconds = 2.0,
+                    const ResponseOptions& response = ResponseOptions{});
 // The paper's worst case: `count` rocks dropped into one corner of the closed
 // box (scenes.hpp CornerDrift: gravity towards the box's corner).
 Scene cornerPile(int count = 500, int resolution = 4, double seconds = 4.0,

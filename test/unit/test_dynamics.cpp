@@ -384,29 +384,68 @@ TEST(Sweep, AFastSmallBodyIsStoppedAtAThinPlateAndSlowOrSlidingOnesAreNot) {
 
   std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Constant(voxel))};
   std::vector<Pose> start(2);
+  const std::vector<const ShapeBounds*> shapes = {&plate, &ball};
+  const std::vector<std::array<std::uint32_t, 2>> pairs = {{0, 1}};  // the broad phase's pair
+  SweepScratch scratch;
+  const auto sweep = [&] {
+    markFastBodies(bodies, start, shapes, 0.5, scratch.fast);
+    return sweepFastBodies(bodies, start, shapes, pairs, pairs.size(), 0.5, scratch);
+  };
   start[1].position = Vec3(0.01, 0.02, 0.5);
   bodies[1].pose.position = Vec3(0.01, 0.02, -1.0);  // straight through the plate in one tick
-  const std::vector<const ShapeBounds*> shapes = {&plate, &ball};
-  SweepStats stats = sweepFastBodies(bodies, start, shapes, 0.5);
+  SweepStats stats = sweep();
   EXPECT_EQ(stats.fast_bodies, 1u);
   EXPECT_EQ(stats.clamped, 1u);
   const double z = bodies[1].pose.position.z();
   EXPECT_GT(z, 0.025);         // centre still above the plate's top face
   EXPECT_LT(z, 0.05);          // and touching it (ball half + plate half = 1 voxel)
+  ASSERT_EQ(scratch.clamped.size(), 1u);
+  const SweepHit& hit = scratch.hits[1];
+  EXPECT_EQ(hit.pair, 0u);
+  EXPECT_NEAR(hit.normal.z(), 1.0, 1e-12);  // from the plate (pair's first body) up to the ball
+  EXPECT_NEAR(hit.point.z(), 0.5 * z, 1e-12);  // between the two leaves (plate leaf at z = 0)
+
+  // Not among its pairs: never swept against it (the broad phase culls).
+  bodies[1].pose.position = Vec3(0.01, 0.02, -1.0);
+  markFastBodies(bodies, start, shapes, 0.5, scratch.fast);
+  stats = sweepFastBodies(bodies, start, shapes, pairs, 0, 0.5, scratch);
+  EXPECT_EQ(stats.clamped, 0u);
 
   // Slow: moved less than half its smallest leaf radius -> not swept.
   bodies[1].pose.position = Vec3(0.01, 0.02, 0.49);
-  stats = sweepFastBodies(bodies, start, shapes, 0.5);
+  stats = sweep();
   EXPECT_EQ(stats.fast_bodies, 0u);
   EXPECT_NEAR(bodies[1].pose.position.z(), 0.49, 1e-15);
 
   // Sliding fast along the plate while resting on it: nothing to stop.
   start[1].position = Vec3(-0.3, 0.02, 0.05);
   bodies[1].pose.position = Vec3(0.3, 0.02, 0.05);
-  stats = sweepFastBodies(bodies, start, shapes, 0.5);
+  stats = sweep();
   EXPECT_EQ(stats.fast_bodies, 1u);
   EXPECT_EQ(stats.clamped, 0u);
   EXPECT_NEAR(bodies[1].pose.position.x(), 0.3, 1e-15);
+
+  // Grazing: sliding fast and sinking a little into the plate (less than half
+  // a box): the discrete step resolves that, the motion is kept.
+  start[1].position = Vec3(-0.3, 0.02, 0.05);
+  bodies[1].pose.position = Vec3(0.3, 0.02, 0.05 - 0.2 * voxel);
+  stats = sweep();
+  EXPECT_EQ(stats.clamped, 0u);
+  EXPECT_NEAR(bodies[1].pose.position.x(), 0.3, 1e-15);
+
+  // Both moving: the plate (as if movable) moves up to meet a slower ball; the
+  // relative motion passes through, so the ball is held back.
+  bodies[0].is_static = false;
+  start[0].position = Vec3::Zero();
+  bodies[0].pose.position = Vec3(0.0, 0.0, 0.5);
+  start[1].position = Vec3(0.01, 0.02, 0.3);
+  bodies[1].pose.position = Vec3(0.01, 0.02, 0.3 - 0.1 * voxel);
+  markFastBodies(bodies, start, shapes, 0.5, scratch.fast);
+  scratch.fast[0] = 0;  // only the ball is swept
+  scratch.fast[1] = 1;
+  stats = sweepFastBodies(bodies, start, shapes, pairs, pairs.size(), 0.5, scratch);
+  EXPECT_EQ(stats.clamped, 1u);
+  EXPECT_GT(bodies[1].pose.position.z(), 0.3 - 0.1 * voxel);
 }
 
 }  // namespace
