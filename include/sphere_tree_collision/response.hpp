@@ -185,8 +185,9 @@ struct SolveBudget {
 // kinetic energy is added. Contacts' normal_impulse/friction_impulse are
 // filled in. Warm starting matches contacts by entity pair and the contact
 // point in body A's frame (within half the gap bound). Stopped early by the
-// budget, the state is still consistent: every impulse applied is clamped
-// (normal >= 0, friction in its cone) and velocities are what they sum to.
+// budget, the state is as consistent as after a full solve: normal impulses
+// >= 0, friction clamped to the cone as each pass goes, and velocities what
+// the impulses sum to (shock propagation aside: it holds supports still).
 class ContactSolver {
  public:
   SolveStats solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
