@@ -392,24 +392,22 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
   return passes;
 }
 
-// The most iterations (<= cap) whose cost beyond the first fits in
-// seconds_left, costed in passes over the rows at the price of the first
-// velocity pass: each further iteration is one velocity pass, one position
-// pass when any contact needs correcting, and shock propagation gains a pass
-// per two iterations above its minimum of two.
+// The most iterations (<= cap) that fit in seconds_left with everything that
+// follows them, costed in passes over the rows at the price of the first
+// velocity pass: per iteration beyond the first one velocity pass and one
+// position pass (when any contact needs correcting); then shock propagation's
+// max(2, n / 2) passes, and one more for restitution and storing the result.
 int ContactSolver::affordableIterations(const ResponseOptions& options, int cap, double pass_seconds,
                                         double seconds_left) const {
   if (!(pass_seconds > 0.0)) return cap;
   bool corrects = false;
   for (const Row& row : rows_) corrects = corrects || row.push != 0.0;
-  const auto shock_passes = [&](int n) { return options.shock_propagation ? std::max(2, n / 2) : 0; };
+  const auto passes_after_the_first = [&](int n) {
+    const int shock = options.shock_propagation ? std::max(2, n / 2) : 0;
+    return (n - 1) + (corrects ? n : 0) + shock + 1;
+  };
   int n = 1;
-  while (n < cap) {
-    const int next = n + 1;
-    const double passes = (next - 1) * (corrects ? 2.0 : 1.0) + (shock_passes(next) - shock_passes(1));
-    if (passes * pass_seconds > seconds_left) break;
-    n = next;
-  }
+  while (n < cap && passes_after_the_first(n + 1) * pass_seconds <= seconds_left) ++n;
   return n;
 }
 

@@ -10,8 +10,8 @@ namespace stc {
 namespace {
 
 // The reserve for what follows the narrow phase forgets a cost spike by this
-// factor a tick: it follows rises at once and falls over a few dozen ticks.
-constexpr double kReserveDecay = 0.9;
+// factor a tick: it follows rises at once and halves in about 14 ticks.
+constexpr double kReserveDecay = 0.95;
 
 // A unit quaternion may be off by this much before normalisation; more means
 // the caller passed something that is not a rotation.
