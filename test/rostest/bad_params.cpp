@@ -103,7 +103,7 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
 
 TEST(BadParams, AGoodSetKeepsRunning) {
   const Case good{"collision_world_node",
-                  {{"rate", 30}, {"scheduler", "round_robin"}, {"marker_levels", list({0, 3})},
+                  {{"rate", 30}, {"scheduler", "round_robin"}, {"marker_levels", list({0, 3})}, {"tick_budget", 16.7},
                    {"camera_position", list({0, -3, 1})}, {"camera_look_at", list({0, 0, 0.5})}},
                   ""};
   const auto [status, output] = run(good, 1000, 3.0);
