@@ -1,67 +1,90 @@
-// Budget: what ends the narrow phase of one tick. A wall-clock deadline, a
-// count of sphere-sphere tests (deterministic: tests and benchmarks), or both.
+// Budget: what one tick may spend. The narrow phase is interruptible by a
+// wall-clock limit or a count of sphere-sphere tests (deterministic: tests and
+// benchmarks); the whole tick (integrate, broad phase, narrow phase, response)
+// by a tick deadline; the response's solver by a count of iterations. Any
+// combination; the first limit reached wins.
 #pragma once
 
-#include <chrono>
 #include <cstdint>
+#include <functional>
 #include <limits>
 
 namespace stc {
 
 struct Budget {
-  double seconds = std::numeric_limits<double>::infinity();
+  double seconds = std::numeric_limits<double>::infinity();       // narrow phase alone
   std::int64_t sphere_tests = std::numeric_limits<std::int64_t>::max();
+  // Whole tick. The narrow phase gets what integrate and the broad phase
+  // leave, less a reserve for the response's mandatory part; the solver
+  // refines while time remains (World::step).
+  double tick_seconds = std::numeric_limits<double>::infinity();
+  // Velocity (and as many position) iterations of the solver; at least one
+  // of each always runs. The deterministic form of the response's share.
+  int solver_iterations = std::numeric_limits<int>::max();
 
   static Budget unlimited() { return Budget{}; }
   static Budget ofSeconds(double s) { Budget b; b.seconds = s; return b; }
   static Budget ofSphereTests(std::int64_t n) { Budget b; b.sphere_tests = n; return b; }
+  static Budget ofTickSeconds(double s) { Budget b; b.tick_seconds = s; return b; }
+  static Budget ofSolverIterations(int n) { Budget b; b.solver_iterations = n; return b; }
 };
 
-// Tracks one tick's spending against a Budget. The clock is read at most once
-// per `check_every` charged tests so the check stays cheap (a clock read costs
-// tens of ns, as much as several sphere tests): a wall-clock deadline is seen
-// at most `check_every` tests (plus the step in progress) late. The first
-// check always reads the clock.
+// Monotonic seconds. The World reads time only through one of these, so a
+// test can replace it with a fake clock and make a time budget deterministic.
+using SecondsClock = std::function<double()>;
+double steadySeconds();  // std::chrono::steady_clock
+
+// A time a phase must end by, on a clock (nullptr: the steady clock).
+class Deadline {
+ public:
+  Deadline() = default;  // never
+  Deadline(const SecondsClock* clock, double at) : clock_(clock), at_(at) {}
+
+  bool isSet() const { return at_ < std::numeric_limits<double>::infinity(); }
+  double at() const { return at_; }
+  double now() const { return clock_ != nullptr ? (*clock_)() : steadySeconds(); }
+  // Seconds left (negative once passed); infinity when not set (no clock read).
+  double remaining() const { return isSet() ? at_ - now() : std::numeric_limits<double>::infinity(); }
+  bool passed() const { return isSet() && now() >= at_; }
+
+ private:
+  const SecondsClock* clock_ = nullptr;
+  double at_ = std::numeric_limits<double>::infinity();
+};
+
+// Tracks the narrow phase's spending against a sphere-test count and a
+// deadline. The clock is read at most once per `check_every` charged tests so
+// the check stays cheap (a clock read costs tens of ns, as much as several
+// sphere tests): a deadline is seen at most `check_every` tests (plus the step
+// in progress) late. The first check always reads the clock.
 class BudgetTracker {
  public:
-  using Clock = std::chrono::steady_clock;
   static constexpr std::int64_t kDefaultCheckEvery = 32;
 
-  explicit BudgetTracker(const Budget& budget, std::int64_t check_every = kDefaultCheckEvery)
-      : budget_(budget), start_(Clock::now()),
-        timed_(budget.seconds < std::numeric_limits<double>::infinity()),
-        check_every_(check_every > 0 ? check_every : 1) {
-    if (timed_) {
-      deadline_ = start_ + std::chrono::duration_cast<Clock::duration>(
-                               std::chrono::duration<double>(budget.seconds > 0 ? budget.seconds : 0.0));
-    }
-  }
+  // The narrow phase alone: budget.seconds from now on the steady clock.
+  explicit BudgetTracker(const Budget& budget, std::int64_t check_every = kDefaultCheckEvery);
+  BudgetTracker(std::int64_t sphere_tests, const Deadline& deadline,
+                std::int64_t check_every = kDefaultCheckEvery)
+      : sphere_tests_(sphere_tests), deadline_(deadline), check_every_(check_every > 0 ? check_every : 1) {}
 
   void charge(std::int64_t sphere_tests) { spent_tests_ += sphere_tests; }
   std::int64_t spentTests() const { return spent_tests_; }
 
   // True once the test count or the deadline is reached. Once true, stays true.
   bool exhausted() {
-    if (spent_tests_ >= budget_.sphere_tests) return true;
-    if (!timed_) return false;
+    if (spent_tests_ >= sphere_tests_) return true;
+    if (!deadline_.isSet()) return false;
     if (expired_) return true;
-    if (budget_.seconds <= 0.0) return expired_ = true;
     if (spent_tests_ < next_clock_check_) return false;
     next_clock_check_ = spent_tests_ + check_every_;
-    return expired_ = Clock::now() >= deadline_;
+    return expired_ = deadline_.passed();
   }
-  double elapsedSeconds() const {
-    return std::chrono::duration<double>(Clock::now() - start_).count();
-  }
-  const Budget& budget() const { return budget_; }
 
  private:
-  Budget budget_;
-  Clock::time_point start_;
-  Clock::time_point deadline_{};
-  bool timed_ = false;
+  std::int64_t sphere_tests_;
+  Deadline deadline_;
   bool expired_ = false;
-  std::int64_t check_every_ = kDefaultCheckEvery;
+  std::int64_t check_every_;
   std::int64_t next_clock_check_ = 0;
   std::int64_t spent_tests_ = 0;
 };

@@ -11,6 +11,7 @@
 #pragma once
 
 #include "sphere_tree_collision/body.hpp"
+#include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
 #include "sphere_tree_collision/dynamics.hpp"
 #include "sphere_tree_collision/pair_test.hpp"
@@ -19,6 +20,7 @@
 #include <algorithm>
 #include <array>
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -155,6 +157,20 @@ struct SolveStats {
   std::size_t warm_started = 0;     // contacts that found last tick's impulse
   std::size_t bounced = 0;          // contacts that got a restitution impulse
   double max_penetration = 0.0;     // max(-separation) over the contacts, metres
+  int velocity_passes = 0;          // velocity iterations run (>= 1 with contacts)
+  int position_passes = 0;          // split-impulse iterations run (>= 1 with penetration)
+  double refinement_seconds = 0.0;  // spent in the iterations a deadline may cut (set with one)
+};
+
+// What the tick lets the solver spend: the response is refineable (paper 3.5
+// and 4: a lower level of response to fall back on). The warm start, the
+// first velocity iteration and the first position iteration always run; more
+// only up to max_iterations (and ResponseOptions::iterations), and, with a
+// deadline, only while the solver's estimate of their cost (its first
+// velocity pass, timed) fits before it.
+struct SolveBudget {
+  int max_iterations = std::numeric_limits<int>::max();
+  Deadline deadline;
 };
 
 // Velocity solve: non-penetration (speculative: a contact with a gap s > 0
@@ -169,11 +185,14 @@ struct SolveStats {
 // bodies out of penetration beyond the slop and are then discarded, so no
 // kinetic energy is added. Contacts' normal_impulse/friction_impulse are
 // filled in. Warm starting matches contacts by entity pair and the contact
-// point in body A's frame (within half the gap bound).
+// point in body A's frame (within half the gap bound). Stopped early by the
+// budget, the state is as consistent as after a full solve: normal impulses
+// >= 0, friction clamped to the cone as each pass goes, and velocities what
+// the impulses sum to (shock propagation aside: it holds supports still).
 class ContactSolver {
  public:
   SolveStats solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
-                   const ResponseOptions& options, double dt);
+                   const ResponseOptions& options, double dt, const SolveBudget& budget = SolveBudget{});
   void forget() { cache_.clear(); }  // drop warm-start impulses
 
  private:
@@ -213,10 +232,12 @@ class ContactSolver {
                  SolveStats& stats);
   void commitJacobi(std::vector<Vec3>& v, std::vector<Vec3>& w);
   static void applyNormal(const Row& row, double impulse, std::vector<Vec3>& v, std::vector<Vec3>& w);
-  void solveVelocities(const ResponseOptions& options);
+  void solveVelocities(const ResponseOptions& options, int passes);
+  int affordableIterations(const ResponseOptions& options, int cap, double pass_seconds,
+                           double seconds_left) const;
   void propagateShock(const ResponseOptions& options);
   void applyRestitution(const ResponseOptions& options, SolveStats& stats);
-  void solvePositions(const ResponseOptions& options);
+  int solvePositions(const ResponseOptions& options, const Deadline& deadline);
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
 
   std::vector<Row> rows_, sorted_rows_;
@@ -320,13 +341,14 @@ class Physics {
              std::size_t count, const ResponseOptions& options);
   // Tick phase 4: contacts of tests[0..count) (pair_bodies: dense indices of
   // each test's bodies; the same pairs the sweep saw), plus the sweep's hit
-  // for a pair whose test gave no contact, then impulses when options.enabled.
+  // for a pair whose test gave no contact, then impulses when options.enabled,
+  // within `budget`.
   void respond(const std::vector<PairTest>& tests, std::size_t count,
                const std::vector<std::array<std::uint32_t, 2>>& pair_bodies,
                const std::vector<double>& priorities, bool accept_unresolved,
                const std::vector<std::uint32_t>& body_shapes, const ShapeOf& shape_of,
                std::vector<BodyState>& bodies, const ResponseOptions& options, double dt,
-               std::vector<Contact>& contacts);
+               std::vector<Contact>& contacts, const SolveBudget& budget = SolveBudget{});
   const PhysicsReport& lastReport() const { return report_; }
   void forget() { solver_.forget(); }
 

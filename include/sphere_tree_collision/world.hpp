@@ -16,6 +16,7 @@
 
 #include <array>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -58,9 +59,23 @@ struct EntitySpec {
 };
 
 struct TickReport {
-  // Phase wall times, seconds.
+  // Phase wall times, seconds (on the World's clock, see World::setClock).
   double integrate_s = 0.0, broad_s = 0.0, narrow_s = 0.0, response_s = 0.0, total_s = 0.0;
   double sweep_s = 0.0;  // continuous collision of fast bodies, between broad and narrow phase
+  // What each phase got of the budget. Integrate and the broad phase cannot be
+  // interrupted: they get what they use. The narrow phase gets Budget::seconds
+  // or what the tick budget leaves after them and the reserve, whichever is
+  // less; the response gets the rest of the tick (infinity: no limit).
+  double tick_budget_s = std::numeric_limits<double>::infinity();
+  double narrow_budget_s = std::numeric_limits<double>::infinity();
+  double response_budget_s = std::numeric_limits<double>::infinity();
+  // Kept back from the narrow phase (with a tick budget) for what cannot be
+  // cut after it: its own accounting and the response's mandatory part (the
+  // largest such cost of recent ticks).
+  double reserve_s = 0.0;
+  double response_refinement_s = 0.0;  // of response_s: iterations the deadline could have cut
+  int velocity_passes = 0;             // solver iterations run (>= 1 with contacts)
+  int position_passes = 0;             // split-impulse iterations run (>= 1 with penetration)
   double scheduling_overhead_s = 0.0;  // part of narrow_s spent deciding, not testing
   std::size_t entities = 0;
   std::size_t broad_pairs = 0;
@@ -109,6 +124,9 @@ class World {
   void clear();  // removes every entity, keeps shapes
 
   TickReport step(double dt, const Budget& budget);
+  // Time source of step(): phase times and deadlines (default steadySeconds).
+  // A fake clock makes time budgets deterministic in tests.
+  void setClock(SecondsClock clock) { clock_ = std::move(clock); }
 
   Perception& perception() { return perception_; }
   const Perception& perception() const { return perception_; }
@@ -138,8 +156,9 @@ class World {
   void integrate(double dt, TickReport& report);
   void broadPhase(TickReport& report);   // also sets up the pair tests of its pairs
   void continuousCollision(TickReport& report);
-  void narrowPhase(const Budget& budget, TickReport& report);
-  void response(double dt, TickReport& report);
+  // Returns the clock when the scheduler stopped (what follows is not interruptible).
+  double narrowPhase(const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
+  void response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report);
   Aabb boxOf(std::size_t index) const;
   Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
@@ -170,6 +189,8 @@ class World {
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
   std::vector<Contact> contacts_;
   Physics physics_;  // integration and response (response.hpp), warm-start state
+  SecondsClock clock_ = steadySeconds;
+  double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
 };
 
 }  // namespace stc

@@ -59,7 +59,7 @@ void Physics::respond(const std::vector<PairTest>& tests, std::size_t count,
                       const std::vector<double>& priorities, bool accept_unresolved,
                       const std::vector<std::uint32_t>& body_shapes, const ShapeOf& shape_of,
                       std::vector<BodyState>& bodies, const ResponseOptions& options, double dt,
-                      std::vector<Contact>& contacts) {
+                      std::vector<Contact>& contacts, const SolveBudget& budget) {
   contacts.clear();
   ContactBuildOptions build;
   build.max_contacts_per_pair = options.max_contacts_per_pair;
@@ -98,7 +98,7 @@ void Physics::respond(const std::vector<PairTest>& tests, std::size_t count,
   if (!options.enabled) return;
   ResponseOptions solve = options;
   solve.restitution_threshold = std::max(options.restitution_threshold, kRestingFallTicks * gravity_speed_);
-  report_.solve = solver_.solve(bodies, contacts, solve, dt);
+  report_.solve = solver_.solve(bodies, contacts, solve, dt, budget);
 }
 
 }  // namespace stc

@@ -298,11 +298,11 @@ void ContactSolver::applyNormal(const Row& row, double impulse, std::vector<Vec3
   w[row.b] += impulse * row.ang_b[0];
 }
 
-void ContactSolver::solveVelocities(const ResponseOptions& options) {
+void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) {
   const bool jacobi = options.solver == SolverKind::Jacobi;
   std::vector<Vec3>& out_v = jacobi ? dv_ : v_;
   std::vector<Vec3>& out_w = jacobi ? dw_ : w_;
-  for (int it = 0; it < options.iterations; ++it) {
+  for (int it = 0; it < passes; ++it) {
     for (Row& row : rows_) {
       // Friction first, bounded by the normal impulse so far (Box2D order).
       Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
@@ -367,14 +367,18 @@ void ContactSolver::applyRestitution(const ResponseOptions& options, SolveStats&
   }
 }
 
-void ContactSolver::solvePositions(const ResponseOptions& options) {
+// Returns the passes run: options.iterations, fewer when the deadline
+// passes first (never fewer than one when anything needs correcting).
+int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline& deadline) {
   bool any = false;
   for (const Row& row : rows_) any = any || row.push > 0.0 || (row.bounced && row.push < 0.0);
-  if (!any) return;
+  if (!any) return 0;
   const bool jacobi = options.solver == SolverKind::Jacobi;
   std::vector<Vec3>& out_v = jacobi ? dv_ : pv_;
   std::vector<Vec3>& out_w = jacobi ? dw_ : pw_;
-  for (int it = 0; it < options.iterations; ++it) {
+  int passes = 0;
+  for (int it = 0; it < options.iterations; ++it, ++passes) {
+    if (it > 0 && deadline.passed()) break;
     for (Row& row : rows_) {
       const Vec3 vrel =
           pv_[row.b] + pw_[row.b].cross(row.rb) - pv_[row.a] - pw_[row.a].cross(row.ra);
@@ -389,6 +393,26 @@ void ContactSolver::solvePositions(const ResponseOptions& options) {
     }
     if (jacobi) commitJacobi(pv_, pw_);
   }
+  return passes;
+}
+
+// The most iterations (<= cap) that fit in seconds_left with everything that
+// follows them, costed in passes over the rows at the price of the first
+// velocity pass: per iteration beyond the first one velocity pass and one
+// position pass (when any contact needs correcting); then shock propagation's
+// max(2, n / 2) passes, and one more for restitution and storing the result.
+int ContactSolver::affordableIterations(const ResponseOptions& options, int cap, double pass_seconds,
+                                        double seconds_left) const {
+  if (!(pass_seconds > 0.0)) return cap;
+  bool corrects = false;
+  for (const Row& row : rows_) corrects = corrects || row.push != 0.0;
+  const auto passes_after_the_first = [&](int n) {
+    const int shock = options.shock_propagation ? std::max(2, n / 2) : 0;
+    return (n - 1) + (corrects ? n : 0) + shock + 1;
+  };
+  int n = 1;
+  while (n < cap && passes_after_the_first(n + 1) * pass_seconds <= seconds_left) ++n;
+  return n;
 }
 
 void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
@@ -429,7 +453,7 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
 }
 
 SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
-                                const ResponseOptions& options, double dt) {
+                                const ResponseOptions& options, double dt, const SolveBudget& budget) {
   SolveStats stats;
   if (!(dt > 0.0) || bodies.empty()) return stats;
   for (Contact& c : contacts) {
@@ -442,13 +466,33 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
     return stats;
   }
   if (options.warm_starting) warmStart(contacts, bodies, stats);
-  solveVelocities(options);
+  // Refineable: the first velocity pass always runs; timed, it prices the
+  // further iterations against the deadline. `run` carries the iterations
+  // afforded to every later stage.
+  const Deadline& deadline = budget.deadline;
+  ResponseOptions run = options;
+  run.iterations = std::max(1, std::min(options.iterations, budget.max_iterations));
+  const double t_first = deadline.isSet() ? deadline.now() : 0.0;
+  solveVelocities(run, 1);
+  const double t_more = deadline.isSet() ? deadline.now() : 0.0;
+  if (deadline.isSet()) {
+    run.iterations = affordableIterations(run, run.iterations, t_more - t_first, deadline.at() - t_more);
+  }
+  solveVelocities(run, run.iterations - 1);
+  stats.velocity_passes = run.iterations;
+  const double t_rest = deadline.isSet() ? deadline.now() : 0.0;
   const bool jacobi = options.solver == SolverKind::Jacobi;
   if (jacobi) for (Row& row : rows_) row.lambda_main = row.lambda[0];
-  if (options.shock_propagation) propagateShock(options);
+  if (options.shock_propagation) propagateShock(run);
   if (!jacobi) for (Row& row : rows_) row.lambda_main = row.lambda[0];
-  applyRestitution(options, stats);
-  solvePositions(options);
+  applyRestitution(run, stats);
+  const double t_positions = deadline.isSet() ? deadline.now() : 0.0;
+  stats.position_passes = solvePositions(run, deadline);
+  if (deadline.isSet()) {
+    const double positions = deadline.now() - t_positions;
+    const int extra = std::max(0, stats.position_passes - 1);
+    stats.refinement_seconds = (t_rest - t_more) + positions * extra / std::max(1, stats.position_passes);
+  }
   store(bodies, contacts, dt);
   if (!options.warm_starting) cache_.clear();
   return stats;

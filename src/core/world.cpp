@@ -2,7 +2,6 @@
 #include "sphere_tree_collision/world.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -10,11 +9,9 @@
 namespace stc {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsBetween(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
+// The reserve for what follows the narrow phase forgets a cost spike by this
+// factor a tick: it follows rises at once and halves in about 14 ticks.
+constexpr double kReserveDecay = 0.95;
 
 // A unit quaternion may be off by this much before normalisation; more means
 // the caller passed something that is not a rotation.
@@ -250,24 +247,29 @@ TickReport World::step(double dt, const Budget& budget) {
   if (!(std::isfinite(dt) && dt >= 0.0)) throw InputError("dt", "must be finite and >= 0");
   TickReport report;
   report.entities = ids_.size();
-  const auto t0 = Clock::now();
+  const double t0 = clock_();
+  const bool timed_tick = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
+  const Deadline tick_end = timed_tick ? Deadline(&clock_, t0 + std::max(budget.tick_seconds, 0.0)) : Deadline();
+  if (timed_tick) report.tick_budget_s = std::max(budget.tick_seconds, 0.0);
   integrate(dt, report);
-  const auto t1 = Clock::now();
+  const double t1 = clock_();
   broadPhase(report);
-  const auto t2 = Clock::now();
+  const double t2 = clock_();
   continuousCollision(report);
-  const auto t2s = Clock::now();
-  narrowPhase(budget, report);
-  const auto t3 = Clock::now();
-  response(dt, report);
-  const auto t4 = Clock::now();
-  report.integrate_s = secondsBetween(t0, t1);
-  report.broad_s = secondsBetween(t1, t2);
-  report.sweep_s = secondsBetween(t2, t2s);
-  report.narrow_s = secondsBetween(t2s, t3);
-  report.response_s = secondsBetween(t3, t4);
-  report.total_s = secondsBetween(t0, t4);
+  const double t2s = clock_();
+  const double scheduled = narrowPhase(budget, tick_end, t2s, report);
+  const double t3 = clock_();
+  if (timed_tick) report.response_budget_s = std::max(tick_end.at() - t3, 0.0);
+  response(dt, budget, tick_end, report);
+  const double t4 = clock_();
+  report.integrate_s = t1 - t0;
+  report.broad_s = t2 - t1;
+  report.sweep_s = t2s - t2;
+  report.narrow_s = t3 - t2s;
+  report.response_s = t4 - t3;
+  report.total_s = t4 - t0;
   report.contacts = contacts_.size();
+  reserve_s_ = std::max(t4 - scheduled - report.response_refinement_s, kReserveDecay * reserve_s_);
   return report;
 }
 
@@ -353,11 +355,21 @@ void World::continuousCollision(TickReport& /*report*/) {
   physics_.sweep(bodies_, pair_bodies_, pair_count_, config_.response);
 }
 
-void World::narrowPhase(const Budget& budget, TickReport& report) {
+double World::narrowPhase(const Budget& budget, const Deadline& tick_end, double start,
+                          TickReport& report) {
+  // Its own limit, or what the tick leaves after the reserve for what follows.
+  double end = std::numeric_limits<double>::infinity();
+  if (budget.seconds < end) end = start + budget.seconds;
+  if (tick_end.isSet()) {
+    report.reserve_s = reserve_s_;
+    end = std::min(end, tick_end.at() - reserve_s_);
+  }
+  if (end < std::numeric_limits<double>::infinity()) report.narrow_budget_s = std::max(end - start, 0.0);
   const bool gaze = perception_.hasFixation();
-  BudgetTracker tracker(budget);
+  BudgetTracker tracker(budget.sphere_tests, Deadline(&clock_, end));
   const ScheduleStats stats =
       scheduler_->run(pair_tests_, pair_count_, gaze ? &perception_ : nullptr, tracker);
+  const double scheduled = clock_();
   report.sphere_tests = stats.sphere_tests;
   report.interrupted = stats.interrupted;
   report.scheduling_overhead_s = stats.overhead_seconds;
@@ -386,15 +398,24 @@ void World::narrowPhase(const Budget& budget, TickReport& report) {
       if (accepted_unresolved) report.perceived_inaccuracy += pair_priority_[i];
     }
   }
+  return scheduled;
 }
 
 // Contacts from the deepest sphere pairs of each colliding or accepted pair,
-// then impulses and position correction (response.hpp).
-void World::response(double dt, TickReport& /*report*/) {
+// then impulses and position correction (response.hpp), refined until the
+// tick's deadline or the iteration budget.
+void World::response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report) {
+  SolveBudget solve;
+  solve.max_iterations = budget.solver_iterations;
+  solve.deadline = tick_end;
   physics_.respond(pair_tests_, pair_count_, pair_bodies_, pair_priority_,
                    config_.unresolved_policy == UnresolvedPolicy::Accept, body_shapes_,
                    [this](ShapeId s) -> const ShapeInfo& { return shapes_[s]; }, bodies_,
-                   config_.response, dt, contacts_);
+                   config_.response, dt, contacts_, solve);
+  const SolveStats& stats = physics_.lastReport().solve;
+  report.velocity_passes = stats.velocity_passes;
+  report.position_passes = stats.position_passes;
+  report.response_refinement_s = stats.refinement_seconds;
 }
 
 }  // namespace stc

@@ -16,7 +16,7 @@ using stc::InputError;
 const std::set<std::string>& knownParams() {
   static const std::set<std::string> kNames{
       "scene", "scene_entities", "scene_seed", "entity_size", "world_frame", "rate", "marker_rate", "marker_levels", "marker_mode", "marker_keyframe_period", "show_voxels", "static_tree_markers", "publish_tf",
-      "max_contact_markers", "contact_marker_size", "detection_budget", "sphere_test_budget", "scheduler", "queue_count", "queue_ratio",
+      "max_contact_markers", "contact_marker_size", "detection_budget", "sphere_test_budget", "tick_budget", "scheduler", "queue_count", "queue_ratio",
       "unresolved_policy", "max_entities", "max_voxels", "tree_levels", "sphere_fit", "gravity",
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y"};
@@ -39,6 +39,7 @@ stc::Budget NodeParams::budget() const {
   stc::Budget b;
   if (detection_budget_ms >= 0.0) b.seconds = detection_budget_ms * 1e-3;
   if (sphere_test_budget >= 0) b.sphere_tests = sphere_test_budget;
+  if (tick_budget_ms > 0.0) b.tick_seconds = tick_budget_ms * 1e-3;
   return b;
 }
 
@@ -61,10 +62,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   readParam(nh, "show_voxels", p.show_voxels);
   readParam(nh, "static_tree_markers", p.static_tree_markers);
   readParam(nh, "publish_tf", p.publish_tf);
-  readParam(nh, "marker_keyframe_period", p.marker_keyframe_period);
-  if (!(p.marker_keyframe_period >= 0.0) || !std::isfinite(p.marker_keyframe_period)) {
-    throw InputError("marker_keyframe_period", "must be finite and >= 0");
-  }
+  p.marker_keyframe_period = nonNegativeParam(nh, "marker_keyframe_period", p.marker_keyframe_period);
   std::string mode = "auto";
   readParam(nh, "marker_mode", mode);
   if (mode == "full" || (mode == "auto" && !p.publish_tf)) {
@@ -83,6 +81,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   int sphere_tests = -1;
   if (readParam(nh, "sphere_test_budget", sphere_tests)) p.sphere_test_budget = sphere_tests;
   if (p.sphere_test_budget < -1) throw InputError("sphere_test_budget", "must be >= 0, or -1 for none");
+  p.tick_budget_ms = nonNegativeParam(nh, "tick_budget", p.tick_budget_ms);
 
   std::string name = "priority_queues";
   readParam(nh, "scheduler", name);

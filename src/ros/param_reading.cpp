@@ -11,6 +11,12 @@ double positiveParam(const ros::NodeHandle& nh, const std::string& name, double 
   return value;
 }
 
+double nonNegativeParam(const ros::NodeHandle& nh, const std::string& name, double fallback) {
+  const double value = paramOr(nh, name, fallback);
+  if (!(value >= 0.0) || !std::isfinite(value)) throw stc::InputError(name, "must be finite and >= 0");
+  return value;
+}
+
 int intParamIn(const ros::NodeHandle& nh, const std::string& name, int fallback, int lo, int hi) {
   const int value = paramOr(nh, name, fallback);
   if (value < lo || value > hi) {

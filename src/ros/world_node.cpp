@@ -106,11 +106,13 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   // each array shows the state of one tick and carries that tick's stamp.
   ticks_per_marker_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(params_.rate / params_.marker_rate)));
   tick_timer_ = nh_.createSteadyTimer(ros::WallDuration(dt_), [this](const ros::SteadyTimerEvent&) { tick(); });
-  ROS_INFO("collision_world_node: %zu entities from %s, %.1f Hz, scheduler %s, budget %s ms / %s sphere tests",
+  ROS_INFO("collision_world_node: %zu entities from %s, %.1f Hz, scheduler %s, budget %s ms / %s sphere tests, "
+           "tick budget %s ms",
            world_.entityCount(), params_.scene.empty() ? "the default scene" : params_.scene.c_str(),
            params_.rate, stc::toString(params_.world.scheduler.kind),
            params_.detection_budget_ms < 0 ? "none" : std::to_string(params_.detection_budget_ms).c_str(),
-           params_.sphere_test_budget < 0 ? "no limit" : std::to_string(params_.sphere_test_budget).c_str());
+           params_.sphere_test_budget < 0 ? "no limit" : std::to_string(params_.sphere_test_budget).c_str(),
+           params_.tick_budget_ms > 0 ? std::to_string(params_.tick_budget_ms).c_str() : "none");
 }
 
 void WorldNode::remember(stc::EntityId id, const std::string& name, const std::optional<Rgba>& color) {
@@ -238,6 +240,12 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.geometric_bound = r.geometric_bound;
   s.perceived_inaccuracy = r.perceived_inaccuracy;
   s.contacts = static_cast<std::uint32_t>(r.contacts);
+  s.tick_budget_ms = r.tick_budget_s * 1e3;
+  s.narrow_budget_ms = r.narrow_budget_s * 1e3;
+  s.response_budget_ms = r.response_budget_s * 1e3;
+  s.reserve_ms = r.reserve_s * 1e3;
+  s.velocity_passes = static_cast<std::uint32_t>(r.velocity_passes);
+  s.position_passes = static_cast<std::uint32_t>(r.position_passes);
   s.rejected_spawn = rejected_[0];
   s.rejected_despawn = rejected_[1];
   s.rejected_gaze = rejected_[2];

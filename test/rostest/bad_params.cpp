@@ -72,6 +72,8 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"scheduler", "fifo"}}, "scheduler"},
       {world, {{"unresolved_policy", "maybe"}}, "unresolved_policy"},
       {world, {{"sphere_test_budget", -5}}, "sphere_test_budget"},
+      {world, {{"tick_budget", -16.7}}, "tick_budget"},
+      {world, {{"tick_budget", "fast"}}, "tick_budget"},
       {world, {{"marker_levels", list({1, 9})}}, "marker_levels"},
       {world, {{"camera_position", list({1, 2, 3})}, {"camera_look_at", list({1, 2, 3})}}, "camera_look_at"},
       {world, {{"camera_fov_y", 200.0}}, "camera_fov_y"},
@@ -101,7 +103,7 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
 
 TEST(BadParams, AGoodSetKeepsRunning) {
   const Case good{"collision_world_node",
-                  {{"rate", 30}, {"scheduler", "round_robin"}, {"marker_levels", list({0, 3})},
+                  {{"rate", 30}, {"scheduler", "round_robin"}, {"marker_levels", list({0, 3})}, {"tick_budget", 16.7},
                    {"camera_position", list({0, -3, 1})}, {"camera_look_at", list({0, 0, 0.5})}},
                   ""};
   const auto [status, output] = run(good, 1000, 3.0);

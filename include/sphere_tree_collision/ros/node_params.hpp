@@ -44,6 +44,7 @@ struct NodeParams {
   double contact_marker_size = 0.04;  // m
   double detection_budget_ms = 8.0;  // < 0: none
   std::int64_t sphere_test_budget = -1;  // < 0: none
+  double tick_budget_ms = 0.0;       // whole tick (integrate .. response); 0: none
   double gaze_timeout = 0.5;         // s
   std::uint32_t default_resolution = 8;  // spawn messages with resolution 0
   std::optional<stc::Vec3> gravity;  // overrides the scene's

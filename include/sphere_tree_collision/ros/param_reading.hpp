@@ -27,6 +27,8 @@ T paramOr(const ros::NodeHandle& nh, const std::string& name, T fallback) {
 
 // Finite and > 0.
 double positiveParam(const ros::NodeHandle& nh, const std::string& name, double fallback);
+// Finite and >= 0.
+double nonNegativeParam(const ros::NodeHandle& nh, const std::string& name, double fallback);
 // In [lo, hi].
 int intParamIn(const ros::NodeHandle& nh, const std::string& name, int fallback, int lo, int hi);
 // A list of three finite numbers, when set.
