@@ -15,6 +15,7 @@
 //                                [--markdown FILE]
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "tick_clock.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -27,23 +28,10 @@
 namespace {
 
 using namespace stc;
-
-// Thread CPU time: immune to the process being descheduled on a shared
-// machine, which wall time is not (the budget itself is wall time).
-double cpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const double pos = p * static_cast<double>(v.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(pos));
-  const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
+using stc_bench::percentile;
+// Thread CPU time beside the wall time: immune to the process being
+// descheduled on a shared machine (the budget itself is wall time).
+using stc_bench::threadCpuSeconds;
 
 struct Run {
   std::vector<double> total, narrow, nonint, overshoot, cpu;
@@ -68,9 +56,9 @@ Run simulate(const SceneParams& params, double seconds, const Budget& budget) {
   const bool timed = std::isfinite(budget.seconds);
   for (int i = 0; i < ticks; ++i) {
     world.perception().setFixation(gaze.fixationAt(i * spec.dt, world));
-    const double c0 = cpuSeconds();
+    const double c0 = threadCpuSeconds();
     const TickReport r = world.step(spec.dt, budget);
-    run.cpu.push_back(cpuSeconds() - c0);
+    run.cpu.push_back(threadCpuSeconds() - c0);
     run.total.push_back(r.total_s);
     run.narrow.push_back(r.narrow_s);
     run.nonint.push_back(r.total_s - r.narrow_s);
