@@ -20,6 +20,7 @@
 // Usage: bench_load [--quick] [--markdown FILE]
 #include "fcl_mesh.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "tick_clock.hpp"
 
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/narrowphase/collision_object.h>
@@ -50,11 +51,7 @@ constexpr double kRockSize = 0.4;  // m: largest extent (8 voxels of 5 cm)
 
 double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-double threadCpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
+using stc_bench::threadCpuSeconds;
 
 double residentBytes() {
   std::ifstream statm("/proc/self/statm");

@@ -21,6 +21,7 @@
 #include "fcl_mesh.hpp"
 #include "pose_sampling.hpp"
 #include "sphere_tree_collision/pair_test.hpp"
+#include "tick_clock.hpp"
 
 #include <fcl/narrowphase/collision.h>
 
@@ -39,11 +40,7 @@ namespace {
 
 using namespace stc;
 
-double cpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
+using stc_bench::threadCpuSeconds;
 
 struct Shape {
   std::string name;
@@ -127,7 +124,7 @@ struct Result {
 // PairTests over poses [begin, end) of the set; returns CPU seconds.
 double timeOurs(const Shape& A, const Shape& B, const PoseSet& set, std::size_t begin, std::size_t end,
                 PairTest& test, std::vector<char>& colliding, std::int64_t& tests, std::int64_t& steps) {
-  const double t0 = cpuSeconds();
+  const double t0 = threadCpuSeconds();
   for (std::size_t i = begin; i < end; ++i) {
     test.reset(PairBody{0, &A.tree, &set.a[i]}, PairBody{1, &B.tree, &set.b[i]});
     while (!test.resolved()) test.step();
@@ -135,19 +132,19 @@ double timeOurs(const Shape& A, const Shape& B, const PoseSet& set, std::size_t 
     tests += test.sphereTests();
     steps += test.stepsDone();
   }
-  return cpuSeconds() - t0;
+  return threadCpuSeconds() - t0;
 }
 
 double timeFcl(const Shape& A, const Shape& B, const PoseSet& set, std::size_t begin, std::size_t end,
                std::vector<char>& colliding) {
   const fcl::CollisionRequestd request;  // yes/no: stop at the first contact
-  const double t0 = cpuSeconds();
+  const double t0 = threadCpuSeconds();
   for (std::size_t i = begin; i < end; ++i) {
     fcl::CollisionResultd result;
     fcl::collide(A.mesh.get(), set.fa[i], B.mesh.get(), set.fb[i], request, result);
     colliding[i] = result.isCollision();
   }
-  return cpuSeconds() - t0;
+  return threadCpuSeconds() - t0;
 }
 
 // The machine may be shared: each chunk of poses is short enough to fit in

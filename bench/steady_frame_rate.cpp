@@ -18,6 +18,7 @@
 //          [--markdown FILE]
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "tick_clock.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -31,21 +32,10 @@
 namespace {
 
 using namespace stc;
-
-double cpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const double pos = p * static_cast<double>(v.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(pos));
-  const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
+using stc_bench::percentile;
+// Thread CPU time beside the wall time: immune to the process being
+// descheduled on a shared machine (the budget itself is wall time).
+using stc_bench::threadCpuSeconds;
 
 double maxOf(const std::vector<double>& v) { return v.empty() ? NAN : *std::max_element(v.begin(), v.end()); }
 
@@ -71,7 +61,7 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
   config.gravity = sceneGravity(kind);
   config.scheduler.kind = SchedulerKind::PriorityQueues;
   World world(config);
-  if (!wall_clock) world.setClock(cpuSeconds);
+  if (!wall_clock) world.setClock(threadCpuSeconds);
   SceneParams params;
   params.entities = entities;
   const SceneSpec spec = populateScene(world, kind, params);
@@ -86,11 +76,11 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
   const int ticks = static_cast<int>(std::lround(seconds / spec.dt));
   for (int i = 0; i < ticks; ++i) {
     world.perception().setFixation(gaze.fixationAt(i * spec.dt, world));
-    const double c0 = cpuSeconds();
+    const double c0 = threadCpuSeconds();
     const auto w0 = std::chrono::steady_clock::now();
     const TickReport r = world.step(spec.dt, budget);
     run.wall.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count());
-    run.cpu.push_back(cpuSeconds() - c0);
+    run.cpu.push_back(threadCpuSeconds() - c0);
     run.cpu_but_integrate.push_back(run.cpu.back() - r.integrate_s);
     run.integrate.push_back(r.integrate_s);
     run.broad.push_back(r.broad_s);

@@ -8,6 +8,7 @@ packages=(
   librostest-dev python3-rostest python3-roslaunch libtf2-msgs-dev
   libeigen3-dev libyaml-cpp-dev libfcl-dev libgtest-dev googletest
   python3-matplotlib
+  libbullet-dev  # benchmarks only: bench_bullet_compare (skipped when absent)
   rviz xvfb xauth imagemagick x11-utils
   catkin-lint
 )

@@ -17,15 +17,18 @@ enum class SceneKind : std::uint8_t {
   PackedBox,    // the paper's case: homogeneous entities tightly packed in a closed box,
                 // random velocities, no gravity: moving and colliding all the time
   BouncingBox,  // a spread-out box of mixed presets bouncing under gravity
-  Rockfall,     // rocks of a few seeded shapes falling down a sloped ravine onto a run-out
+  Rockfall,     // rocks of a few seeded shapes falling down a sloped ravine onto a run-out,
+                // in a walled tray that catches them; the ravine grows with the count
   CornerDrift,  // worst case: the packed box with gravity pointing into one corner
+  CubeBox,      // cubes on a loose lattice in a closed box, falling into a pile under gravity
 };
-// "packed_box" | "bouncing_box" | "rockfall" | "corner_drift"; throws InputError("scene").
+// "packed_box" | "bouncing_box" | "rockfall" | "corner_drift" | "cube_box";
+// throws InputError("scene").
 SceneKind parseScene(const std::string& name);
 const char* toString(SceneKind kind);
 
 struct SceneParams {
-  int entities = 0;            // movable entities; 0: the scene's default (500, 100, 200, 500)
+  int entities = 0;            // movable entities; 0: the scene's default (500, 100, 200, 500, 1000)
   std::uint32_t seed = 1;      // poses, velocities and rock shapes
   double entity_size = 0.4;    // metres: largest extent of one entity
   int resolution = 8;          // voxels along an entity's largest extent
@@ -36,7 +39,7 @@ struct SceneSpec {
   SceneKind kind = SceneKind::PackedBox;
   Vec3 gravity = Vec3::Zero();  // what sceneGravity(kind) returns
   Camera camera;                // sees the whole scene (1280x720, 60 deg)
-  Aabb bounds;                  // where the movable entities live
+  Aabb bounds;                  // where the movable entities' centres stay (inside the walls)
   std::vector<EntityId> movers; // movable entities, creation order
   std::vector<EntityId> walls;  // static plates (box walls, ravine walls and floor)
   double dt = 1.0 / 60.0;       // suggested tick

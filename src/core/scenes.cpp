@@ -14,11 +14,12 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 
-const std::array<std::pair<SceneKind, const char*>, 4> kScenes{{
+const std::array<std::pair<SceneKind, const char*>, 5> kScenes{{
     {SceneKind::PackedBox, "packed_box"},
     {SceneKind::BouncingBox, "bouncing_box"},
     {SceneKind::Rockfall, "rockfall"},
-    {SceneKind::CornerDrift, "corner_drift"}}};
+    {SceneKind::CornerDrift, "corner_drift"},
+    {SceneKind::CubeBox, "cube_box"}}};
 
 // Seeded draws that mean the same on every standard library (the
 // std:: distributions do not promise that).
@@ -115,15 +116,17 @@ class SceneBuilder {
     }
   }
 
-  // Six walls, inner faces on the box [c - h, c + h].
-  void closedBox(const Vec3& c, const Vec3& h, double tile, const Material& m) {
+  // Walls with inner faces on the box [c - h, c + h]: the floor in tiles of
+  // `floor_tile`, the four sides (and the ceiling, unless open) of `wall_tile`.
+  void box(const Vec3& c, const Vec3& h, double floor_tile, double wall_tile, bool open_top,
+           const Material& m) {
     const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
-    wall(c - h.z() * z, x, y, h.x(), h.y(), tile, m);   // floor, normal +z
-    wall(c + h.z() * z, y, x, h.y(), h.x(), tile, m);   // ceiling, normal -z
-    wall(c - h.x() * x, y, z, h.y(), h.z(), tile, m);   // normal +x
-    wall(c + h.x() * x, z, y, h.z(), h.y(), tile, m);   // normal -x
-    wall(c - h.y() * y, z, x, h.z(), h.x(), tile, m);   // normal +y
-    wall(c + h.y() * y, x, z, h.x(), h.z(), tile, m);   // normal -y
+    wall(c - h.z() * z, x, y, h.x(), h.y(), floor_tile, m);                // floor, normal +z
+    if (!open_top) wall(c + h.z() * z, y, x, h.y(), h.x(), wall_tile, m);  // ceiling, normal -z
+    wall(c - h.x() * x, y, z, h.y(), h.z(), wall_tile, m);   // normal +x
+    wall(c + h.x() * x, z, y, h.z(), h.y(), wall_tile, m);   // normal -x
+    wall(c - h.y() * y, z, x, h.z(), h.x(), wall_tile, m);   // normal +y
+    wall(c + h.y() * y, x, z, h.x(), h.z(), wall_tile, m);   // normal -y
   }
 
  private:
@@ -146,6 +149,7 @@ int defaultCount(SceneKind kind) {
     case SceneKind::BouncingBox: return 100;
     case SceneKind::Rockfall: return 200;
     case SceneKind::CornerDrift: return 500;
+    case SceneKind::CubeBox: return 1000;
   }
   return 100;
 }
@@ -156,7 +160,7 @@ Vec3 latticeCell(int index, int per_side, double spacing) {
   return Vec3(i + 0.5, j + 0.5, k + 0.5) * spacing;
 }
 
-// PackedBox / CornerDrift / BouncingBox: entities on a cubic lattice in a closed box.
+// PackedBox / CornerDrift / BouncingBox / CubeBox: entities on a cubic lattice in a closed box.
 void boxScene(SceneBuilder& b, SceneSpec& spec, const SceneParams& p, int count, Draw& draw) {
   struct Style {
     double spacing;      // lattice spacing / entity size
@@ -167,18 +171,22 @@ void boxScene(SceneBuilder& b, SceneSpec& spec, const SceneParams& p, int count,
   Style s{1.1, 1.0, 2.0, Material{0.9, 0.1}};                            // packed: always colliding
   if (spec.kind == SceneKind::BouncingBox) s = Style{2.5, 2.0, 3.0, Material{0.7, 0.3}};
   if (spec.kind == SceneKind::CornerDrift) s = Style{1.6, 0.3, 1.0, Material{0.3, 0.5}};
+  // Cubes start apart: a cube turned any way (diagonal sqrt(3)) fits a cell of 2.
+  if (spec.kind == SceneKind::CubeBox) s = Style{2.0, 0.5, 1.0, Material{0.2, 0.5}};
 
   const int per_side = static_cast<int>(std::ceil(std::cbrt(static_cast<double>(count)) - 1e-9));
   const double spacing = s.spacing * p.entity_size;
   const double half = 0.5 * per_side * spacing;
   const Vec3 centre = Vec3::Constant(half);  // box [0, 2 half]^3
-  b.closedBox(centre, Vec3::Constant(half), std::max(p.entity_size * 2.5, 2.0 * half / 4.0),
-              s.material);
+  const double tile = std::max(p.entity_size * 2.5, 2.0 * half / 4.0);
+  b.box(centre, Vec3::Constant(half), tile, tile, false, s.material);
 
   // Homogeneous for the paper's scenes; a cycle of presets for the bouncing box.
   static const char* kMixed[] = {"cube", "rock", "rod", "L", "ring", "sphere"};
   for (int i = 0; i < count; ++i) {
-    const char* name = spec.kind == SceneKind::BouncingBox ? kMixed[i % 6] : "rock";
+    const char* name = spec.kind == SceneKind::BouncingBox ? kMixed[i % 6]
+                       : spec.kind == SceneKind::CubeBox   ? "cube"
+                                                           : "rock";
     const ShapeId shape = b.preset(name, p.resolution, p.entity_size, p.seed);
     Pose pose;
     pose.position = latticeCell(i, per_side, spacing);
@@ -194,27 +202,36 @@ void boxScene(SceneBuilder& b, SceneSpec& spec, const SceneParams& p, int count,
 
 // Rockfall: a straight ravine (floor, two side walls, a back wall) sloping down
 // along +x onto a flat run-out; rocks of four seeded shapes start stacked
-// above its upper half and fall, tumble and bounce off each other.
+// above its upper half and fall, tumble and bounce off each other. A walled
+// tray under the whole scene (its floor is the run-out) catches what rolls off
+// the run-out or spills over the ravine walls, so every rock ends in the pile.
+// Up to 200 rocks the ravine has its base size; beyond, every length grows with
+// the cube root of the count, so the starting column keeps to the same share
+// of the ravine's depth (at 5,000 rocks a 2.9 times larger ravine, not a 59 m column).
 void rockfall(SceneBuilder& b, SceneSpec& spec, const SceneParams& p, int count, Draw& draw) {
   const double size = p.entity_size;
-  const double length = 30.0 * size, width = 6.0 * size, height = 10.0 * size;
+  const double scale = std::max(1.0, std::cbrt(count / 200.0));
+  const double length = 30.0 * size * scale, width = 6.0 * size * scale, height = 10.0 * size * scale;
   const double slope = 25.0 * kPi / 180.0;
   const Material rock{0.3, 0.6};
   // Ravine frame: x downhill along the floor, y across, z up from the floor.
   const Quat tilt(Eigen::AngleAxisd(slope, Vec3::UnitY()));
   const Vec3 top(0.0, 0.0, length * std::sin(slope));
   const Vec3 ex = tilt * Vec3::UnitX(), ey = tilt * Vec3::UnitY(), ez = tilt * Vec3::UnitZ();
-  const double tile = 2.5 * size;
+  const double tile = 2.5 * size * scale;
   const Vec3 mid = top + 0.5 * length * ex;
   b.wall(mid, ex, ey, 0.5 * length, 0.5 * width, tile, rock);                                     // floor
   b.wall(mid - 0.5 * width * ey + 0.5 * height * ez, ez, ex, 0.5 * height, 0.5 * length, tile, rock);  // +y facing
   b.wall(mid + 0.5 * width * ey + 0.5 * height * ez, ex, ez, 0.5 * length, 0.5 * height, tile, rock);  // -y facing
   b.wall(top + 0.5 * height * ez, ey, ez, 0.5 * width, 0.5 * height, tile, rock);               // back, facing +x
-  // Run-out: flat, wider than the ravine, from the ravine's foot onward.
+
+  // Tray: floor at z = 0 from behind the ravine's back wall to the run-out's
+  // end, three ravine widths across, walls as high as the ravine's; coarser
+  // tiles on its walls, which only catch.
   const Vec3 foot = top + length * ex;
-  const double runout = 16.0 * size;
-  b.wall(foot + Vec3(0.5 * runout, 0, 0), Vec3::UnitX(), Vec3::UnitY(), 0.5 * runout, 1.5 * width,
-         tile, rock);
+  const double runout = 16.0 * size * scale;
+  const Vec3 lo(-size * scale, -1.5 * width, 0.0), hi(foot.x() + runout, 1.5 * width, height);
+  b.box(0.5 * (lo + hi), 0.5 * (hi - lo), tile, 2.0 * tile, true, rock);
 
   // Rocks: a lattice in the ravine frame over the upper half, layered upward.
   const double spacing = 1.3 * size;
@@ -225,8 +242,8 @@ void rockfall(SceneBuilder& b, SceneSpec& spec, const SceneParams& p, int count,
     shapes[k] = b.preset("rock", p.resolution, size, p.seed * 4 + k);
   }
   for (int i = 0; i < count; ++i) {
-    const int a = i % along, c = (i / along) % across, layer = i / (along * across);
-    const Vec3 local(size + (a + 0.5) * spacing, -0.5 * (across - 1) * spacing + c * spacing,
+    const int a = i % along, across_i = (i / along) % across, layer = i / (along * across);
+    const Vec3 local(size + (a + 0.5) * spacing, -0.5 * (across - 1) * spacing + across_i * spacing,
                      size + (layer + 0.5) * spacing);
     Pose pose;
     pose.position = top + local.x() * ex + local.y() * ey + local.z() * ez;
@@ -235,8 +252,9 @@ void rockfall(SceneBuilder& b, SceneSpec& spec, const SceneParams& p, int count,
     const Vec3 w = draw.direction() * draw.range(0.0, 2.0);
     b.mover(shapes[static_cast<std::size_t>(i) % shapes.size()], pose, v, w, rock);
   }
-  spec.bounds.min = Vec3(-size, -1.5 * width, -size);
-  spec.bounds.max = Vec3(foot.x() + runout, 1.5 * width, top.z() + height + 4.0 * size);
+  // Inside the tray, up to the top of the ravine's back wall.
+  spec.bounds.min = lo;
+  spec.bounds.max = Vec3(hi.x(), hi.y(), top.z() + height + 4.0 * size);
   const Vec3 look = top + 0.6 * length * ex + 0.3 * height * ez;
   spec.camera = cameraOn(look, 0.45 * length, Vec3(0.35, -1.0, 0.55));
   spec.dt = 1.0 / 60.0;
@@ -264,7 +282,8 @@ Vec3 sceneGravity(SceneKind kind) {
   switch (kind) {
     case SceneKind::PackedBox: return Vec3::Zero();
     case SceneKind::BouncingBox:
-    case SceneKind::Rockfall: return Vec3(0.0, 0.0, -kG);
+    case SceneKind::Rockfall:
+    case SceneKind::CubeBox: return Vec3(0.0, 0.0, -kG);
     case SceneKind::CornerDrift: return -kG * Vec3::Ones().normalized();  // into the box's (0,0,0) corner
   }
   return Vec3::Zero();

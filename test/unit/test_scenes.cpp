@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -28,7 +29,12 @@ WorldConfig configFor(SceneKind kind) {
 }
 
 constexpr SceneKind kAllScenes[] = {SceneKind::PackedBox, SceneKind::BouncingBox,
-                                    SceneKind::Rockfall, SceneKind::CornerDrift};
+                                    SceneKind::Rockfall, SceneKind::CornerDrift,
+                                    SceneKind::CubeBox};
+
+bool inside(const Aabb& box, const Vec3& p) {
+  return p.allFinite() && (p.array() >= box.min.array()).all() && (p.array() <= box.max.array()).all();
+}
 
 TEST(Scenes, NamesRoundTrip) {
   for (SceneKind kind : kAllScenes) EXPECT_EQ(parseScene(toString(kind)), kind);
@@ -56,8 +62,7 @@ TEST(Scenes, EachSceneHasMoversInsideItsBoundsStaticWallsAndACameraOnThem) {
       const BodyState& body = world.bodies()[*world.indexOf(id)];
       EXPECT_FALSE(body.is_static);
       const Vec3& p = body.pose.position;
-      EXPECT_TRUE((p.array() >= spec.bounds.min.array()).all() &&
-                  (p.array() <= spec.bounds.max.array()).all());
+      EXPECT_TRUE(inside(spec.bounds, p));
       const auto pixel = world.perception().project(p);
       if (pixel && world.perception().onScreen(*pixel)) ++on_screen;
     }
@@ -110,6 +115,69 @@ TEST(Scenes, RockfallUsesSeveralRockShapesAboveTheRavineFloor) {
   EXPECT_EQ(std::unique(shapes.begin(), shapes.end()) - shapes.begin(), 4);
   EXPECT_GT(lowest, 0.0);  // every rock starts above the run-out floor (z = 0)
   // Nothing starts in contact, rock on rock or rock on wall (full depth).
+  const TickReport report = world.step(0.0, Budget::unlimited());
+  EXPECT_GT(report.broad_pairs, 0u);
+  EXPECT_EQ(report.colliding, 0u);
+}
+
+TEST(Scenes, RockfallRavineGrowsWithTheRockCountSoTheColumnStartsInside) {
+  auto spec = [](int rocks, World& world) {
+    SceneParams p;
+    p.entities = rocks;
+    return populateScene(world, SceneKind::Rockfall, p);
+  };
+  World w60(configFor(SceneKind::Rockfall)), w200(configFor(SceneKind::Rockfall)),
+      w5000(configFor(SceneKind::Rockfall));
+  const SceneSpec small = spec(60, w60), base = spec(200, w200), large = spec(5000, w5000);
+  // Up to 200 rocks: one ravine.
+  EXPECT_EQ(small.bounds.min, base.bounds.min);
+  EXPECT_EQ(small.bounds.max, base.bounds.max);
+  EXPECT_EQ(small.walls.size(), base.walls.size());
+  // 5,000 rocks: every length 25^(1/3) times the base, and every rock starts
+  // inside (a column of fixed footprint would reach 59 m up).
+  const Vec3 base_size = base.bounds.max - base.bounds.min, large_size = large.bounds.max - large.bounds.min;
+  EXPECT_NEAR(large_size.y() / base_size.y(), std::cbrt(25.0), 1e-9);
+  ASSERT_EQ(large.movers.size(), 5000u);
+  std::size_t outside = 0;
+  for (EntityId id : large.movers) {
+    if (!inside(large.bounds, w5000.bodies()[*w5000.indexOf(id)].pose.position)) ++outside;
+  }
+  EXPECT_EQ(outside, 0u);
+}
+
+TEST(Scenes, RockfallRocksStayInTheSceneThroughTheDrop) {
+  World world(configFor(SceneKind::Rockfall));
+  SceneParams p;
+  p.entities = 300;
+  const SceneSpec spec = populateScene(world, SceneKind::Rockfall, p);
+  // 4 s: the rocks land, slide down the ravine and pile up at the run-out;
+  // the first reach the tray's far wall.
+  double start = -1e9;
+  for (EntityId id : spec.movers) start = std::max(start, world.bodies()[*world.indexOf(id)].pose.position.x());
+  double farthest = start;
+  for (int tick = 0; tick < 240; ++tick) {
+    world.step(spec.dt, Budget::unlimited());
+    for (EntityId id : spec.movers) {
+      const Vec3& at = world.bodies()[*world.indexOf(id)].pose.position;
+      ASSERT_TRUE(inside(spec.bounds, at)) << "tick " << tick << " rock " << id << " at " << at.transpose();
+      farthest = std::max(farthest, at.x());
+    }
+  }
+  // They did go somewhere: down the ravine into the run-out.
+  EXPECT_GT(farthest, start + 5.0);
+}
+
+TEST(Scenes, CubeBoxIsOneCubeShapeUnderGravityStartingApart) {
+  World world(configFor(SceneKind::CubeBox));
+  SceneParams p;
+  p.entities = 125;
+  const SceneSpec spec = populateScene(world, SceneKind::CubeBox, p);
+  EXPECT_EQ(spec.gravity, Vec3(0.0, 0.0, -9.81));
+  const ShapeId shape = world.bodyShapes()[*world.indexOf(spec.movers.front())];
+  const VoxelShape& voxels = world.shape(shape).voxels;
+  EXPECT_EQ(voxels.occupiedCount(), static_cast<std::int64_t>(voxels.nx()) * voxels.ny() * voxels.nz());
+  EXPECT_EQ(voxels.nx(), voxels.nz());
+  for (EntityId id : spec.movers) EXPECT_EQ(world.bodyShapes()[*world.indexOf(id)], shape);
   const TickReport report = world.step(0.0, Budget::unlimited());
   EXPECT_GT(report.broad_pairs, 0u);
   EXPECT_EQ(report.colliding, 0u);

@@ -1,0 +1,498 @@
+// Side by side with Bullet 3.24 (issue 9, item 6): each built-in scene run by
+// this package's World (WorldConfig defaults, unlimited budget) and by
+// Bullet's btDiscreteDynamicsWorld with its defaults (dynamic AABB tree broad
+// phase, sequential impulses with 10 iterations and split impulse, sleeping
+// on), on the same bodies: same poses, velocities, masses, inertia, gravity,
+// dt and materials. Bullet gets each voxel shape twice, one run each:
+//   compound  btCompoundShape of the shape's leaf spheres (its SphereTree);
+//   hull      btConvexHullShape of the corners of the occupied voxels, shrunk
+//             by its collision margin so that hull + margin is the voxel hull.
+// Walls (static plates) are built the same way as the movers in each run.
+// Materials combine as in this package: restitution max, friction sqrt(a b).
+//
+// Per tick: wall and thread-CPU time of one step, this package's phase
+// split (TickReport), and sanity figures over the movers: mean stored speed
+// against mean |dx|/dt (they agree when stored velocity is real motion),
+// final mean speed, bodies out of the scene's bounds (at the end; ever).
+// Ends with one SUMMARY line per scene: this package's thread-CPU p50 and
+// p99, Bullet's best (lowest) thread-CPU p50 and the ratio of the two p50s.
+//
+// Usage: bench_bullet_compare [--seconds S] [--scenes LIST] [--variants LIST] [--markdown FILE]
+//   --seconds   simulated time per run (default 10)
+//   --scenes    comma separated, each NAME or NAME:BODIES (default: corner_drift:500,
+//               packed_box:500, rockfall:1000, rockfall:5000, cube_box:10000;
+//               a bare NAME picks that scene's cases from the default list)
+//   --variants  Bullet shapes to run: compound,hull (default both)
+#include "sphere_tree_collision/scenes.hpp"
+#include "sphere_tree_collision/world.hpp"
+#include "tick_clock.hpp"
+
+#include <btBulletDynamicsCommon.h>
+#include <BulletCollision/CollisionDispatch/btManifoldResult.h>
+#include <LinearMath/btConvexHullComputer.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace stc;
+using stc_bench::maxOf;
+using stc_bench::meanOf;
+using stc_bench::percentile;
+
+struct Case {
+  SceneKind kind;
+  int bodies;
+};
+const Case kDefaultCases[] = {{SceneKind::CornerDrift, 500},
+                              {SceneKind::PackedBox, 500},
+                              {SceneKind::Rockfall, 1000},
+                              {SceneKind::Rockfall, 5000},
+                              {SceneKind::CubeBox, 10000}};
+
+// What one engine did over one run of one scene.
+struct Run {
+  std::string engine;
+  std::vector<double> wall, cpu;                          // s per tick
+  std::vector<double> integrate, broad, narrow, response; // s per tick (this package)
+  std::vector<double> contacts;                           // per tick (this package)
+  double stored_speed = 0.0;  // mean over ticks and movers of |v|
+  double moved_speed = 0.0;   // mean over ticks and movers of |dx| / dt
+  double final_speed = 0.0;   // mean |v| after the last tick
+  int out_end = 0, out_ever = 0, non_finite = 0;
+  int sleeping = -1;          // Bullet: movers asleep at the end
+};
+
+// Follows the movers' centres tick by tick for the sanity figures.
+class MotionCheck {
+ public:
+  MotionCheck(const Aabb& bounds, double dt) : bounds_(bounds), dt_(dt) {}
+  void start(const std::vector<Vec3>& positions) {
+    last_ = positions;
+    ever_out_.assign(positions.size(), 0);
+  }
+  void tick(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities) {
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+      stored_sum_ += velocities[i].norm();
+      moved_sum_ += (positions[i] - last_[i]).norm() / dt_;
+      if (!inside(positions[i])) ever_out_[i] = 1;
+    }
+    samples_ += positions.size();
+    last_ = positions;
+    last_velocities_ = velocities;
+  }
+  void finish(Run& run) const {
+    const double n = static_cast<double>(std::max<std::size_t>(samples_, 1));
+    run.stored_speed = stored_sum_ / n;
+    run.moved_speed = moved_sum_ / n;
+    double speed = 0.0;
+    for (std::size_t i = 0; i < last_.size(); ++i) {
+      speed += last_velocities_.empty() ? 0.0 : last_velocities_[i].norm();
+      if (!inside(last_[i])) ++run.out_end;
+      if (ever_out_[i]) ++run.out_ever;
+      if (!last_[i].allFinite()) ++run.non_finite;
+    }
+    run.final_speed = last_.empty() ? 0.0 : speed / static_cast<double>(last_.size());
+  }
+
+ private:
+  bool inside(const Vec3& p) const {
+    return p.allFinite() && (p.array() >= bounds_.min.array()).all() &&
+           (p.array() <= bounds_.max.array()).all();
+  }
+  Aabb bounds_;
+  double dt_;
+  std::vector<Vec3> last_, last_velocities_;
+  std::vector<char> ever_out_;
+  double stored_sum_ = 0.0, moved_sum_ = 0.0;
+  std::size_t samples_ = 0;
+};
+
+World sceneWorld(const Case& c, SceneSpec& spec) {
+  WorldConfig config;
+  config.gravity = sceneGravity(c.kind);
+  World world(config);
+  SceneParams params;
+  params.entities = c.bodies;
+  spec = populateScene(world, c.kind, params);
+  return world;
+}
+
+void timeTick(Run& run, double wall0, double cpu0) {
+  run.wall.push_back(stc_bench::wallSeconds() - wall0);
+  run.cpu.push_back(stc_bench::threadCpuSeconds() - cpu0);
+}
+
+Run runPackage(const Case& c, int ticks) {
+  SceneSpec spec;
+  World world = sceneWorld(c, spec);
+  std::vector<std::size_t> dense;
+  for (EntityId id : spec.movers) dense.push_back(*world.indexOf(id));
+  std::vector<Vec3> positions(dense.size()), velocities(dense.size());
+  auto read = [&] {
+    for (std::size_t i = 0; i < dense.size(); ++i) {
+      positions[i] = world.bodies()[dense[i]].pose.position;
+      velocities[i] = world.bodies()[dense[i]].linear_velocity;
+    }
+  };
+  Run run;
+  run.engine = "this package";
+  MotionCheck check(spec.bounds, spec.dt);
+  read();
+  check.start(positions);
+  for (int t = 0; t < ticks; ++t) {
+    const double wall0 = stc_bench::wallSeconds(), cpu0 = stc_bench::threadCpuSeconds();
+    const TickReport r = world.step(spec.dt, Budget::unlimited());
+    timeTick(run, wall0, cpu0);
+    run.integrate.push_back(r.integrate_s);
+    run.broad.push_back(r.broad_s);
+    run.narrow.push_back(r.narrow_s);
+    run.response.push_back(r.response_s);
+    run.contacts.push_back(static_cast<double>(r.contacts));
+    read();
+    check.tick(positions, velocities);
+  }
+  check.finish(run);
+  return run;
+}
+
+// ---------------------------------------------------------------------------
+// Bullet
+
+enum class BulletShape { Compound, Hull };
+const char* toString(BulletShape s) { return s == BulletShape::Compound ? "compound" : "hull"; }
+
+btVector3 bt(const Vec3& v) { return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z())); }
+Vec3 eig(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
+
+btScalar combinedRestitution(const btCollisionObject* a, const btCollisionObject* b) {
+  return std::max(a->getRestitution(), b->getRestitution());
+}
+btScalar combinedFriction(const btCollisionObject* a, const btCollisionObject* b) {
+  return std::sqrt(a->getFriction() * b->getFriction());
+}
+
+// One voxel shape as Bullet sees it: Bullet wants the body frame on the
+// principal axes of inertia, so points are taken from this package's body
+// frame (centre of mass, grid axes) by principal^T.
+struct BulletBodyShape {
+  btCollisionShape* shape = nullptr;
+  Mat3 principal = Mat3::Identity();  // columns: principal axes in the body frame
+  Vec3 moments = Vec3::Zero();        // principal moments per kg
+};
+
+class BulletScene {
+ public:
+  BulletScene(const World& world, const SceneSpec& spec, BulletShape kind) : kind_(kind) {
+    gCalculateCombinedRestitutionCallback = &combinedRestitution;
+    gCalculateCombinedFrictionCallback = &combinedFriction;
+    world_.setGravity(bt(spec.gravity));
+    for (std::size_t i = 0; i < world.entityCount(); ++i) add(world, i);
+    for (EntityId id : spec.movers) movers_.push_back(bodies_[*world.indexOf(id)].get());
+  }
+  ~BulletScene() {
+    for (auto& body : bodies_) world_.removeRigidBody(body.get());
+  }
+  void step(double dt) { world_.stepSimulation(btScalar(dt), 0); }
+  void read(std::vector<Vec3>& positions, std::vector<Vec3>& velocities) const {
+    positions.resize(movers_.size());
+    velocities.resize(movers_.size());
+    for (std::size_t i = 0; i < movers_.size(); ++i) {
+      positions[i] = eig(movers_[i]->getWorldTransform().getOrigin());
+      velocities[i] = eig(movers_[i]->getLinearVelocity());
+    }
+  }
+  int sleeping() const {
+    int n = 0;
+    for (const btRigidBody* b : movers_) n += b->getActivationState() == ISLAND_SLEEPING;
+    return n;
+  }
+
+ private:
+  void add(const World& world, std::size_t index) {
+    const BodyState& state = world.bodies()[index];
+    const BulletBodyShape& s = shapeOf(world, world.bodyShapes()[index]);
+    const double mass = state.is_static ? 0.0 : 1.0 / state.inv_mass;
+    btRigidBody::btRigidBodyConstructionInfo info(btScalar(mass), nullptr, s.shape,
+                                                  bt(mass * s.moments));
+    const Quat q(state.pose.orientation.toRotationMatrix() * s.principal);
+    info.m_startWorldTransform =
+        btTransform(btQuaternion(btScalar(q.x()), btScalar(q.y()), btScalar(q.z()), btScalar(q.w())),
+                    bt(state.pose.position));
+    info.m_restitution = btScalar(state.material.restitution);
+    info.m_friction = btScalar(state.material.friction);
+    bodies_.push_back(std::make_unique<btRigidBody>(info));
+    btRigidBody* body = bodies_.back().get();
+    body->setLinearVelocity(bt(state.linear_velocity));
+    body->setAngularVelocity(bt(state.angular_velocity));
+    world_.addRigidBody(body);
+  }
+
+  const BulletBodyShape& shapeOf(const World& world, ShapeId id) {
+    auto found = shapes_.find(id);
+    if (found != shapes_.end()) return found->second;
+    const ShapeInfo& info = world.shape(id);
+    BulletBodyShape s;
+    const Mat3 inertia = info.unit_mass.inertia / info.unit_mass.mass;  // per kg
+    Eigen::SelfAdjointEigenSolver<Mat3> eigen(inertia);
+    s.principal = eigen.eigenvectors();
+    if (s.principal.determinant() < 0.0) s.principal.col(2) *= -1.0;
+    s.moments = eigen.eigenvalues();
+    s.shape = kind_ == BulletShape::Compound ? leafCompound(info, s.principal)
+                                             : voxelHull(info, s.principal);
+    return shapes_.emplace(id, s).first->second;
+  }
+
+  btCollisionShape* own(btCollisionShape* shape) {
+    owned_.emplace_back(shape);
+    return shape;
+  }
+
+  btCollisionShape* leafCompound(const ShapeInfo& info, const Mat3& principal) {
+    auto* compound = new btCompoundShape(true);
+    own(compound);
+    const auto& nodes = info.tree.nodes();
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      if (nodes[i].child_count != 0) continue;
+      btTransform at;
+      at.setIdentity();
+      at.setOrigin(bt(principal.transpose() * nodes[i].centre));
+      compound->addChildShape(at, own(new btSphereShape(btScalar(nodes[i].radius))));
+    }
+    return compound;
+  }
+
+  btCollisionShape* voxelHull(const ShapeInfo& info, const Mat3& principal) {
+    const VoxelShape& v = info.voxels;
+    std::vector<double> corners;
+    for (int k = 0; k < v.nz(); ++k) {
+      for (int j = 0; j < v.ny(); ++j) {
+        for (int i = 0; i < v.nx(); ++i) {
+          if (!v.isSurfaceVoxel(i, j, k)) continue;  // inner corners are inside the hull
+          for (int c = 0; c < 8; ++c) {
+            const Vec3 grid(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1));
+            const Vec3 p = principal.transpose() * (grid * v.voxelSize() - info.body_origin);
+            corners.insert(corners.end(), {p.x(), p.y(), p.z()});
+          }
+        }
+      }
+    }
+    // Faces moved in by Bullet's default margin (at most a quarter of the
+    // hull's inner radius); the margin puts them back.
+    btConvexHullComputer computer;
+    const btScalar margin = computer.compute(corners.data(), 3 * static_cast<int>(sizeof(double)),
+                                             static_cast<int>(corners.size() / 3), btScalar(0.04),
+                                             btScalar(0.25));
+    auto* hull = new btConvexHullShape();
+    own(hull);
+    hull->setMargin(margin);
+    for (int i = 0; i < computer.vertices.size(); ++i) hull->addPoint(computer.vertices[i], false);
+    hull->recalcLocalAabb();
+    return hull;
+  }
+
+  BulletShape kind_;
+  btDefaultCollisionConfiguration config_;
+  btCollisionDispatcher dispatcher_{&config_};
+  btDbvtBroadphase broad_phase_;
+  btSequentialImpulseConstraintSolver solver_;
+  btDiscreteDynamicsWorld world_{&dispatcher_, &broad_phase_, &solver_, &config_};
+  std::vector<std::unique_ptr<btCollisionShape>> owned_;
+  std::map<ShapeId, BulletBodyShape> shapes_;
+  std::vector<std::unique_ptr<btRigidBody>> bodies_;  // dense order of the World
+  std::vector<btRigidBody*> movers_;
+};
+
+Run runBullet(const Case& c, int ticks, BulletShape kind) {
+  SceneSpec spec;
+  std::unique_ptr<BulletScene> scene;
+  {
+    const World world = sceneWorld(c, spec);
+    scene = std::make_unique<BulletScene>(world, spec, kind);
+  }
+  Run run;
+  run.engine = std::string("Bullet ") + toString(kind);
+  MotionCheck check(spec.bounds, spec.dt);
+  std::vector<Vec3> positions, velocities;
+  scene->read(positions, velocities);
+  check.start(positions);
+  for (int t = 0; t < ticks; ++t) {
+    const double wall0 = stc_bench::wallSeconds(), cpu0 = stc_bench::threadCpuSeconds();
+    scene->step(spec.dt);
+    timeTick(run, wall0, cpu0);
+    scene->read(positions, velocities);
+    check.tick(positions, velocities);
+  }
+  check.finish(run);
+  run.sleeping = scene->sleeping();
+  return run;
+}
+
+// ---------------------------------------------------------------------------
+// Report
+
+double loadAverage() {
+  double load[1] = {NAN};
+  return getloadavg(load, 1) == 1 ? load[0] : NAN;
+}
+
+std::string label(const Case& c) { return std::string(toString(c.kind)) + " " + std::to_string(c.bodies); }
+
+std::string runRow(const Case& c, const Run& r) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "| %s | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.3f | %.3f | %.3f | %d / %d | %s |\n",
+                label(c).c_str(), r.engine.c_str(), 1e3 * percentile(r.cpu, 0.5),
+                1e3 * percentile(r.cpu, 0.99), 1e3 * maxOf(r.cpu), 1e3 * percentile(r.wall, 0.5),
+                1e3 * percentile(r.wall, 0.99), 1e3 * maxOf(r.wall), r.stored_speed, r.moved_speed,
+                r.final_speed, r.out_end, r.out_ever,
+                r.sleeping < 0 ? "-" : std::to_string(r.sleeping).c_str());
+  return buf;
+}
+
+std::string phaseRow(const Case& c, const Run& r) {
+  char buf[512];
+  auto cell = [](const std::vector<double>& v) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%.2f / %.2f", 1e3 * percentile(v, 0.5), 1e3 * meanOf(v));
+    return std::string(b);
+  };
+  std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %.0f |\n", label(c).c_str(),
+                cell(r.integrate).c_str(), cell(r.broad).c_str(), cell(r.narrow).c_str(),
+                cell(r.response).c_str(), cell(r.wall).c_str(), percentile(r.contacts, 0.5));
+  return buf;
+}
+
+struct Options {
+  double seconds = 10.0;
+  std::vector<Case> cases;
+  std::vector<BulletShape> variants{BulletShape::Compound, BulletShape::Hull};
+  std::string markdown;
+};
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  for (std::string item; std::getline(in, item, ',');) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+Options parse(int argc, char** argv) {
+  Options o;
+  std::string scenes;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) throw InputError(a, "needs a value");
+      return argv[++i];
+    };
+    if (a == "--seconds") {
+      o.seconds = std::stod(next());
+      if (!(o.seconds > 0.0)) throw InputError("--seconds", "must be > 0");
+    } else if (a == "--scenes") {
+      scenes = next();
+    } else if (a == "--variants") {
+      o.variants.clear();
+      for (const std::string& v : splitList(next())) {
+        if (v == "compound") o.variants.push_back(BulletShape::Compound);
+        else if (v == "hull") o.variants.push_back(BulletShape::Hull);
+        else throw InputError("--variants", "unknown value '" + v + "' (expected compound, hull)");
+      }
+    } else if (a == "--markdown") {
+      o.markdown = next();
+    } else {
+      throw InputError(a, "unknown argument");
+    }
+  }
+  if (scenes.empty()) {
+    o.cases.assign(std::begin(kDefaultCases), std::end(kDefaultCases));
+  }
+  for (const std::string& item : splitList(scenes)) {
+    const auto colon = item.find(':');
+    const SceneKind kind = parseScene(item.substr(0, colon));
+    if (colon != std::string::npos) {
+      const int bodies = std::stoi(item.substr(colon + 1));
+      if (bodies <= 0) throw InputError("--scenes", "bodies must be > 0 in '" + item + "'");
+      o.cases.push_back({kind, bodies});
+      continue;
+    }
+    for (const Case& c : kDefaultCases) {
+      if (c.kind == kind) o.cases.push_back(c);
+    }
+  }
+  return o;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options opt;
+  try {
+    opt = parse(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_bullet_compare: %s\n", e.what());
+    return 2;
+  }
+  const int ticks = static_cast<int>(std::lround(opt.seconds * 60.0));
+  std::string runs_md =
+      "| scene | engine | CPU p50 | CPU p99 | CPU max | wall p50 | wall p99 | wall max | "
+      "stored speed | \\|dx\\|/dt | final speed | out of bounds (end / ever) | asleep |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::string phases_md =
+      "| scene | integrate | broad | narrow | response | whole tick | contacts p50 |\n"
+      "|---|---|---|---|---|---|---|\n";
+  std::string summary;
+  std::printf("# bench_bullet_compare: %.1f s simulated per run (%d ticks at 60 Hz), load %.2f\n",
+              opt.seconds, ticks, loadAverage());
+  for (const Case& c : opt.cases) {
+    std::printf("## %s (load %.2f)\n", label(c).c_str(), loadAverage());
+    std::fflush(stdout);
+    const Run ours = runPackage(c, ticks);
+    std::string rows = runRow(c, ours);
+    std::printf("%s", rows.c_str());
+    std::fflush(stdout);
+    double best = NAN;
+    for (BulletShape v : opt.variants) {
+      const Run theirs = runBullet(c, ticks, v);
+      const std::string row = runRow(c, theirs);
+      std::printf("%s", row.c_str());
+      std::fflush(stdout);
+      rows += row;
+      const double p50 = percentile(theirs.cpu, 0.5);
+      if (!(best <= p50)) best = p50;
+    }
+    runs_md += rows;
+    phases_md += phaseRow(c, ours);
+    std::printf("phases p50 / mean ms: %s", phaseRow(c, ours).c_str());
+    char buf[256];
+    const double p50 = percentile(ours.cpu, 0.5);
+    std::snprintf(buf, sizeof buf,
+                  "SUMMARY scene=%s bodies=%d p50_ms=%.3f p99_ms=%.3f bullet_best_p50_ms=%.3f "
+                  "ratio_p50=%.3f\n",
+                  toString(c.kind), c.bodies, 1e3 * p50, 1e3 * percentile(ours.cpu, 0.99), 1e3 * best,
+                  p50 / best);
+    summary += buf;
+  }
+  std::string md;
+  char head[256];
+  std::snprintf(head, sizeof head,
+                "%.1f s simulated per run (%d ticks, dt = 1/60 s). Times in ms per tick; speeds in "
+                "m/s, means over movers and ticks.\n\n",
+                opt.seconds, ticks);
+  md = std::string(head) + runs_md +
+       "\nThis package's phases, ms per tick (p50 / mean, wall time):\n\n" + phases_md;
+  std::printf("\n%s\nload at the end %.2f\n%s", md.c_str(), loadAverage(), summary.c_str());
+  if (!opt.markdown.empty()) std::ofstream(opt.markdown) << md << "\n```\n" << summary << "```\n";
+  return 0;
+}
