@@ -8,6 +8,7 @@ packages=(
   librostest-dev python3-rostest python3-roslaunch libtf2-msgs-dev
   libeigen3-dev libyaml-cpp-dev libfcl-dev libgtest-dev googletest
   python3-matplotlib
+  clang libfuzzer-14-dev
   rviz xvfb xauth imagemagick x11-utils
 )
 missing=()

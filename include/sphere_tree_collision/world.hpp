@@ -6,6 +6,7 @@
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/limits.hpp"
 #include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
 #include "sphere_tree_collision/response.hpp"
@@ -43,6 +44,7 @@ struct WorldConfig {
   VoxelLimits voxel_limits;
   std::size_t max_entities = 20000;
   ResponseOptions response;
+  PhysicalLimits limits;  // inputs beyond them are rejected; bodies beyond them quarantined
 };
 
 struct EntitySpec {
@@ -74,6 +76,18 @@ struct TickReport {
   double geometric_bound = 0.0;         // sum of rigorous bounds h_a + h_b over the same pairs
   double perceived_inaccuracy = 0.0;    // P: sum of f(e, g) over the same pairs
   std::size_t contacts = 0;
+  // Removed at the end of the tick (World::quarantined() names them): state
+  // non-finite or beyond the limits, and, apart, bodies that left the world.
+  std::size_t quarantined = 0;
+  std::size_t left_world = 0;
+};
+
+// One entity removed at the end of a tick, and why.
+struct QuarantinedEntity {
+  EntityId id = kInvalidEntity;
+  std::string name;
+  ShapeId shape = 0;
+  Quarantine reason = Quarantine::None;
 };
 
 struct ShapeInfo {
@@ -100,14 +114,18 @@ class World {
 
   // Throws InputError naming the field ("shape", "pose.position",
   // "pose.orientation", "linear_velocity", "angular_velocity", "density",
-  // "material.restitution", "material.friction", "name", "max_entities");
-  // on throw nothing changes.
+  // "material.restitution", "material.friction", "name", "max_entities") and,
+  // for a value beyond config().limits, the limit; on throw nothing changes.
   EntityId addEntity(const EntitySpec& spec);
   bool removeEntity(EntityId id);
   std::optional<EntityId> findByName(const std::string& name) const;
   void clear();  // removes every entity, keeps shapes
 
+  // Throws InputError("dt") only. A body whose state leaves the limits during
+  // the tick is removed at its end (see quarantined()); the rest goes on.
   TickReport step(double dt, const Budget& budget);
+  // The entities the last step removed, with the reason.
+  const std::vector<QuarantinedEntity>& quarantined() const { return quarantined_; }
 
   Perception& perception() { return perception_; }
   const Perception& perception() const { return perception_; }
@@ -129,6 +147,8 @@ class World {
   const std::vector<PairTest>& pairTests() const { return pair_tests_; }
   std::size_t pairCount() const { return pair_count_; }
   const std::vector<Contact>& contacts() const { return contacts_; }
+  // The broad phase: its pairs and boxes as of the last step (checks and tests).
+  const SweepAndPrune& broadPhase() const { return broad_phase_; }
   // What the physics did in the last step: fast bodies swept back, solver stats.
   const PhysicsReport& physicsReport() const { return physics_.lastReport(); }
 
@@ -138,6 +158,7 @@ class World {
   void broadPhase(TickReport& report);
   void narrowPhase(const Budget& budget, TickReport& report);
   void response(double dt, TickReport& report);
+  void quarantine(TickReport& report);  // last: removes bodies beyond the limits
   Aabb boxOf(std::size_t index) const;
   void invalidateLastTick();
 
@@ -167,6 +188,7 @@ class World {
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
   std::vector<Contact> contacts_;
   Physics physics_;  // integration and response (response.hpp), warm-start state
+  std::vector<QuarantinedEntity> quarantined_;  // by the last step
 };
 
 }  // namespace stc
