@@ -122,7 +122,8 @@ class World {
   void clear();  // removes every entity, keeps shapes
 
   // Throws InputError("dt") only. A body whose state leaves the limits during
-  // the tick is removed at its end (see quarantined()); the rest goes on.
+  // the tick is removed at its end (see quarantined()); the rest goes on. A
+  // state edited through bodies() is checked the same way before the tick.
   TickReport step(double dt, const Budget& budget);
   // The entities the last step removed, with the reason.
   const std::vector<QuarantinedEntity>& quarantined() const { return quarantined_; }
@@ -158,7 +159,7 @@ class World {
   void broadPhase(TickReport& report);
   void narrowPhase(const Budget& budget, TickReport& report);
   void response(double dt, TickReport& report);
-  void quarantine(TickReport& report);  // last: removes bodies beyond the limits
+  void quarantine(TickReport& report);  // first and last: removes bodies beyond the limits
   Aabb boxOf(std::size_t index) const;
   void invalidateLastTick();
 

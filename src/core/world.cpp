@@ -230,6 +230,8 @@ TickReport World::step(double dt, const Budget& budget) {
   if (!(std::isfinite(dt) && dt >= 0.0)) throw InputError("dt", "must be finite and >= 0");
   TickReport report;
   report.entities = ids_.size();
+  quarantined_.clear();
+  quarantine(report);  // states edited through bodies() since the last step
   const auto t0 = Clock::now();
   integrate(dt, report);
   const auto t1 = Clock::now();
@@ -360,7 +362,7 @@ void World::response(double dt, TickReport& /*report*/) {
 // state, and named in quarantined(). Removing invalidates this tick's
 // contacts (they name dense indices); the rest of the world is untouched.
 void World::quarantine(TickReport& report) {
-  quarantined_.clear();
+  const std::size_t first = quarantined_.size();
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     if (bodies_[i].is_static) continue;  // never moves: checked at input
     const Quarantine reason = quarantineReason(bodies_[i], config_.limits);
@@ -368,8 +370,8 @@ void World::quarantine(TickReport& report) {
     quarantined_.push_back({ids_[i], names_[i], body_shapes_[i], reason});
     ++(reason == Quarantine::LeftWorld ? report.left_world : report.quarantined);
   }
-  for (const QuarantinedEntity& q : quarantined_) removeEntity(q.id);
-  if (quarantined_.empty()) return;
+  if (quarantined_.size() == first) return;
+  for (std::size_t q = first; q < quarantined_.size(); ++q) removeEntity(quarantined_[q].id);
   report.entities = ids_.size();
   report.contacts = contacts_.size();
 }

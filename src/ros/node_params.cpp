@@ -53,7 +53,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   readParam(nh, "world_frame", p.world_frame);
   if (p.world_frame.empty()) throw InputError("world_frame", "must not be empty");
   p.rate = positiveParam(nh, "rate", p.rate);
-  if (p.rate > 10000.0) throw InputError("rate", "must be <= 10000 Hz");
+  if (p.rate > 10000.0 || p.rate < 0.01) throw InputError("rate", "must be in [0.01, 10000] Hz");
   p.marker_rate = positiveParam(nh, "marker_rate", p.marker_rate);
   if (readParam(nh, "marker_levels", p.marker_levels)) {
     for (int level : p.marker_levels) {
