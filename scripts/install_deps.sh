@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libfcl-dev libgtest-dev googletest
   python3-matplotlib
   libbullet-dev  # benchmarks only: bench_bullet_compare (skipped when absent)
+  clang libfuzzer-14-dev
   rviz xvfb xauth imagemagick x11-utils
   catkin-lint
 )

@@ -21,7 +21,8 @@ struct Camera {
   int height = 720;
   double fov_y_deg = 60.0;  // vertical field of view
 };
-// Throws InputError naming "width", "height", "fov_y_deg", or "camera_pose".
+// Throws InputError naming "width", "height", "fov_y_deg", or "camera_pose"
+// (not finite, a coordinate beyond 1e9 m, not a unit quaternion).
 void validateCamera(const Camera& camera);
 
 // Optical-frame pose of a camera at `eye` looking at `target`, image "up"
@@ -63,7 +64,8 @@ class Perception {
 
   static constexpr double kNearDepth = 1e-6;  // metres; nearer points do not project
 
-  // Pixel of a world point; nullopt when it is behind (or on) the camera plane.
+  // Pixel of a world point; nullopt when it is behind (or on) the camera plane
+  // or so far out that its pixel is not finite.
   std::optional<Vec2> project(const Vec3& world) const;
   // Depth along the optical axis; nullopt when <= kNearDepth.
   std::optional<double> depthOf(const Vec3& world) const;

@@ -37,6 +37,8 @@ class SweepAndPrune {
   // Aabb::overlaps) as of the last update(), in no particular order.
   const std::vector<BroadPair>& pairs() const { return pairs_; }
   std::size_t size() const;
+  // The box last given for an entity (by add or setBox); unknown id throws InputError("id").
+  Aabb box(EntityId id) const;
   // Endpoint swaps done by the last update(): the measure of coherence.
   std::size_t lastSwapCount() const { return last_swaps_; }
 

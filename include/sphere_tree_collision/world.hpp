@@ -6,6 +6,7 @@
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/limits.hpp"
 #include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
 #include "sphere_tree_collision/response.hpp"
@@ -44,6 +45,7 @@ struct WorldConfig {
   VoxelLimits voxel_limits;
   std::size_t max_entities = 20000;
   ResponseOptions response;
+  PhysicalLimits limits;  // inputs beyond them are rejected; bodies beyond them quarantined
 };
 
 struct EntitySpec {
@@ -90,6 +92,18 @@ struct TickReport {
   double geometric_bound = 0.0;         // sum of rigorous bounds h_a + h_b over the same pairs
   double perceived_inaccuracy = 0.0;    // P: sum of f(e, g) over the same pairs
   std::size_t contacts = 0;
+  // Removed at the end of the tick (World::quarantined() names them): state
+  // non-finite or beyond the limits, and, apart, bodies that left the world.
+  std::size_t quarantined = 0;
+  std::size_t left_world = 0;
+};
+
+// One entity removed at the end of a tick, and why.
+struct QuarantinedEntity {
+  EntityId id = kInvalidEntity;
+  std::string name;
+  ShapeId shape = 0;
+  Quarantine reason = Quarantine::None;
 };
 
 struct ShapeInfo {
@@ -116,17 +130,22 @@ class World {
 
   // Throws InputError naming the field ("shape", "pose.position",
   // "pose.orientation", "linear_velocity", "angular_velocity", "density",
-  // "material.restitution", "material.friction", "name", "max_entities");
-  // on throw nothing changes.
+  // "material.restitution", "material.friction", "name", "max_entities") and,
+  // for a value beyond config().limits, the limit; on throw nothing changes.
   EntityId addEntity(const EntitySpec& spec);
   bool removeEntity(EntityId id);
   std::optional<EntityId> findByName(const std::string& name) const;
   void clear();  // removes every entity, keeps shapes
 
+  // Throws InputError("dt") only. A body whose state leaves the limits during
+  // the tick is removed at its end (see quarantined()); the rest goes on. A
+  // state edited through bodies() is checked the same way before the tick.
   TickReport step(double dt, const Budget& budget);
   // Time source of step(): phase times and deadlines (default steadySeconds).
   // A fake clock makes time budgets deterministic in tests.
   void setClock(SecondsClock clock) { clock_ = std::move(clock); }
+  // The entities the last step removed, with the reason.
+  const std::vector<QuarantinedEntity>& quarantined() const { return quarantined_; }
 
   Perception& perception() { return perception_; }
   const Perception& perception() const { return perception_; }
@@ -148,6 +167,8 @@ class World {
   const std::vector<PairTest>& pairTests() const { return pair_tests_; }
   std::size_t pairCount() const { return pair_count_; }
   const std::vector<Contact>& contacts() const { return contacts_; }
+  // The broad phase: its pairs and boxes as of the last step (checks and tests).
+  const SweepAndPrune& broadPhase() const { return broad_phase_; }
   // What the physics did in the last step: fast bodies swept back, solver stats.
   const PhysicsReport& physicsReport() const { return physics_.lastReport(); }
 
@@ -159,6 +180,7 @@ class World {
   // Returns the clock when the scheduler stopped (what follows is not interruptible).
   double narrowPhase(const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
   void response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report);
+  void quarantine(TickReport& report);  // first and last: removes bodies beyond the limits
   Aabb boxOf(std::size_t index) const;
   Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
@@ -191,6 +213,7 @@ class World {
   Physics physics_;  // integration and response (response.hpp), warm-start state
   SecondsClock clock_ = steadySeconds;
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
+  std::vector<QuarantinedEntity> quarantined_;  // by the last step
 };
 
 }  // namespace stc

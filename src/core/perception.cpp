@@ -25,6 +25,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxImageSide = 1 << 16;        // pixels; larger is a unit mistake
 constexpr double kOrientationNormTol = 1e-3;  // |q| may be off by this much, then normalised
+// Metres from the origin: farther, projections of the scene overflow (found by fuzz_gaze).
+constexpr double kMaxCameraCoordinate = 1e9;
 
 }  // namespace
 
@@ -41,8 +43,8 @@ void validateCamera(const Camera& camera) {
     throw InputError("fov_y_deg", "must be finite and in (0, 180) degrees");
   }
   const Pose& pose = camera.camera_to_world;
-  if (!pose.position.allFinite()) {
-    throw InputError("camera_pose", "position must be finite");
+  if (!pose.position.allFinite() || pose.position.cwiseAbs().maxCoeff() > kMaxCameraCoordinate) {
+    throw InputError("camera_pose", "position must be finite, each coordinate within 1e9 m");
   }
   if (!pose.orientation.coeffs().allFinite() ||
       std::abs(pose.orientation.norm() - 1.0) > kOrientationNormTol) {
@@ -110,8 +112,9 @@ std::optional<Vec2> Perception::project(const Vec3& world) const {
   const Vec3 c = world_to_camera_rotation_ * (world - camera_position_);
   if (!(c.z() > kNearDepth)) return std::nullopt;
   const double inv_z = 1.0 / c.z();
-  return Vec2(0.5 * camera_.width + focal_px_ * c.x() * inv_z,
-              0.5 * camera_.height + focal_px_ * c.y() * inv_z);
+  const Vec2 pixel(0.5 * camera_.width + focal_px_ * c.x() * inv_z, 0.5 * camera_.height + focal_px_ * c.y() * inv_z);
+  if (!pixel.allFinite()) return std::nullopt;  // a point too far out to have a pixel (found by fuzz_gaze)
+  return pixel;
 }
 
 Perception::GazeWeight Perception::gazeWeight(const Vec3& world) const {

@@ -537,6 +537,17 @@ bool SweepAndPrune::contains(EntityId id) const {
   return impl_->slot_of_id.find(id) != FlatHashMap::kMissing;
 }
 
+Aabb SweepAndPrune::box(EntityId id) const {
+  const Impl& m = *impl_;
+  const std::uint32_t slot = m.slotOfId(id);
+  Aabb out;
+  for (int a = 0; a < 3; ++a) {
+    out.min[a] = m.spans[a][slot].min;
+    out.max[a] = m.spans[a][slot].max;
+  }
+  return out;
+}
+
 void SweepAndPrune::setBox(EntityId id, const Aabb& box) {
   Impl& m = *impl_;
   // Fast path without the hash lookup: the slot after the last one set.

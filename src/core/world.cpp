@@ -13,10 +13,6 @@ namespace {
 // factor a tick: it follows rises at once and halves in about 14 ticks.
 constexpr double kReserveDecay = 0.95;
 
-// A unit quaternion may be off by this much before normalisation; more means
-// the caller passed something that is not a rotation.
-constexpr double kOrientationNormTolerance = 1e-3;
-
 // Auto box mode: a shape whose occupied extent is this much longer along its
 // longest axis than along its shortest gets a dynamic box (paper 3.2: long,
 // thin objects are bounded badly by a fixed cube). With the presets at
@@ -59,14 +55,13 @@ bool isElongated(const VoxelShape& shape) {
   return extent.maxCoeff() >= kElongationRatio * extent.minCoeff();
 }
 
-void requireFinite(const Vec3& v, const char* field) {
-  if (!allFinite(v)) throw InputError(field, "must be finite");
-}
-
 }  // namespace
 
 World::World(const WorldConfig& config)
-    : config_(config), scheduler_(makeScheduler(config.scheduler)) {}
+    : config_(config), scheduler_(makeScheduler(config.scheduler)) {
+  validateLimits(config_.limits);
+  validateGravity(config_.gravity, config_.limits);
+}
 World::~World() = default;
 World::World(World&&) noexcept = default;
 World& World::operator=(World&&) noexcept = default;
@@ -121,23 +116,8 @@ EntityId World::addEntity(const EntitySpec& spec) {
   if (spec.shape >= shapes_.size()) {
     throw InputError("shape", "unknown shape id " + std::to_string(spec.shape));
   }
-  requireFinite(spec.pose.position, "pose.position");
-  const double q_norm = spec.pose.orientation.coeffs().norm();
-  if (!spec.pose.orientation.coeffs().allFinite() ||
-      std::abs(q_norm - 1.0) > kOrientationNormTolerance) {
-    throw InputError("pose.orientation", "must be a unit quaternion (|q| = " + std::to_string(q_norm) + ")");
-  }
-  requireFinite(spec.linear_velocity, "linear_velocity");
-  requireFinite(spec.angular_velocity, "angular_velocity");
-  if (!(std::isfinite(spec.density) && spec.density > 0.0)) {
-    throw InputError("density", "must be finite and > 0");
-  }
-  if (!(spec.material.restitution >= 0.0 && spec.material.restitution <= 1.0)) {
-    throw InputError("material.restitution", "must be in [0, 1]");
-  }
-  if (!(std::isfinite(spec.material.friction) && spec.material.friction >= 0.0)) {
-    throw InputError("material.friction", "must be finite and >= 0");
-  }
+  validateBodyInput(spec.pose, spec.linear_velocity, spec.angular_velocity, spec.density,
+                    spec.material, config_.limits);
   if (!spec.name.empty() && id_by_name_.count(spec.name) != 0) {
     throw InputError("name", "'" + spec.name + "' is already used");
   }
@@ -247,6 +227,8 @@ TickReport World::step(double dt, const Budget& budget) {
   if (!(std::isfinite(dt) && dt >= 0.0)) throw InputError("dt", "must be finite and >= 0");
   TickReport report;
   report.entities = ids_.size();
+  quarantined_.clear();
+  quarantine(report);  // states edited through bodies() since the last step
   const double t0 = clock_();
   const bool timed_tick = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
   const Deadline tick_end = timed_tick ? Deadline(&clock_, t0 + std::max(budget.tick_seconds, 0.0)) : Deadline();
@@ -270,6 +252,7 @@ TickReport World::step(double dt, const Budget& budget) {
   report.total_s = t4 - t0;
   report.contacts = contacts_.size();
   reserve_s_ = std::max(t4 - scheduled - report.response_refinement_s, kReserveDecay * reserve_s_);
+  quarantine(report);
   return report;
 }
 
@@ -416,6 +399,25 @@ void World::response(double dt, const Budget& budget, const Deadline& tick_end, 
   report.velocity_passes = stats.velocity_passes;
   report.position_passes = stats.position_passes;
   report.response_refinement_s = stats.refinement_seconds;
+}
+
+// A body the tick left non-finite or beyond the limits (an explosion, a
+// solver blow-up, a fall forever) is removed here, before anything reads its
+// state, and named in quarantined(). Removing invalidates this tick's
+// contacts (they name dense indices); the rest of the world is untouched.
+void World::quarantine(TickReport& report) {
+  const std::size_t first = quarantined_.size();
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_[i].is_static) continue;  // never moves: checked at input
+    const Quarantine reason = quarantineReason(bodies_[i], config_.limits);
+    if (reason == Quarantine::None) continue;
+    quarantined_.push_back({ids_[i], names_[i], body_shapes_[i], reason});
+    ++(reason == Quarantine::LeftWorld ? report.left_world : report.quarantined);
+  }
+  if (quarantined_.size() == first) return;
+  for (std::size_t q = first; q < quarantined_.size(); ++q) removeEntity(quarantined_[q].id);
+  report.entities = ids_.size();
+  report.contacts = contacts_.size();
 }
 
 }  // namespace stc

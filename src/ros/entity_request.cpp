@@ -55,10 +55,6 @@ stc::ShapeId gridShape(stc::World& world, ExplicitGrid grid) {
   }
 }
 
-void checkFinite(const stc::Vec3& v, const char* field) {
-  if (!v.allFinite()) throw stc::InputError(field, "not finite");
-}
-
 }  // namespace
 
 stc::EntityId addRequest(stc::World& world, EntityRequest request) {
@@ -67,26 +63,9 @@ stc::EntityId addRequest(stc::World& world, EntityRequest request) {
     throw stc::InputError("name", "'" + request.spec.name + "' is already taken");
   }
   // Cheap state checks before any shape work: bad input builds nothing.
-  checkFinite(request.spec.pose.position, "pose.position");
-  checkFinite(request.spec.linear_velocity, "linear_velocity");
-  checkFinite(request.spec.angular_velocity, "angular_velocity");
-  const stc::Quat& q = request.spec.pose.orientation;
-  if (!q.coeffs().allFinite()) throw stc::InputError("pose.orientation", "not finite");
-  if (std::abs(q.norm() - 1.0) > 1e-3) {
-    throw stc::InputError("pose.orientation", "quaternion norm " + std::to_string(q.norm()) +
-                                                  " is not 1 (tolerance 1e-3)");
-  }
-  request.spec.pose.orientation.normalize();
-  if (!(request.spec.density > 0.0) || !std::isfinite(request.spec.density)) {
-    throw stc::InputError("density", "must be finite and > 0");
-  }
-  const stc::Material& m = request.spec.material;
-  if (!(m.restitution >= 0.0 && m.restitution <= 1.0)) {
-    throw stc::InputError("material.restitution", "must be in [0, 1]");
-  }
-  if (!(m.friction >= 0.0) || !std::isfinite(m.friction)) {
-    throw stc::InputError("material.friction", "must be finite and >= 0");
-  }
+  const stc::EntitySpec& spec = request.spec;
+  stc::validateBodyInput(spec.pose, spec.linear_velocity, spec.angular_velocity, spec.density, spec.material,
+                         world.config().limits);
   if (request.color) {
     for (float c : *request.color) {
       if (!(c >= 0.0f && c <= 1.0f)) throw stc::InputError("color", "components must be in [0, 1]");

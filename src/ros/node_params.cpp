@@ -19,7 +19,9 @@ const std::set<std::string>& knownParams() {
       "max_contact_markers", "contact_marker_size", "detection_budget", "sphere_test_budget", "tick_budget", "scheduler", "queue_count", "queue_ratio",
       "unresolved_policy", "max_entities", "max_voxels", "tree_levels", "sphere_fit", "gravity",
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
-      "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y"};
+      "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
+      "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
+      "min_voxel_size", "max_voxel_size"};
   return kNames;
 }
 
@@ -52,7 +54,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   readParam(nh, "world_frame", p.world_frame);
   if (p.world_frame.empty()) throw InputError("world_frame", "must not be empty");
   p.rate = positiveParam(nh, "rate", p.rate);
-  if (p.rate > 10000.0) throw InputError("rate", "must be <= 10000 Hz");
+  if (p.rate > 10000.0 || p.rate < 0.01) throw InputError("rate", "must be in [0.01, 10000] Hz");
   p.marker_rate = positiveParam(nh, "marker_rate", p.marker_rate);
   if (readParam(nh, "marker_levels", p.marker_levels)) {
     for (int level : p.marker_levels) {
@@ -101,7 +103,23 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
       intParamIn(nh, "max_entities", static_cast<int>(p.world.max_entities), 1, 10000000));
   int max_voxels = static_cast<int>(p.world.voxel_limits.max_voxels);
   p.world.voxel_limits.max_voxels = intParamIn(nh, "max_voxels", max_voxels, 1, 1 << 30);
+  stc::PhysicalLimits& limits = p.world.limits;
+  limits.max_speed = positiveParam(nh, "max_speed", limits.max_speed);
+  limits.max_spin = positiveParam(nh, "max_spin", limits.max_spin);
+  limits.world_extent = positiveParam(nh, "world_extent", limits.world_extent);
+  limits.min_density = positiveParam(nh, "min_density", limits.min_density);
+  limits.max_density = positiveParam(nh, "max_density", limits.max_density);
+  limits.max_friction = positiveParam(nh, "max_friction", limits.max_friction);
+  limits.max_gravity = positiveParam(nh, "max_gravity", limits.max_gravity);
+  stc::validateLimits(limits);  // its fields are named as the parameters
+  stc::VoxelLimits& voxels = p.world.voxel_limits;
+  voxels.min_voxel_size = positiveParam(nh, "min_voxel_size", voxels.min_voxel_size);
+  voxels.max_voxel_size = positiveParam(nh, "max_voxel_size", voxels.max_voxel_size);
+  if (voxels.min_voxel_size > voxels.max_voxel_size) {
+    throw InputError("min_voxel_size", "is above ~max_voxel_size " + std::to_string(voxels.max_voxel_size));
+  }
   p.gravity = vec3Param(nh, "gravity");
+  if (p.gravity) stc::validateGravity(*p.gravity, limits);
   readParam(nh, "response", p.world.response.enabled);
   p.world.response.iterations = intParamIn(nh, "solver_iterations", p.world.response.iterations, 1, 1000);
   parsed("solver_iterations", [&] { stc::validateResponseOptions(p.world.response); return 0; });

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 
 namespace stc_ros {
@@ -50,6 +51,22 @@ stc::Vec3 gazeTarget(const stc::World& world, const stc::Vec3& origin, const stc
   return origin + 5.0 * dir;
 }
 
+// What an exception caught by catch (...) says.
+std::string causeOf(const std::exception_ptr& error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "an exception that is not a std::exception";
+  }
+}
+
+bool isFinite(const stc::Contact& c) {
+  return c.point.allFinite() && c.normal.allFinite() && std::isfinite(c.depth) && std::isfinite(c.gap_bound) &&
+         std::isfinite(c.priority);
+}
+
 // Unknown names are warned about first: a typo may be why a value is missing.
 NodeParams readParamsWarningUnknown(const ros::NodeHandle& private_nh) {
   for (const std::string& name : unknownParams(private_nh)) {
@@ -89,12 +106,15 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   marker_options_.contact_size = params_.contact_marker_size;
   if (params_.marker_mode == NodeParams::MarkerMode::Incremental) {
     markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>(
-        "markers", 100, [this](const ros::SingleSubscriberPublisher& s) { sendMarkerSnapshot(s); });
+        "markers", 100, [this](const ros::SingleSubscriberPublisher& s) {
+          guarded("marker snapshot", [&] { sendMarkerSnapshot(s); });
+        });
   } else {
     markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
   }
   contacts_pub_ = nh_.advertise<sphere_tree_collision::ContactArray>("contacts", 10);
   stats_pub_ = nh_.advertise<sphere_tree_collision::TickStats>("tick_stats", 10);
+  quarantined_pub_ = nh_.advertise<sphere_tree_collision::Quarantined>("quarantined", 100);
   if (params_.publish_tf) tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
   spawn_sub_ = nh_.subscribe("spawn", 1000, &WorldNode::onSpawn, this);
   despawn_sub_ = nh_.subscribe("despawn", 1000, &WorldNode::onDespawn, this);
@@ -131,7 +151,11 @@ stc::Pose WorldNode::loadScene() {
       throw stc::InputError(e.field() == "scene" ? "scene" : "scene " + e.field(), reasonOf(e));
     }
     config.gravity = params_.gravity ? *params_.gravity : scene.gravity;
-    world_ = stc::World(config);
+    try {
+      world_ = stc::World(config);  // checks the scene's gravity against ~max_gravity
+    } catch (const stc::InputError& e) {
+      throw stc::InputError("scene " + e.field(), reasonOf(e));
+    }
     std::vector<stc::EntityId> ids;
     try {
       ids = addScene(world_, scene);
@@ -172,12 +196,28 @@ stc::Pose WorldNode::loadScene() {
 // ---------------------------------------------------------------------------------
 // Tick
 
+template <typename F>
+void WorldNode::guarded(const char* what, F&& callback) {
+  try {
+    callback();
+  } catch (...) {
+    ++callback_errors_;
+    ROS_ERROR_THROTTLE(5.0, "%s failed: %s (%llu caught so far; the node goes on)", what,
+                       causeOf(std::current_exception()).c_str(), static_cast<unsigned long long>(callback_errors_));
+  }
+}
+
 void WorldNode::tick() {
+  guarded("tick", [this] { runTick(); });
+}
+
+void WorldNode::runTick() {
   const ros::Time now = ros::Time::now();
   if (camera_from_tf_ || tf_buffer_) updateCameraFromTf();
   expireGaze(now);
   const stc::TickReport report = world_.step(dt_, budget_);
   ++tick_;
+  for (const stc::QuarantinedEntity& q : world_.quarantined()) onQuarantined(q, now);
   publishStats(report, now);
   publishContacts(now);
   publishTf(now);
@@ -189,6 +229,37 @@ void WorldNode::tick() {
                     report.unresolved, report.unresolved_accepted, static_cast<long long>(report.sphere_tests),
                     report.contacts, report.total_s * 1e3, world_.perception().hasFixation() ? "on" : "off",
                     static_cast<unsigned long long>(rejected_[0] + rejected_[1] + rejected_[2] + rejected_[3]));
+}
+
+void WorldNode::onQuarantined(const stc::QuarantinedEntity& q, const ros::Time& stamp) {
+  const auto frame = frames_.find(q.id);
+  const std::string name = frame != frames_.end() ? frame->second : entityFrame(q.id, q.name);
+  const bool left = q.reason == stc::Quarantine::LeftWorld;
+  ++(left ? left_world_total_ : quarantined_total_);
+  last_quarantine_ = name + ": " + stc::toString(q.reason);
+  if (left) {
+    ROS_INFO_THROTTLE(1.0, "removed %s: left the world (|coordinate| > ~world_extent %g m)", name.c_str(),
+                      params_.world.limits.world_extent);
+  } else {
+    ROS_WARN_THROTTLE(1.0, "quarantined %s: %s (%llu so far)", name.c_str(), stc::toString(q.reason),
+                      static_cast<unsigned long long>(quarantined_total_));
+  }
+  if (quarantined_pub_.getNumSubscribers() > 0) {
+    sphere_tree_collision::Quarantined msg;
+    msg.header.stamp = stamp;
+    msg.header.frame_id = params_.world_frame;
+    msg.id = q.id;
+    msg.frame = name;
+    msg.reason = stc::toString(q.reason);
+    quarantined_pub_.publish(msg);
+  }
+  forget(q.id, q.shape, false);  // static bodies never move, so are never quarantined
+}
+
+void WorldNode::forget(stc::EntityId id, stc::ShapeId shape, bool is_static) {
+  if (markers_sent_.erase(id) != 0) markers_removed_.push_back({id, shape, is_static});
+  colors_.erase(id);
+  frames_.erase(id);
 }
 
 void WorldNode::updateCameraFromTf() {
@@ -209,7 +280,7 @@ void WorldNode::updateCameraFromTf() {
 }
 
 void WorldNode::expireGaze(const ros::Time& now) {
-  if (world_.perception().hasFixation() && now > gaze_expiry_) world_.perception().clearFixation();
+  if (world_.perception().hasFixation() && now.toSec() > gaze_expiry_s_) world_.perception().clearFixation();
 }
 
 void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
@@ -224,7 +295,7 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.response_ms = r.response_s * 1e3;
   s.total_ms = r.total_s * 1e3;
   s.scheduling_overhead_ms = r.scheduling_overhead_s * 1e3;
-  s.budget_ms = std::isfinite(budget_.seconds) ? budget_.seconds * 1e3 : std::numeric_limits<double>::infinity();
+  s.budget_ms = std::isfinite(budget_.seconds) ? budget_.seconds * 1e3 : -1.0;  // nothing non-finite is published
   s.budget_sphere_tests = params_.sphere_test_budget;
   s.scheduler = stc::toString(params_.world.scheduler.kind);
   s.perception_used = r.perception_used;
@@ -253,6 +324,12 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.rejected_inputs = rejected_[0] + rejected_[1] + rejected_[2] + rejected_[3];
   s.last_rejection = last_rejection_;
   s.gaze_active = world_.perception().hasFixation();
+  s.quarantined = static_cast<std::uint32_t>(r.quarantined);
+  s.left_world = static_cast<std::uint32_t>(r.left_world);
+  s.quarantined_total = quarantined_total_;
+  s.left_world_total = left_world_total_;
+  s.last_quarantine = last_quarantine_;
+  s.callback_errors = callback_errors_;
   stats_pub_.publish(s);
 }
 
@@ -262,9 +339,10 @@ void WorldNode::publishContacts(const ros::Time& stamp) {
   contacts_msg_.header.stamp = stamp;
   contacts_msg_.header.frame_id = params_.world_frame;
   contacts_msg_.contacts.resize(contacts.size());
-  for (std::size_t i = 0; i < contacts.size(); ++i) {
-    const stc::Contact& c = contacts[i];
-    auto& m = contacts_msg_.contacts[i];
+  std::size_t n = 0;
+  for (const stc::Contact& c : contacts) {
+    if (!isFinite(c)) continue;  // nothing non-finite is published
+    auto& m = contacts_msg_.contacts[n++];
     m.entity_a = c.a;
     m.entity_b = c.b;
     m.point = toPointMsg(c.point);
@@ -275,6 +353,7 @@ void WorldNode::publishContacts(const ros::Time& stamp) {
     m.resolved = c.resolved;
     m.priority = c.priority;
   }
+  contacts_msg_.contacts.resize(n);
   contacts_pub_.publish(contacts_msg_);
 }
 
@@ -283,15 +362,19 @@ void WorldNode::publishTf(const ros::Time& stamp) {
   const auto& ids = world_.entityIds();
   const auto& bodies = world_.bodies();
   tf_msg_.transforms.resize(ids.size());
+  std::size_t n = 0;
   for (std::size_t i = 0; i < ids.size(); ++i) {
-    auto& t = tf_msg_.transforms[i];
+    // Quarantine removed every non-finite body; this only guards the topic.
+    if (!bodies[i].pose.position.allFinite() || !bodies[i].pose.orientation.coeffs().allFinite()) continue;
+    auto& t = tf_msg_.transforms[n++];
     t.header.stamp = stamp;
     t.header.frame_id = params_.world_frame;
     t.child_frame_id = frames_[ids[i]];
     t.transform.translation = toVector3Msg(bodies[i].pose.position);
     t.transform.rotation = toQuaternionMsg(bodies[i].pose.orientation);
   }
-  if (!ids.empty()) tf_pub_.publish(tf_msg_);
+  tf_msg_.transforms.resize(n);
+  if (n != 0) tf_pub_.publish(tf_msg_);
 }
 
 void WorldNode::publishMarkers(const ros::Time& now) {
@@ -387,6 +470,10 @@ void WorldNode::reject(Input input, const std::string& field, const std::string&
   ROS_ERROR("rejected %s message: %s: %s", kInputTopics[k], field.c_str(), reason.c_str());
 }
 
+void WorldNode::rejectUnexpected(Input input) {
+  reject(input, "message", causeOf(std::current_exception()));
+}
+
 void WorldNode::onSpawn(const sphere_tree_collision::SpawnEntity& msg) {
   const bool is_preset = !msg.preset.empty();
   try {
@@ -398,28 +485,38 @@ void WorldNode::onSpawn(const sphere_tree_collision::SpawnEntity& msg) {
     ROS_DEBUG("spawned entity %u (%s)", id, frames_[id].c_str());
   } catch (const stc::InputError& e) {
     reject(Input::Spawn, spawnFieldOf(e.field(), is_preset), reasonOf(e));
+  } catch (...) {
+    rejectUnexpected(Input::Spawn);
   }
 }
 
 void WorldNode::onDespawn(const sphere_tree_collision::Despawn& msg) {
-  std::optional<stc::EntityId> id;
-  if (!msg.name.empty()) {
-    id = world_.findByName(msg.name);
-    if (!id) return reject(Input::Despawn, "name", "no entity named '" + msg.name + "'");
-  } else {
-    id = msg.id;
+  try {
+    std::optional<stc::EntityId> id;
+    if (!msg.name.empty()) {
+      id = world_.findByName(msg.name);
+      if (!id) throw stc::InputError("name", "no entity named '" + msg.name + "'");
+    } else {
+      id = msg.id;
+    }
+    const auto index = world_.indexOf(*id);
+    if (!index) throw stc::InputError("id", "no entity with id " + std::to_string(msg.id));
+    const stc::ShapeId shape = world_.bodyShapes()[*index];
+    const bool is_static = world_.bodies()[*index].is_static;
+    world_.removeEntity(*id);
+    forget(*id, shape, is_static);
+  } catch (const stc::InputError& e) {
+    reject(Input::Despawn, e.field(), reasonOf(e));
+  } catch (...) {
+    rejectUnexpected(Input::Despawn);
   }
-  const auto index = world_.indexOf(*id);
-  if (!index) return reject(Input::Despawn, "id", "no entity with id " + std::to_string(msg.id));
-  if (markers_sent_.erase(*id) != 0) {
-    markers_removed_.push_back({*id, world_.bodyShapes()[*index], world_.bodies()[*index].is_static});
-  }
-  world_.removeEntity(*id);
-  colors_.erase(*id);
-  frames_.erase(*id);
 }
 
 void WorldNode::onClear(const std_msgs::Empty&) {
+  guarded("clear", [this] { clearWorld(); });
+}
+
+void WorldNode::clearWorld() {
   ROS_INFO("clear: removing %zu entities", world_.entityCount());
   world_.clear();
   colors_.clear();
@@ -439,18 +536,21 @@ void WorldNode::setFixation(double x, double y, const ros::Time& stamp, const ch
   if (y < 0.0 || y > camera.height) {
     throw stc::InputError(y_field, "off screen: " + std::to_string(y) + " outside [0, " + std::to_string(camera.height) + "]");
   }
-  const ros::Time now = ros::Time::now();
-  const ros::Time when = stamp.isZero() ? now : stamp;
-  const double age = (now - when).toSec();
+  // In doubles: ros::Time / ros::Duration arithmetic throws near the ends of
+  // their range (stamp.sec = 4294967295), a double difference never does.
+  const double now = ros::Time::now().toSec();
+  const double when = stamp.isZero() ? now : stamp.toSec();
+  const double age = now - when;
   if (age > params_.gaze_timeout) {
     throw stc::InputError("header.stamp", "stale: " + std::to_string(age) + " s old (~gaze_timeout " +
                                               std::to_string(params_.gaze_timeout) + " s)");
   }
   if (-age > params_.gaze_timeout) {
-    throw stc::InputError("header.stamp", "in the future by " + std::to_string(-age) + " s");
+    throw stc::InputError("header.stamp", "in the future by " + std::to_string(-age) + " s (~gaze_timeout " +
+                                              std::to_string(params_.gaze_timeout) + " s)");
   }
   world_.perception().setFixation(stc::Vec2(x, y));
-  gaze_expiry_ = when + ros::Duration(params_.gaze_timeout);
+  gaze_expiry_s_ = when + params_.gaze_timeout;
 }
 
 void WorldNode::onGaze(const sphere_tree_collision::GazePoint& msg) {
@@ -458,6 +558,8 @@ void WorldNode::onGaze(const sphere_tree_collision::GazePoint& msg) {
     setFixation(msg.x, msg.y, msg.header.stamp, "x", "y");
   } catch (const stc::InputError& e) {
     reject(Input::Gaze, e.field(), reasonOf(e));
+  } catch (...) {
+    rejectUnexpected(Input::Gaze);
   }
 }
 
@@ -480,11 +582,17 @@ void WorldNode::onClickedPoint(const geometry_msgs::PointStamped& msg) {
         throw stc::InputError("header.frame_id", e.what());
       }
     }
+    const double extent = params_.world.limits.world_extent;
+    if (!(point.cwiseAbs().maxCoeff() <= extent)) {  // in the world frame, after tf
+      throw stc::InputError("point", "a coordinate is beyond ~world_extent " + std::to_string(extent) + " m");
+    }
     const auto pixel = world_.perception().project(point);
     if (!pixel) throw stc::InputError("point", "behind the camera");
     setFixation(pixel->x(), pixel->y(), ros::Time(0), "point", "point");
   } catch (const stc::InputError& e) {
     reject(Input::ClickedPoint, e.field(), reasonOf(e));
+  } catch (...) {
+    rejectUnexpected(Input::ClickedPoint);
   }
 }
 

@@ -121,6 +121,12 @@ TEST_F(BadInput, EveryMalformedKindIsRejectedByFieldAndNothingChanges) {
       {"spawn", "pose.position", spawn(spawnWith([](SpawnEntity& m) { m.pose.position.y = kInf; }))},
       {"spawn", "twist.linear", spawn(spawnWith([](SpawnEntity& m) { m.twist.linear.z = -kInf; }))},
       {"spawn", "twist.angular", spawn(spawnWith([](SpawnEntity& m) { m.twist.angular.x = kNaN; }))},
+      // Finite but beyond the limits (~world_extent, ~max_speed, ~max_spin, ~min_density).
+      {"spawn", "pose.position", spawn(spawnWith([](SpawnEntity& m) { m.pose.position.x = 1e300; }))},
+      {"spawn", "twist.linear", spawn(spawnWith([](SpawnEntity& m) { m.twist.linear.x = 1e308; }))},
+      {"spawn", "twist.angular", spawn(spawnWith([](SpawnEntity& m) { m.twist.angular.y = 1e308; }))},
+      {"spawn", "density", spawn(spawnWith([](SpawnEntity& m) { m.density = 5e-324; }))},
+      {"spawn", "density", spawn(spawnWith([](SpawnEntity& m) { m.density = 1e-310; }))},
       {"spawn", "occupancy", spawn(grid(2, 7, 1))},   // dims x data mismatch
       {"spawn", "occupancy", spawn(grid(2, 8, 0))},   // empty grid
       {"spawn", "voxel_size", spawn([] { auto m = grid(2, 8, 1); m.voxel_size = 0.0; return m; }())},
@@ -150,12 +156,18 @@ TEST_F(BadInput, EveryMalformedKindIsRejectedByFieldAndNothingChanges) {
       {"despawn", "name", [&] { sphere_tree_collision::Despawn d; d.name = "nobody"; despawn_.publish(d); }},
       {"gaze", "header.stamp", [&] { gaze_.publish(gaze(100, 100, 5.0)); }},   // stale
       {"gaze", "header.stamp", [&] { gaze_.publish(gaze(100, 100, -5.0)); }},  // from the future
+      {"gaze", "header.stamp", [&] {  // at the end of the time range: no ROS time arithmetic throws
+         auto g = gaze(100, 100, 0.0);
+         g.header.stamp.sec = 4294967295u;
+         gaze_.publish(g);
+       }},
       {"gaze", "x", [&] { gaze_.publish(gaze(5000, 100, 0.0)); }},             // off screen
       {"gaze", "y", [&] { gaze_.publish(gaze(100, -1, 0.0)); }},
       {"gaze", "x", [&] { gaze_.publish(gaze(kNaN, 100, 0.0)); }},
       {"clicked_point", "point", [&] { clicked_.publish(clicked(0.0, -10.0, 1.0)); }},  // behind the camera
       {"clicked_point", "point", [&] { clicked_.publish(clicked(50.0, 0.0, 0.5)); }},   // in front, off screen
       {"clicked_point", "point", [&] { clicked_.publish(clicked(kNaN, 0.0, 0.5)); }},
+      {"clicked_point", "point", [&] { clicked_.publish(clicked(0.0, 1e300, 0.5)); }},  // past ~world_extent
       {"clicked_point", "header.frame_id", [&] { clicked_.publish(clicked(0.0, 0.0, 0.5, "map")); }},
   };
 

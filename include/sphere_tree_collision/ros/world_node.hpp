@@ -2,7 +2,8 @@
 // on a steady timer, turns input messages into World calls (rejecting bad ones
 // by field name, counted in tick_stats) and World state into messages. Every
 // algorithm lives in the core; this class is glue only. Single-threaded: all
-// callbacks run from one spinner, so no locking.
+// callbacks run from one spinner, so no locking. No callback throws: whatever
+// escapes is logged, counted (tick_stats.callback_errors) and the node goes on.
 #pragma once
 
 #include "sphere_tree_collision/ros/marker_builder.hpp"
@@ -14,6 +15,7 @@
 #include <sphere_tree_collision/ContactArray.h>
 #include <sphere_tree_collision/Despawn.h>
 #include <sphere_tree_collision/GazePoint.h>
+#include <sphere_tree_collision/Quarantined.h>
 #include <sphere_tree_collision/SpawnEntity.h>
 #include <sphere_tree_collision/TickStats.h>
 #include <std_msgs/Empty.h>
@@ -37,8 +39,9 @@ class WorldNode {
   // reports it and exits non-zero rather than run on a guess.
   WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
 
-  // One tick: camera, gaze expiry, World::step, tick_stats / contacts / tf,
-  // and markers every ticks_per_marker_ ticks (~rate / ~marker_rate).
+  // One tick: camera, gaze expiry, World::step, quarantined bodies forgotten,
+  // tick_stats / contacts / tf, and markers every ticks_per_marker_ ticks
+  // (~rate / ~marker_rate). Never throws.
   void tick();
   void publishMarkers(const ros::Time& stamp);
   // Incremental marker mode: the whole scene (DELETEALL first), to one new
@@ -55,9 +58,19 @@ class WorldNode {
   void onSpawn(const sphere_tree_collision::SpawnEntity& msg);
   void onDespawn(const sphere_tree_collision::Despawn& msg);
   void onClear(const std_msgs::Empty& msg);
+  void clearWorld();
   void onGaze(const sphere_tree_collision::GazePoint& msg);
   void onClickedPoint(const geometry_msgs::PointStamped& msg);
   void reject(Input input, const std::string& field, const std::string& reason);
+  // In a catch (...) after the InputError one: anything else is a rejection too.
+  void rejectUnexpected(Input input);
+  // Runs a timer or connection callback; logs and counts what it throws.
+  template <typename F>
+  void guarded(const char* what, F&& callback);
+  void runTick();
+  void onQuarantined(const stc::QuarantinedEntity& q, const ros::Time& stamp);
+  // Drops what the node keeps of an entity the world no longer has.
+  void forget(stc::EntityId id, stc::ShapeId shape, bool is_static);
 
   // Sets the fixation from a pixel stamped `stamp` (zero: now), or throws InputError.
   void setFixation(double x, double y, const ros::Time& stamp, const char* x_field, const char* y_field);
@@ -85,8 +98,9 @@ class WorldNode {
   std::unordered_map<stc::EntityId, Rgba> colors_;
   std::unordered_map<stc::EntityId, std::string> frames_;
 
-  // Gaze: valid until gaze_expiry_ (stamp of the last fixation + gaze_timeout).
-  ros::Time gaze_expiry_;
+  // Gaze: valid until gaze_expiry_s_ (stamp of the last fixation + gaze_timeout),
+  // seconds as a double: ros::Time arithmetic throws near the ends of its range.
+  double gaze_expiry_s_ = 0.0;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;  // only with ~camera_frame
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   bool camera_from_tf_ = false;
@@ -95,6 +109,9 @@ class WorldNode {
   // Rejected inputs, total and per topic.
   std::uint64_t rejected_[4] = {0, 0, 0, 0};
   std::string last_rejection_;
+  // Removed by the world at the end of a tick, and exceptions caught.
+  std::uint64_t quarantined_total_ = 0, left_world_total_ = 0, callback_errors_ = 0;
+  std::string last_quarantine_;
 
   MarkerBuilder marker_builder_;
   MarkerOptions marker_options_;
@@ -115,7 +132,7 @@ class WorldNode {
   sphere_tree_collision::ContactArray contacts_msg_;
   tf2_msgs::TFMessage tf_msg_;
 
-  ros::Publisher markers_pub_, contacts_pub_, stats_pub_, tf_pub_;
+  ros::Publisher markers_pub_, contacts_pub_, stats_pub_, tf_pub_, quarantined_pub_;
   ros::Subscriber spawn_sub_, despawn_sub_, clear_sub_, gaze_sub_, clicked_sub_;
   ros::SteadyTimer tick_timer_;
 };

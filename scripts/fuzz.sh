@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (fuzz/fuzz_*.cpp) with clang, AddressSanitizer
+# and UndefinedBehaviorSanitizer in build_fuzz (or $STC_FUZZ_BUILD), then runs
+# each for $STC_FUZZ_SECONDS (default 15: about 60 s for the four) on its
+# committed seed corpus fuzz/corpus/<target>/ (read only; new inputs go to the
+# build directory). A finding (crash, sanitizer report, uncaught exception,
+# leak, timeout, out-of-memory) is saved as build_fuzz/findings/<target>-*.
+# Exit status 0: no finding; 1: at least one. Last line, for the test count:
+#   fuzz: 4 targets, 1234567 executions, 0 findings
+set -euo pipefail
+source "$(dirname "$0")/common.sh"
+build="${STC_FUZZ_BUILD:-$STC_ROOT/build_fuzz}"
+seconds="${STC_FUZZ_SECONDS:-15}"
+jobs="${STC_JOBS:-$(nproc)}"
+flags="-fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=all -fno-omit-frame-pointer -g"
+CC=clang CXX=clang++ cmake -S "$STC_ROOT" -B "$build" -DPYTHON_EXECUTABLE=/usr/bin/python3 \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCATKIN_ENABLE_TESTING=OFF -DSTC_FUZZ=ON \
+  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+targets=()
+for src in "$STC_ROOT"/fuzz/fuzz_*.cpp; do targets+=("$(basename "$src" .cpp)"); done
+cmake --build "$build" --target "${targets[@]}" -- -j"$jobs" >/dev/null
+
+export ASAN_OPTIONS="detect_leaks=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+mkdir -p "$build/findings"
+findings=0
+executions=0
+for target in "${targets[@]}"; do
+  name="${target#fuzz_}"
+  work="$build/corpus/$name"
+  mkdir -p "$work"
+  log="$build/$target.log"
+  dict=()
+  [ -f "$STC_ROOT/fuzz/$name.dict" ] && dict=(-dict="$STC_ROOT/fuzz/$name.dict")
+  status=0
+  "$build/fuzz/$target" "${dict[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+    -artifact_prefix="$build/findings/$name-" "$work" "$STC_ROOT/fuzz/corpus/$name" >"$log" 2>&1 || status=$?
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1 || true)
+  executions=$((executions + ${runs:-0}))
+  if [ "$status" -ne 0 ]; then
+    findings=$((findings + 1))
+    echo "fuzz: $target FINDING (exit $status), log: $log"
+    grep -m 1 -E 'ERROR|runtime error|invariant|terminate|Timeout|out-of-memory' "$log" || tail -n 20 "$log"
+  else
+    echo "fuzz: $target ok, ${runs:-0} executions, ${cov:-cov: ?} edges"
+  fi
+done
+echo "fuzz: ${#targets[@]} targets, $executions executions, $findings findings"
+[ "$findings" -eq 0 ]

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Builds the core and every gtest (test/unit) with AddressSanitizer and
+# UndefinedBehaviorSanitizer in a separate build directory and runs them.
+# Any sanitizer report or failed test fails the script. Usage:
+#   bash scripts/sanitize.sh            (build dir: build_sanitize, or $STC_SANITIZE_BUILD)
+# Last line: "sanitize: N gtests, M failed".
+set -euo pipefail
+source "$(dirname "$0")/common.sh"
+build="${STC_SANITIZE_BUILD:-$STC_ROOT/build_sanitize}"
+jobs="${STC_JOBS:-$(nproc)}"
+flags="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g"
+cmake -S "$STC_ROOT" -B "$build" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+  -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+tests=()
+for src in "$STC_ROOT"/test/unit/*.cpp; do tests+=("$(basename "$src" .cpp)"); done
+cmake --build "$build" --target "${tests[@]}" -- -j"$jobs"
+
+export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+failed=0
+for t in "${tests[@]}"; do
+  bin="$build/devel/lib/sphere_tree_collision/$t"
+  start=$(date +%s)
+  # Tests run from the source root, as catkin_add_gtest's WORKING_DIRECTORY does.
+  if (cd "$STC_ROOT" && "$bin" --gtest_brief=1 >"$build/$t.log" 2>&1); then
+    echo "sanitize: $t ok ($(( $(date +%s) - start )) s)"
+  else
+    failed=$((failed + 1))
+    echo "sanitize: $t FAILED ($(( $(date +%s) - start )) s), log: $build/$t.log"
+    tail -n 40 "$build/$t.log"
+  fi
+done
+echo "sanitize: ${#tests[@]} gtests, $failed failed"
+[ "$failed" -eq 0 ]
