@@ -48,11 +48,21 @@ struct TickStamps {
 
 TEST(Smoke, AdvertisedTypes) {
   ros::NodeHandle nh;
-  ASSERT_TRUE(stc_test::spinUntil([] { return stc_test::topicType("/tick_stats") != ""; }, stc_test::kLivenessSeconds));
-  EXPECT_EQ(stc_test::topicType("/markers"), "visualization_msgs/MarkerArray");
-  EXPECT_EQ(stc_test::topicType("/tick_stats"), "sphere_tree_collision/TickStats");
-  EXPECT_EQ(stc_test::topicType("/contacts"), "sphere_tree_collision/ContactArray");
-  EXPECT_EQ(stc_test::topicType("/tf"), "tf2_msgs/TFMessage");
+  const std::vector<std::pair<std::string, std::string>> expected = {
+      {"/markers", "visualization_msgs/MarkerArray"},
+      {"/tick_stats", "sphere_tree_collision/TickStats"},
+      {"/contacts", "sphere_tree_collision/ContactArray"},
+      {"/tf", "tf2_msgs/TFMessage"}};
+  // The node advertises them one after the other at start-up: wait for all.
+  ASSERT_TRUE(stc_test::spinUntil(
+      [&] {
+        for (const auto& [topic, type] : expected) {
+          if (stc_test::topicType(topic).empty()) return false;
+        }
+        return true;
+      },
+      stc_test::kLivenessSeconds));
+  for (const auto& [topic, type] : expected) EXPECT_EQ(stc_test::topicType(topic), type) << topic;
 }
 
 TEST(Smoke, MarkersEveryFewTicks) {

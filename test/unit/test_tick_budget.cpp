@@ -188,8 +188,9 @@ TEST(TickBudget, NarrowPhaseGetsWhatTheFixedPhasesAndTheReserveLeave) {
     const TickReport r = w.step(kDt, Budget::ofTickSeconds(tick));
     EXPECT_EQ(r.tick_budget_s, tick);
     EXPECT_GE(r.reserve_s, 0.0);
-    EXPECT_NEAR(r.narrow_budget_s, std::max(0.0, tick - r.integrate_s - r.broad_s - r.reserve_s), 1e-12);
-    EXPECT_NEAR(r.response_budget_s, std::max(0.0, tick - r.integrate_s - r.broad_s - r.narrow_s), 1e-12);
+    EXPECT_NEAR(r.narrow_budget_s, std::max(0.0, tick - r.integrate_s - r.broad_s - r.sweep_s - r.reserve_s), 1e-12);
+    EXPECT_NEAR(r.response_budget_s,
+                std::max(0.0, tick - r.integrate_s - r.broad_s - r.sweep_s - r.narrow_s), 1e-12);
     if (i == 0) EXPECT_GT(r.reserve_s, 0.0);  // measured by the unlimited ticks before
     if (r.interrupted && r.narrow_budget_s > 0.0) {
       interrupted_with_time = true;
