@@ -249,7 +249,7 @@ struct SweepStats {
 struct SweepHit {
   double t = 1.0;              // fraction of the tick at the hit; 1: none
   std::uint32_t pair = 0;      // index into the candidate pairs
-  Vec3 point = Vec3::Zero();   // between the two leaf boxes at the hit
+  Vec3 point = Vec3::Zero();   // halfway between the two leaf boxes' faces, below the held body's box centre
   Vec3 normal = Vec3::UnitZ(); // face axis the boxes met on, from pairs[pair][0] towards [1]
 };
 
