@@ -45,9 +45,9 @@ struct Sweeper {
   // sliding over a floor would keep running into the spheres ahead.
   // A hit that the discrete step handles is not one: while the boxes overlap
   // this tick they never get deeper than the thinner box's half extent (its
-  // centre does not cross the other box.s face). A body grazing a wall or sliding
-  // over a tiled floor keeps its motion; only one that would pass through or
-  // sink in is held back. The depth (shallowest axis) is concave in t: taken
+  // centre does not cross the other box's face). A body grazing a wall or
+  // sliding over a tiled floor keeps its motion; only one that would pass
+  // through or sink in is held back. The depth (shallowest axis) is concave in t: taken
   // at the middle and the end of the overlap.
   //
   // On a hit, `n` is the face axis the boxes met on (from the first towards
@@ -203,10 +203,10 @@ SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pos
   if (scratch.fast.size() != bodies.size()) return stats;  // markFastBodies not run on these bodies
   for (const std::uint8_t f : scratch.fast) stats.fast_bodies += f;
   if (stats.fast_bodies == 0) return stats;
-  // Every pair sees the end poses of this integration: the result does not
-  // depend on the pair order.
-  // Each pair is swept once, in the relative motion of its two bodies; the hit
-  // holds back whichever of them is fast.
+  // Each pair is swept once, in the relative motion of its two bodies, and
+  // the hit holds back whichever of them is fast. Every pair sees the poses
+  // of this integration (bodies are put back after all pairs): the result
+  // does not depend on the pair order.
   for (std::size_t k = 0; k < pair_count; ++k) {
     const std::uint32_t a = pairs[k][0];
     const std::uint32_t b = pairs[k][1];
