@@ -177,9 +177,9 @@ struct SolveBudget {
 // lets the bodies close at most s/dt this tick) and Coulomb friction
 // (circular cone, friction = sqrt(mu_a mu_b)), iterated with rows ordered up
 // the contact graph from the static bodies; then shock propagation (see
-// ResponseOptions); then restitution (e = max(e_a, e_b)) in its own pass for
-// contacts that were approaching faster than the threshold before the solve
-// and took an impulse in it, every other contact still holding (a bounce
+// ResponseOptions). Restitution (e = max(e_a, e_b)) comes first, as
+// collisions: contacts approaching faster than the threshold that close their
+// gap this tick are bounced in waves before the solve (collide(); a bounce
 // across a speculative gap also closes the gap, so it starts at the surface).
 // Position correction by split impulse: pseudo-velocities that move the
 // bodies out of penetration beyond the slop and are then discarded, so no
@@ -217,6 +217,10 @@ class ContactSolver {
     double lambda[3] = {0.0, 0.0, 0.0};
     double lambda_main = 0.0;  // normal impulse before restitution (what warm starts)
     double lambda_push = 0.0;
+    double bounce_from = 0.0;  // normal velocity its bounce reverses (< 0), in its wave
+    double lambda_wave = 0.0;  // impulse of the current restitution wave
+    double bounce_impulse = 0.0;  // of all its restitution waves (before the solve)
+    int wave = -1;             // restitution wave it bounced in (-1: none)
     bool bounced = false;      // took a restitution impulse this tick
   };
   struct Cached {
@@ -236,7 +240,7 @@ class ContactSolver {
   int affordableIterations(const ResponseOptions& options, int cap, double pass_seconds,
                            double seconds_left) const;
   void propagateShock(const ResponseOptions& options);
-  void applyRestitution(const ResponseOptions& options, SolveStats& stats);
+  void collide(const ResponseOptions& options, SolveStats& stats);
   int solvePositions(const ResponseOptions& options, const Deadline& deadline);
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
 
@@ -270,7 +274,7 @@ struct SweepStats {
 struct SweepHit {
   double t = 1.0;              // fraction of the tick at the hit; 1: none
   std::uint32_t pair = 0;      // index into the candidate pairs
-  Vec3 point = Vec3::Zero();   // between the two leaf boxes at the hit
+  Vec3 point = Vec3::Zero();   // halfway between the two leaf boxes' faces, below the held body's box centre
   Vec3 normal = Vec3::UnitZ(); // face axis the boxes met on, from pairs[pair][0] towards [1]
 };
 

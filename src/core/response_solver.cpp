@@ -218,7 +218,7 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
           }
         };
         Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
-        const double limit = row.friction * row.lambda[0];
+        const double limit = row.friction * (row.lambda[0] + row.bounce_impulse);
         const double t1 = row.lambda[1] - mass[1] * vrel.dot(row.t1);
         const double t2 = row.lambda[2] - mass[2] * vrel.dot(row.t2);
         const double tn = std::sqrt(t1 * t1 + t2 * t2);
@@ -306,7 +306,7 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
     for (Row& row : rows_) {
       // Friction first, bounded by the normal impulse so far (Box2D order).
       Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
-      const double limit = row.friction * row.lambda[0];
+      const double limit = row.friction * (row.lambda[0] + row.bounce_impulse);
       const double t1 = row.lambda[1] - row.mass[1] * vrel.dot(row.t1);
       const double t2 = row.lambda[2] - row.mass[2] * vrel.dot(row.t2);
       const double tn = std::sqrt(t1 * t1 + t2 * t2);
@@ -333,37 +333,61 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
   }
 }
 
-// Restitution in its own pass after the solve (as Box2D v3): a contact that
-// approached faster than the threshold before the solve (row.approach) and
-// took an impulse in it is driven to separate at e times that approach. Every
-// other contact keeps its non-penetration constraint in the same pass: a
-// bounce may not push a body into a neighbour it rests against. In a row of
-// touching balls the struck ball's bounce then moves the whole row instead of
-// driving the second ball into the third (which would meet it next tick,
-// inelastically, losing energy at each link).
-void ContactSolver::applyRestitution(const ResponseOptions& options, SolveStats& stats) {
+// Restitution before the solve, as collisions (Guendelman et al. 2003): wave
+// 0 bounces the contacts that approach faster than the threshold and close
+// their gap this tick, to separate at e times that approach; each further
+// wave bounces the contacts its predecessor left approaching so, from that
+// approach (a Newton's cradle passes the struck ball's speed down the row to
+// the last ball). Each wave only pushes (impulses >= 0), so none gains
+// energy. The solve then holds every contact and resolves what is left
+// inelastically; friction is bounded by the bounce's impulse too.
+void ContactSolver::collide(const ResponseOptions& options, SolveStats& stats) {
   const bool jacobi = options.solver == SolverKind::Jacobi;
   std::vector<Vec3>& out_v = jacobi ? dv_ : v_;
   std::vector<Vec3>& out_w = jacobi ? dw_ : w_;
+  const auto normalVelocity = [&](const Row& row) {
+    return (v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra)).dot(row.n);
+  };
   bool any = false;
   for (Row& row : rows_) {
-    row.bounced = row.approach < -options.restitution_threshold && row.restitution > 0.0 && row.lambda_main > 0.0;
-    if (row.bounced) {
-      any = true;
-      ++stats.bounced;
-    }
+    row.bounce_impulse = 0.0;
+    row.bounced = row.restitution > 0.0 && row.approach < -std::max(options.restitution_threshold, row.speculative);
+    row.wave = row.bounced ? 0 : -1;
+    row.bounce_from = row.approach;
+    any = any || row.bounced;
   }
   if (!any) return;
-  for (int it = 0; it < options.iterations; ++it) {
+  for (int wave = 0; wave < options.iterations; ++wave) {
     for (Row& row : rows_) {
-      const Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
-      const double target = row.bounced ? -row.restitution * row.approach : -row.speculative;
-      const double normal = std::max(0.0, row.lambda[0] + row.mass[0] * (target - vrel.dot(row.n)));
-      const double delta = normal - row.lambda[0];
-      row.lambda[0] = normal;
-      applyNormal(row, delta, out_v, out_w);
+      if (row.wave == wave) {
+        ++stats.bounced;
+        row.lambda_wave = 0.0;
+      }
     }
-    if (jacobi) commitJacobi(v_, w_);
+    for (int it = 0; it < options.iterations; ++it) {
+      for (Row& row : rows_) {
+        if (row.wave != wave) continue;
+        const double target = -row.restitution * row.bounce_from;
+        const double impulse = std::max(0.0, row.lambda_wave + row.mass[0] * (target - normalVelocity(row)));
+        const double delta = impulse - row.lambda_wave;
+        row.lambda_wave = impulse;
+        row.bounce_impulse += delta;
+        applyNormal(row, delta, out_v, out_w);
+      }
+      if (jacobi) commitJacobi(v_, w_);
+    }
+    bool next = false;
+    for (Row& row : rows_) {
+      if (row.wave == wave || row.restitution <= 0.0) continue;
+      const double vn = normalVelocity(row);
+      if (vn < -std::max(options.restitution_threshold, row.speculative)) {
+        row.wave = wave + 1;
+        row.bounce_from = vn;
+        row.bounced = true;
+        next = true;
+      }
+    }
+    if (!next) break;
   }
 }
 
@@ -435,7 +459,7 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
   next_cache_.clear();
   for (const Row& row : rows_) {
     Contact& c = contacts[row.contact];
-    c.normal_impulse = row.lambda[0];
+    c.normal_impulse = row.lambda[0] + row.bounce_impulse;
     c.friction_impulse = row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
     Cached cached;
     cached.a = c.a;
@@ -465,6 +489,7 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
     cache_.clear();
     return stats;
   }
+  collide(options, stats);
   if (options.warm_starting) warmStart(contacts, bodies, stats);
   // Refineable: the first velocity pass always runs; timed, it prices the
   // further iterations against the deadline. `run` carries the iterations
@@ -485,7 +510,6 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
   if (jacobi) for (Row& row : rows_) row.lambda_main = row.lambda[0];
   if (options.shock_propagation) propagateShock(run);
   if (!jacobi) for (Row& row : rows_) row.lambda_main = row.lambda[0];
-  applyRestitution(run, stats);
   const double t_positions = deadline.isSet() ? deadline.now() : 0.0;
   stats.position_passes = solvePositions(run, deadline);
   if (deadline.isSet()) {

@@ -30,6 +30,7 @@ struct Sweeper {
   Vec3 x0, x1, xo0, xo1;
   double best;            // earliest hit so far, fraction of the tick
   std::vector<std::pair<std::int32_t, std::int32_t>>& stack;
+  bool anchor_first = true;  // the contact point is taken below the first body's leaf (else the second's)
   Mat3 relative_abs = (ro1.transpose() * r1).cwiseAbs();  // |cosines| between the end axes
   Vec3 normal = Vec3::UnitZ();  // of the earliest hit, from the first body towards the second
   Vec3 point = Vec3::Zero();
@@ -44,11 +45,17 @@ struct Sweeper {
   // sliding over a floor would keep running into the spheres ahead.
   // A hit that the discrete step handles is not one: while the boxes overlap
   // this tick they never get deeper than the thinner box's half extent (its
-  // centre does not cross the other box.s face). A body grazing a wall or sliding
-  // over a tiled floor keeps its motion; only one that would pass through or
-  // sink in is held back. The depth (shallowest axis) is concave in t: taken
+  // centre does not cross the other box's face). A body grazing a wall or
+  // sliding over a tiled floor keeps its motion; only one that would pass
+  // through or sink in is held back. The depth (shallowest axis) is concave in t: taken
   // at the middle and the end of the overlap.
-  double leafEntry(std::int32_t nf, std::int32_t no, int& axis, double& side) const {
+  //
+  // On a hit, `n` is the face axis the boxes met on (from the first towards
+  // the second) and `p` the contact point: on the plane halfway between the
+  // two faces; across it, the box centre of the body to be held back (the
+  // first when anchor_first), kept within the boxes' overlap: a ball landing
+  // flat on a plate is pushed through its centre, not spun.
+  double leafEntry(std::int32_t nf, std::int32_t no, Vec3& n, Vec3& p) const {
     const std::size_t f = static_cast<std::size_t>(nf);
     const std::size_t o = static_cast<std::size_t>(no);
     const Vec3 local_f = first.tree->node(nf).centre + first.box_offset[f];
@@ -100,8 +107,20 @@ struct Sweeper {
     };
     const double last = std::min(hi, 1.0);
     if (std::max(depth(0.5 * (lo + last)), depth(last)) <= thinner) return -1.0;  // a graze
-    axis = entry_axis;
-    side = offset[axis] + lo * change[axis] >= 0.0 ? 1.0 : -1.0;
+    const Mat3& frame = entry_axis < 3 ? r1 : ro1;  // the box whose face it is
+    const int k = entry_axis % 3;
+    n = offset[entry_axis] + lo * change[entry_axis] >= 0.0 ? Vec3(frame.col(k)) : Vec3(-frame.col(k));
+    const Vec3 ca = r0 * local_f + x0 + lo * (r1 * local_f + x1 - (r0 * local_f + x0));  // box centres at the hit
+    const Vec3 cb = ca + d0 + lo * (d1 - d0);
+    const auto extent = [&](const Vec3& u, const Vec3& h, const Mat3& r) { return h.dot((r.transpose() * u).cwiseAbs()); };
+    p = 0.5 * (ca.dot(n) + extent(n, hf, r1) + cb.dot(n) - extent(n, ho, ro1)) * n;
+    const Vec3& anchor = anchor_first ? ca : cb;
+    for (const int j : {(k + 1) % 3, (k + 2) % 3}) {  // across the face: below the held body's box centre
+      const Vec3 u = frame.col(j);
+      const double lo_u = std::max(ca.dot(u) - extent(u, hf, r1), cb.dot(u) - extent(u, ho, ro1));
+      const double hi_u = std::min(ca.dot(u) + extent(u, hf, r1), cb.dot(u) + extent(u, ho, ro1));
+      p += std::clamp(anchor.dot(u), std::min(lo_u, hi_u), std::max(lo_u, hi_u)) * u;
+    }
     return lo;
   }
 
@@ -121,15 +140,14 @@ struct Sweeper {
       const bool f_leaf = f.child_count == 0;
       const bool o_leaf = o.child_count == 0;
       if (f_leaf && o_leaf) {
-        int axis = 0;
-        double side = 1.0;
+        Vec3 n, p;
         ++leaf_tests;
-        const double t = leafEntry(nf, no, axis, side);
+        const double t = leafEntry(nf, no, n, p);
         if (t >= 0.0 && t < best) {
           best = t;
           hit = true;
-          normal = side * (axis < 3 ? Vec3(r1.col(axis)) : Vec3(ro1.col(axis - 3)));
-          point = 0.5 * (a0 + t * (a1 - a0) + b0 + t * (b1 - b0));
+          normal = n;
+          point = p;
         }
         continue;
       }
@@ -185,10 +203,10 @@ SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pos
   if (scratch.fast.size() != bodies.size()) return stats;  // markFastBodies not run on these bodies
   for (const std::uint8_t f : scratch.fast) stats.fast_bodies += f;
   if (stats.fast_bodies == 0) return stats;
-  // Every pair sees the end poses of this integration: the result does not
-  // depend on the pair order.
-  // Each pair is swept once, in the relative motion of its two bodies; the hit
-  // holds back whichever of them is fast.
+  // Each pair is swept once, in the relative motion of its two bodies, and
+  // the hit holds back whichever of them is fast. Every pair sees the poses
+  // of this integration (bodies are put back after all pairs): the result
+  // does not depend on the pair order.
   for (std::size_t k = 0; k < pair_count; ++k) {
     const std::uint32_t a = pairs[k][0];
     const std::uint32_t b = pairs[k][1];
@@ -213,6 +231,7 @@ SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pos
     Sweeper s{*shapes[a], *shapes[b], p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(),
               q0.orientation.toRotationMatrix(), q1.orientation.toRotationMatrix(),
               p0.position, p1.position, q0.position, q1.position, latest, scratch.stack};
+    s.anchor_first = scratch.fast[a] != 0;
     ++stats.pairs;
     const bool found = s.run();
     stats.leaf_tests += s.leaf_tests;

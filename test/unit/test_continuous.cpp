@@ -2,6 +2,8 @@
 // bodies that would pass through or sink into another, the response of the
 // same tick turns them, so the stored velocity always agrees with the real
 // motion; it sweeps only the broad phase's pairs.
+#include "stability_scenes.hpp"
+
 #include "sphere_tree_collision/dynamics.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -199,6 +201,29 @@ TEST(Continuous, CubeGrazingAFrictionlessWallKeepsFalling) {
   EXPECT_GT(b.pose.position.x(), 0.2 - 0.25 * kVoxel);  // and not through it (a quarter voxel, as the fast sphere of test_stability)
   const double fallen = -20.0 * steps * kDt - kG * kDt * kDt * steps * (steps - 1) / 2.0;
   EXPECT_NEAR(b.pose.position.z() - 1.0, fallen, 1e-9);
+}
+
+// With no detection budget and unresolved pairs rejected, the narrow phase
+// gives no contact at all: the sweep's hit is the contact, so the ball held
+// at the plate still bounces (e = 0.5) instead of hanging there at 100 m/s.
+TEST(Continuous, AHitWithoutANarrowPhaseContactIsTheContact) {
+  stability::Scene scene = stability::fastSphere(100.0);
+  World& w = *scene.world;
+  w.setUnresolvedPolicy(UnresolvedPolicy::Reject);
+  const std::size_t ball = scene.movers.front();
+  double lowest = 1e9;
+  int clamped = 0;
+  for (int s = 0; s < 30; ++s) {
+    const TickReport r = w.step(scene.dt, Budget::ofSphereTests(0));
+    EXPECT_EQ(r.colliding, 0u);
+    clamped += static_cast<int>(w.physicsReport().sweep.clamped);
+    lowest = std::min(lowest, w.bodies()[ball].pose.position.z());
+  }
+  EXPECT_GT(clamped, 0);
+  EXPECT_GT(lowest, 0.5 * scene.voxel);  // never past the plate's top face
+  EXPECT_NEAR(w.bodies()[ball].linear_velocity.z(), 50.0, 0.5);
+  EXPECT_LT(w.bodies()[ball].angular_velocity.norm(), 1e-6);  // pushed through its centre, not spun
+  EXPECT_GT(w.bodies()[ball].pose.position.z(), 1.0);  // and flew back up
 }
 
 }  // namespace
