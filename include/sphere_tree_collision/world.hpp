@@ -73,7 +73,7 @@ struct TickReport {
   double response_budget_s = std::numeric_limits<double>::infinity();
   // Kept back from the narrow phase (with a tick budget) for what cannot be
   // cut after it: its own accounting and the response's mandatory part (the
-  // largest such cost of recent ticks).
+  // largest such cost of recent ticks, with a 10% margin).
   double reserve_s = 0.0;
   double response_refinement_s = 0.0;  // of response_s: iterations the deadline could have cut
   int velocity_passes = 0;             // solver iterations run (>= 1 with contacts)
