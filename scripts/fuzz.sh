@@ -3,7 +3,8 @@
 # and UndefinedBehaviorSanitizer in build_fuzz (or $STC_FUZZ_BUILD), then runs
 # each for $STC_FUZZ_SECONDS (default 15: about 60 s for the four) on its
 # committed seed corpus fuzz/corpus/<target>/ (read only; new inputs go to the
-# build directory). A finding (crash, sanitizer report, uncaught exception,
+# build directory; to grow the seeds: fuzz_<target> -merge=1 fuzz/corpus/<target>
+# build_fuzz/corpus/<target>). A finding (crash, sanitizer report, uncaught exception,
 # leak, timeout, out-of-memory) is saved as build_fuzz/findings/<target>-*.
 # Exit status 0: no finding; 1: at least one. Last line, for the test count:
 #   fuzz: 4 targets, 1234567 executions, 0 findings
@@ -27,7 +28,8 @@ findings=0
 executions=0
 for target in "${targets[@]}"; do
   name="${target#fuzz_}"
-  work="$build/corpus/$name"
+  work="$build/corpus/$name"  # this run's new inputs; fresh, so a run replays only the committed seeds
+  rm -rf "$work"
   mkdir -p "$work"
   log="$build/$target.log"
   dict=()

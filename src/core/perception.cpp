@@ -39,8 +39,9 @@ void validateCamera(const Camera& camera) {
     throw InputError("height", "must be in [1, " + std::to_string(kMaxImageSide) + "] pixels, got " +
                                    std::to_string(camera.height));
   }
-  if (!std::isfinite(camera.fov_y_deg) || camera.fov_y_deg <= 0.0 || camera.fov_y_deg >= 180.0) {
-    throw InputError("fov_y_deg", "must be finite and in (0, 180) degrees");
+  // Narrower than 0.01 degrees (a subnormal, found by fuzz_gaze) the focal length overflows.
+  if (!std::isfinite(camera.fov_y_deg) || camera.fov_y_deg < 0.01 || camera.fov_y_deg >= 180.0) {
+    throw InputError("fov_y_deg", "must be finite and in [0.01, 180) degrees");
   }
   const Pose& pose = camera.camera_to_world;
   if (!pose.position.allFinite() || pose.position.cwiseAbs().maxCoeff() > kMaxCameraCoordinate) {

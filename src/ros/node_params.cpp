@@ -141,7 +141,9 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   p.camera.width = intParamIn(nh, "camera_width", p.camera.width, 1, 100000);
   p.camera.height = intParamIn(nh, "camera_height", p.camera.height, 1, 100000);
   p.camera.fov_y_deg = positiveParam(nh, "camera_fov_y", p.camera.fov_y_deg);
-  if (p.camera.fov_y_deg >= 180.0) throw InputError("camera_fov_y", "must be < 180 degrees");
+  if (p.camera.fov_y_deg < 0.01 || p.camera.fov_y_deg >= 180.0) {
+    throw InputError("camera_fov_y", "must be in [0.01, 180) degrees");
+  }
   parsed("camera_look_at", [&] { return stc::opticalLookAt(p.camera.position, p.camera.look_at); });
   return p;
 }

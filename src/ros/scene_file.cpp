@@ -15,9 +15,13 @@ namespace {
 
 using stc::InputError;
 
+constexpr std::int64_t kMaxSceneEntities = 1000000;  // repeats expanded, whole file
+
 void checkKeys(const YAML::Node& node, const std::string& path, const std::set<std::string>& allowed) {
   for (const auto& kv : node) {
-    const std::string key = kv.first.as<std::string>();
+    // A key may be any YAML node ({[1]: 2}); as<std::string> would throw a YAML error (found by fuzz_scene).
+    if (!kv.first.IsScalar()) throw InputError(path.empty() ? "scene" : path.substr(0, path.size() - 1), "keys must be plain names");
+    const std::string key = kv.first.Scalar();
     if (allowed.count(key) == 0) throw InputError(path + key, "unknown key");
   }
 }
@@ -156,7 +160,10 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
     }
     total *= static_cast<std::int64_t>(c);
   }
-  if (total > 1000000) throw InputError(p + "repeat.count", "more than 1000000 copies");
+  // Over the whole file, not per entry: many large repeats would otherwise exhaust memory.
+  if (total + static_cast<std::int64_t>(scene.entities.size()) > kMaxSceneEntities) {
+    throw InputError(p + "repeat.count", "the scene would hold more than " + std::to_string(kMaxSceneEntities) + " entities");
+  }
   int index = 0;
   for (int k = 0; k < static_cast<int>(count[2]); ++k) {
     for (int j = 0; j < static_cast<int>(count[1]); ++j) {
@@ -183,7 +190,9 @@ std::string sceneKeyOf(const std::string& field) {
 
 }  // namespace
 
-Scene parseSceneYaml(const std::string& yaml_text) {
+namespace {
+
+Scene parseSceneTree(const std::string& yaml_text) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -203,6 +212,16 @@ Scene parseSceneYaml(const std::string& yaml_text) {
     }
   }
   return scene;
+}
+
+}  // namespace
+
+Scene parseSceneYaml(const std::string& yaml_text) {
+  try {
+    return parseSceneTree(yaml_text);
+  } catch (const YAML::Exception& e) {  // any the checks above did not foresee: still a bad scene, by name
+    throw InputError("scene", std::string("unexpected YAML: ") + e.what());
+  }
 }
 
 Scene loadSceneYaml(const std::string& path) {

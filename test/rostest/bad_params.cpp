@@ -65,6 +65,10 @@ std::pair<std::optional<int>, std::string> run(const Case& c, int index, double 
 TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
   const std::string bad_scene = "/tmp/stc_bad_scene_" + std::to_string(getpid()) + ".yaml";
   std::ofstream(bad_scene) << "entities:\n  - {preset: cube, position: [0, 0]}\n";
+  const std::string key_scene = "/tmp/stc_key_scene_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(key_scene) << "{[1]: 2}\n";  // a key that is not a name: once a crash at start-up
+  const std::string heavy_scene = "/tmp/stc_heavy_scene_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(heavy_scene) << "gravity: [0, 0, -1e308]\n";
   const std::string world = "collision_world_node";
   const std::vector<Case> cases{
       {world, {{"rate", -1.0}}, "rate"},
@@ -84,6 +88,11 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"scene", "/nonexistent/scene.yaml"}}, "scene"},
       {world, {{"scene", bad_scene}}, "scene entities[0].position"},
       {world, {{"scene", "rockfal"}}, "scene"},
+      {world, {{"scene", key_scene}}, "scene"},
+      {world, {{"scene", heavy_scene}}, "scene gravity"},
+      {world, {{"gravity", list({0, 0, 1e308})}}, "gravity"},
+      {world, {{"max_speed", -1.0}}, "max_speed"},
+      {world, {{"min_density", 10.0}, {"max_density", 1.0}}, "min_density"},
       {world, {{"scene", "rockfall"}, {"scene_entities", 30000}}, "scene_entities"},
       {"gaze_simulator", {{"mode", "blink"}}, "mode"},
       {"gaze_simulator", {{"mode", "follow"}}, "target"},
@@ -99,6 +108,8 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
     EXPECT_NE(output.find("invalid ~" + c.field + ":"), std::string::npos) << "output:\n" << output;
   }
   std::remove(bad_scene.c_str());
+  std::remove(key_scene.c_str());
+  std::remove(heavy_scene.c_str());
 }
 
 TEST(BadParams, AGoodSetKeepsRunning) {

@@ -15,6 +15,7 @@
 #include <sphere_tree_collision/ContactArray.h>
 #include <sphere_tree_collision/Despawn.h>
 #include <sphere_tree_collision/GazePoint.h>
+#include <sphere_tree_collision/Quarantined.h>
 #include <sphere_tree_collision/SpawnEntity.h>
 #include <sphere_tree_collision/TickStats.h>
 #include <tf2_msgs/TFMessage.h>
@@ -262,6 +263,37 @@ TEST(Hammer, MalformedFloodIsRejectedByTopicWhileTheWorldRuns) {
   EXPECT_TRUE(stc_test::spinUntil([&] { return tf_seen > tf_before && contacts_seen > 0; }, kLiveness));
   EXPECT_EQ(tf_non_finite, 0u) << "of " << tf_seen << " transforms";
   EXPECT_EQ(contacts_non_finite, 0u) << "of " << contacts_seen << " contacts";
+}
+
+TEST(Hammer, ABodyLeavingTheWorldIsRemovedAndReportedByName) {
+  ros::NodeHandle nh;
+  ros::Publisher spawn = nh.advertise<SpawnEntity>("/spawn", 10);
+  Recorder<TickStats> stats(nh, "/tick_stats");
+  Recorder<sphere_tree_collision::Quarantined> quarantined(nh, "/quarantined");
+  quarantined.keep_all = true;
+  ASSERT_TRUE(stc_test::spinUntil(
+      [&] { return spawn.getNumSubscribers() > 0 && stats.count() > 0 && quarantined.sub_.getNumPublishers() > 0; },
+      kLiveness));
+  const TickStats before = stats.last;
+  // 0.5 m inside ~world_extent (10 km), flying out at 100 m/s: gone within a few ticks.
+  SpawnEntity m = validSpawn("escaper", 0);
+  m.pose.position.x = 9999.5;
+  m.twist.linear.x = 100.0;
+  spawn.publish(m);
+  ASSERT_TRUE(stc_test::spinUntil([&] { return !quarantined.all.empty(); }, kLiveness));
+  EXPECT_EQ(quarantined.all[0].frame, "escaper");
+  EXPECT_EQ(quarantined.all[0].reason, "left the world");
+  ASSERT_TRUE(stc_test::spinUntil([&] { return stats.last.left_world_total == before.left_world_total + 1; }, kLiveness));
+  EXPECT_EQ(stats.last.entities, before.entities) << "removed from the world";
+  EXPECT_EQ(stats.last.quarantined_total, before.quarantined_total) << "leaving is not an error";
+  EXPECT_EQ(stats.last.last_quarantine, "escaper: left the world");
+  EXPECT_EQ(stats.last.rejected_spawn, before.rejected_spawn);
+  // Its name is free again: the node forgot it as well.
+  m.pose.position.x = 60.0;
+  m.twist.linear.x = 0.0;
+  spawn.publish(m);
+  EXPECT_TRUE(stc_test::spinUntil([&] { return stats.last.entities == before.entities + 1; }, kLiveness));
+  EXPECT_EQ(stats.last.rejected_spawn, before.rejected_spawn);
 }
 
 }  // namespace

@@ -90,6 +90,10 @@ TEST(Perception, ValidateCameraNamesTheBadField) {
   EXPECT_EQ(with([](Camera& c) { c.fov_y_deg = 0.0; }), "fov_y_deg");
   EXPECT_EQ(with([](Camera& c) { c.fov_y_deg = 180.0; }), "fov_y_deg");
   EXPECT_EQ(with([](Camera& c) { c.fov_y_deg = kNaN; }), "fov_y_deg");
+  // Found by fuzz_gaze: a subnormal field of view overflows the focal length,
+  // a camera far enough out overflows every projection.
+  EXPECT_EQ(with([](Camera& c) { c.fov_y_deg = 5e-324; }), "fov_y_deg");
+  EXPECT_EQ(with([](Camera& c) { c.camera_to_world.position.z() = 1e300; }), "camera_pose");
   EXPECT_EQ(with([](Camera& c) { c.camera_to_world.position.x() = kNaN; }), "camera_pose");
   EXPECT_EQ(with([](Camera& c) { c.camera_to_world.orientation = Quat(0, 0, 0, 0); }), "camera_pose");
   EXPECT_EQ(with([](Camera& c) { c.camera_to_world.orientation = Quat(2, 0, 0, 0); }), "camera_pose");
