@@ -167,11 +167,12 @@ int main(int argc, char** argv) {
 
   std::string md;
   char buf[1024];
+  char budget_text[32] = "off";
+  if (!budget_off) std::snprintf(budget_text, sizeof budget_text, "%.1f ms", budget_ms);
   std::snprintf(buf, sizeof buf,
                 "%.0f s at 60 Hz per scene; tick budget %s (%s clock); priority queues, saccadic gaze, "
                 "policy accept. ms as p50 / p99 / max.\n\n",
-                seconds, budget_off ? "off" : (std::to_string(budget_ms) + " ms").c_str(),
-                wall_clock ? "steady" : "thread-CPU");
+                seconds, budget_text, wall_clock ? "steady" : "thread-CPU");
   md += buf;
   md += "| scene | bodies | whole tick CPU | whole tick wall | p99 CPU / budget | ticks > 1.1 budget "
         "| CPU less integrate | integrate | broad | narrow "
