@@ -112,9 +112,10 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   } else {
     markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
   }
-  contacts_pub_ = nh_.advertise<sphere_tree_collision::ContactArray>("contacts", 10);
-  stats_pub_ = nh_.advertise<sphere_tree_collision::TickStats>("tick_stats", 10);
   quarantined_pub_ = nh_.advertise<sphere_tree_collision::Quarantined>("quarantined", 100);
+  contacts_pub_ = nh_.advertise<sphere_tree_collision::ContactArray>("contacts", 10);
+  // tick_stats last but /tf: smoke.test waits for tick_stats, then expects the rest advertised.
+  stats_pub_ = nh_.advertise<sphere_tree_collision::TickStats>("tick_stats", 10);
   if (params_.publish_tf) tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
   spawn_sub_ = nh_.subscribe("spawn", 1000, &WorldNode::onSpawn, this);
   despawn_sub_ = nh_.subscribe("despawn", 1000, &WorldNode::onDespawn, this);
