@@ -17,4 +17,6 @@ make -C "$STC_BUILD" run_tests -j1 2>&1 | tee "$STC_BUILD/run_tests.log" | grep 
 check() { /usr/bin/python3 "$STC_ROOT/scripts/run_check.py" "$STC_BUILD/test_results" "$@" || true; }
 check catkin_lint -- /usr/bin/catkin_lint --strict --skip-path build "$STC_ROOT"
 check installed_demo -- bash "$STC_ROOT/scripts/check_install.sh"
+# libFuzzer under ASan + UBSan on the message-to-core path, about 60 s (docs/fuzzing.md).
+check fuzz -- bash "$STC_ROOT/scripts/fuzz.sh"
 /usr/bin/python3 "$STC_ROOT/scripts/count_results.py" "$STC_BUILD/test_results"
