@@ -9,6 +9,7 @@ count_results.py counts them with everything else. The command's output is
 kept in the case's system-out; exit status 0 passes.
 """
 import pathlib
+import re
 import subprocess
 import sys
 import time
@@ -24,11 +25,13 @@ def main(argv) -> int:
     proc = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
     elapsed = time.monotonic() - start
     sys.stdout.write(proc.stdout)
+    # Terminal colour codes and other control characters are not allowed in XML.
+    text = re.sub(r"\x1b\[[0-9;]*m|[\x00-\x08\x0b\x0c\x0e-\x1f]", "", proc.stdout)
     suite = ET.Element("testsuite", name=name, tests="1", failures="0" if proc.returncode == 0 else "1")
     case = ET.SubElement(suite, "testcase", classname="checks", name=name, time=f"{elapsed:.1f}")
     if proc.returncode != 0:
-        ET.SubElement(case, "failure", message=f"exit status {proc.returncode}").text = proc.stdout[-4000:]
-    ET.SubElement(case, "system-out").text = proc.stdout[-20000:]
+        ET.SubElement(case, "failure", message=f"exit status {proc.returncode}").text = text[-4000:]
+    ET.SubElement(case, "system-out").text = text[-20000:]
     out = results / "checks"
     out.mkdir(parents=True, exist_ok=True)
     ET.ElementTree(suite).write(out / f"check-{name}.xml", encoding="unicode", xml_declaration=True)
