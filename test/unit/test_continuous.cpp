@@ -128,17 +128,22 @@ TEST(Continuous, RockHittingARavineLedgeComesToRestOnIt) {
   EXPECT_GT(clamped, 0);  // the swept test caught it
 }
 
+// A world under gravity with a vertical slab of material m whose +x face is at x = 0.
+World besideAWall(const Material& m) {
+  WorldConfig config;
+  config.gravity = Vec3(0.0, 0.0, -kG);
+  World w(config);
+  addSlab(w, Vec3(-0.1, 0.0, 0.0), Quat(Eigen::AngleAxisd(-0.5 * M_PI, Vec3::UnitY())), m);
+  return w;
+}
+
 // Free fall beside a wall and beside another falling rock, 1 mm apart: both
 // are fast, neither moves towards the other, so nothing holds them back and
 // they fall at exactly g. The wall and the neighbour are the only sweep
 // partners of each (bodies far away never are).
 TEST(Continuous, RockFallingNearOtherBodiesAcceleratesAtG) {
-  WorldConfig config;
-  config.gravity = Vec3(0.0, 0.0, -kG);
-  World w(config);
   const Material m{0.3, 0.6};
-  // A vertical slab whose +x face is at x = 0.
-  addSlab(w, Vec3(-0.1, 0.0, 0.0), Quat(Eigen::AngleAxisd(-0.5 * M_PI, Vec3::UnitY())), m);
+  World w = besideAWall(m);
   const ShapeId rock = preset(w, "rock");
   const ShapeId cube = preset(w, "cube");
   for (int k = 0; k < 50; ++k) {  // far-away bodies: never swept against
@@ -182,11 +187,8 @@ TEST(Continuous, RockFallingNearOtherBodiesAcceleratesAtG) {
 // Sliding fast down a frictionless wall while pressing into it: a graze,
 // not a hit. The wall takes the sideways approach; the fall is not held back.
 TEST(Continuous, CubeGrazingAFrictionlessWallKeepsFalling) {
-  WorldConfig config;
-  config.gravity = Vec3(0.0, 0.0, -kG);
-  World w(config);
   const Material frictionless{0.0, 0.0};
-  addSlab(w, Vec3(-0.1, 0.0, 0.0), Quat(Eigen::AngleAxisd(-0.5 * M_PI, Vec3::UnitY())), frictionless);
+  World w = besideAWall(frictionless);
   EntitySpec spec;
   spec.shape = preset(w, "cube");
   spec.material = frictionless;
