@@ -7,7 +7,7 @@ add_library(stc_fuzz_ros STATIC
   ${PROJECT_SOURCE_DIR}/src/ros/entity_request.cpp
   ${PROJECT_SOURCE_DIR}/src/ros/scene_file.cpp
   ${PROJECT_SOURCE_DIR}/src/ros/conversions.cpp)
-target_include_directories(stc_fuzz_ros PUBLIC ${PROJECT_SOURCE_DIR}/include)
+target_include_directories(stc_fuzz_ros PUBLIC ${PROJECT_SOURCE_DIR}/include ${PROJECT_SOURCE_DIR}/src/ros/include)
 target_link_libraries(stc_fuzz_ros stc_core yaml-cpp ${catkin_LIBRARIES})
 add_dependencies(stc_fuzz_ros ${PROJECT_NAME}_generate_messages_cpp)
 

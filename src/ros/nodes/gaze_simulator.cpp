@@ -1,5 +1,5 @@
 // gaze_simulator: publishes GazePoint like an eye tracker would. See
-// include/sphere_tree_collision/ros/gaze_simulator.hpp and docs/ros_interface.md.
+// src/ros/include/sphere_tree_collision/ros/gaze_simulator.hpp and docs/ros_interface.md.
 #include "sphere_tree_collision/ros/gaze_simulator.hpp"
 #include "sphere_tree_collision/ros/run_node.hpp"
 

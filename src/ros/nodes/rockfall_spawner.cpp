@@ -1,5 +1,5 @@
 // rockfall_spawner: rocks dropping into the ravine at a set rate. See
-// include/sphere_tree_collision/ros/rockfall_spawner.hpp and docs/ros_interface.md.
+// src/ros/include/sphere_tree_collision/ros/rockfall_spawner.hpp and docs/ros_interface.md.
 #include "sphere_tree_collision/ros/rockfall_spawner.hpp"
 #include "sphere_tree_collision/ros/run_node.hpp"
 
