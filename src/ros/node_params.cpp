@@ -21,7 +21,7 @@ const std::set<std::string>& knownParams() {
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
-      "min_voxel_size", "max_voxel_size"};
+      "min_voxel_size", "max_voxel_size", "entity_states_rate", "publish_clock"};
   return kNames;
 }
 
@@ -56,6 +56,8 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   p.rate = positiveParam(nh, "rate", p.rate);
   if (p.rate > 10000.0 || p.rate < 0.01) throw InputError("rate", "must be in [0.01, 10000] Hz");
   p.marker_rate = positiveParam(nh, "marker_rate", p.marker_rate);
+  p.entity_states_rate = positiveParam(nh, "entity_states_rate", p.entity_states_rate);
+  readParam(nh, "publish_clock", p.publish_clock);
   if (readParam(nh, "marker_levels", p.marker_levels)) {
     for (int level : p.marker_levels) {
       if (level < 0 || level > 7) throw InputError("marker_levels", "levels must be in [0, 7]");

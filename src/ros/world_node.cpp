@@ -78,7 +78,7 @@ NodeParams readParamsWarningUnknown(const ros::NodeHandle& private_nh) {
 }  // namespace
 
 WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : nh_(nh), pnh_(private_nh), params_(readParamsWarningUnknown(private_nh)) {
+    : nh_(nh), pnh_(private_nh), params_(readParamsWarningUnknown(private_nh)), clock_(nh_, params_.publish_clock) {
   const stc::Pose camera_pose = loadScene();
   world_.perception().setCamera(cameraAt(params_.camera, camera_pose));
   if (!params_.camera.frame.empty()) {
@@ -126,7 +126,10 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   // Markers are published from the tick, every ticks_per_marker_ ticks, so that
   // each array shows the state of one tick and carries that tick's stamp.
   ticks_per_marker_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(params_.rate / params_.marker_rate)));
-  tick_timer_ = nh_.createSteadyTimer(ros::WallDuration(dt_), [this](const ros::SteadyTimerEvent&) { tick(); });
+  ticks_per_states_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(params_.rate / params_.entity_states_rate)));
+  entity_states_.advertise(pnh_, params_.world_frame);
+  services_ = std::make_unique<WorldServices>(pnh_, *this);
+  clock_.start(nh_, dt_, [this] { tick(); });
   ROS_INFO("collision_world_node: %zu entities from %s, %.1f Hz, scheduler %s, budget %s ms / %s sphere tests, "
            "tick budget %s ms",
            world_.entityCount(), params_.scene.empty() ? "the default scene" : params_.scene.c_str(),
@@ -139,6 +142,7 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 void WorldNode::remember(stc::EntityId id, const std::string& name, const std::optional<Rgba>& color) {
   colors_[id] = color ? *color : paletteColor(id);
   frames_[id] = entityFrame(id, name);
+  entity_states_.markChanged();
 }
 
 stc::Pose WorldNode::loadScene() {
@@ -209,11 +213,26 @@ void WorldNode::guarded(const char* what, F&& callback) {
 }
 
 void WorldNode::tick() {
+  if (paused_ && steps_pending_ == 0) {
+    guarded("entity list", [this] { publishEntityList(); });  // inputs still change the world while paused
+    return;
+  }
+  if (steps_pending_ > 0) --steps_pending_;
   guarded("tick", [this] { runTick(); });
 }
 
+void WorldNode::setPaused(bool paused) {
+  paused_ = paused;
+  steps_pending_ = 0;
+}
+
+std::uint64_t WorldNode::queueSteps(std::uint32_t n) {
+  steps_pending_ += n;
+  return tick_ + steps_pending_;
+}
+
 void WorldNode::runTick() {
-  const ros::Time now = ros::Time::now();
+  const ros::Time now = clock_.beginTick(dt_);
   if (camera_from_tf_ || tf_buffer_) updateCameraFromTf();
   expireGaze(now);
   const stc::TickReport report = world_.step(dt_, budget_);
@@ -223,6 +242,8 @@ void WorldNode::runTick() {
   publishContacts(now);
   publishTf(now);
   if (tick_ % ticks_per_marker_ == 0) publishMarkers(now);
+  entity_states_.publishListIfChanged(world_, frames_, now);
+  if (tick_ % ticks_per_states_ == 0) entity_states_.publishStates(world_, frames_, now);
   ROS_INFO_THROTTLE(1.0,
                     "tick %llu: %zu entities, %zu broad pairs, %zu colliding, %zu unresolved (%zu accepted), "
                     "%lld sphere tests, %zu contacts, %.2f ms, gaze %s, %llu rejected inputs",
@@ -261,6 +282,7 @@ void WorldNode::forget(stc::EntityId id, stc::ShapeId shape, bool is_static) {
   if (markers_sent_.erase(id) != 0) markers_removed_.push_back({id, shape, is_static});
   colors_.erase(id);
   frames_.erase(id);
+  entity_states_.markChanged();
 }
 
 void WorldNode::updateCameraFromTf() {
@@ -331,6 +353,9 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.left_world_total = left_world_total_;
   s.last_quarantine = last_quarantine_;
   s.callback_errors = callback_errors_;
+  s.physics_time = clock_.physicsSeconds();
+  s.real_time_factor = clock_.realTimeFactor();
+  s.paused = paused_;
   stats_pub_.publish(s);
 }
 
@@ -346,6 +371,8 @@ void WorldNode::publishContacts(const ros::Time& stamp) {
     auto& m = contacts_msg_.contacts[n++];
     m.entity_a = c.a;
     m.entity_b = c.b;
+    m.name_a = frames_[c.a];
+    m.name_b = frames_[c.b];
     m.point = toPointMsg(c.point);
     m.normal = toVector3Msg(c.normal);
     m.depth = c.depth;
@@ -446,7 +473,7 @@ void WorldNode::sendMarkerSnapshot(const ros::SingleSubscriberPublisher& subscri
   // state stays theirs and the next array brings the newcomer what is pending
   // as well (twice is harmless: an ADD replaces).
   visualization_msgs::MarkerArray snapshot;
-  buildMarkerSnapshot(ros::Time::now(), markers_pub_.getNumSubscribers() <= 1, snapshot);
+  buildMarkerSnapshot(clock_.now(), markers_pub_.getNumSubscribers() <= 1, snapshot);
   subscriber.publish(snapshot);
 }
 
@@ -475,8 +502,7 @@ void WorldNode::rejectUnexpected(Input input) {
   reject(input, "message", causeOf(std::current_exception()));
 }
 
-void WorldNode::onSpawn(const sphere_tree_collision::SpawnEntity& msg) {
-  const bool is_preset = !msg.preset.empty();
+stc::EntityId WorldNode::spawnEntity(const sphere_tree_collision::SpawnEntity& msg) {
   try {
     EntityRequest request = toEntityRequest(msg, params_.default_resolution);
     const std::string name = request.spec.name;
@@ -484,28 +510,41 @@ void WorldNode::onSpawn(const sphere_tree_collision::SpawnEntity& msg) {
     const stc::EntityId id = addRequest(world_, std::move(request));
     remember(id, name, color);
     ROS_DEBUG("spawned entity %u (%s)", id, frames_[id].c_str());
+    return id;
   } catch (const stc::InputError& e) {
-    reject(Input::Spawn, spawnFieldOf(e.field(), is_preset), reasonOf(e));
+    throw stc::InputError(spawnFieldOf(e.field(), !msg.preset.empty()), reasonOf(e));
+  }
+}
+
+void WorldNode::onSpawn(const sphere_tree_collision::SpawnEntity& msg) {
+  try {
+    spawnEntity(msg);
+  } catch (const stc::InputError& e) {
+    reject(Input::Spawn, e.field(), reasonOf(e));
   } catch (...) {
     rejectUnexpected(Input::Spawn);
   }
 }
 
+void WorldNode::despawnEntity(stc::EntityId requested, const std::string& name) {
+  std::optional<stc::EntityId> id;
+  if (!name.empty()) {
+    id = world_.findByName(name);
+    if (!id) throw stc::InputError("name", "no entity named '" + name + "'");
+  } else {
+    id = requested;
+  }
+  const auto index = world_.indexOf(*id);
+  if (!index) throw stc::InputError("id", "no entity with id " + std::to_string(requested));
+  const stc::ShapeId shape = world_.bodyShapes()[*index];
+  const bool is_static = world_.bodies()[*index].is_static;
+  world_.removeEntity(*id);
+  forget(*id, shape, is_static);
+}
+
 void WorldNode::onDespawn(const sphere_tree_collision::Despawn& msg) {
   try {
-    std::optional<stc::EntityId> id;
-    if (!msg.name.empty()) {
-      id = world_.findByName(msg.name);
-      if (!id) throw stc::InputError("name", "no entity named '" + msg.name + "'");
-    } else {
-      id = msg.id;
-    }
-    const auto index = world_.indexOf(*id);
-    if (!index) throw stc::InputError("id", "no entity with id " + std::to_string(msg.id));
-    const stc::ShapeId shape = world_.bodyShapes()[*index];
-    const bool is_static = world_.bodies()[*index].is_static;
-    world_.removeEntity(*id);
-    forget(*id, shape, is_static);
+    despawnEntity(msg.id, msg.name);
   } catch (const stc::InputError& e) {
     reject(Input::Despawn, e.field(), reasonOf(e));
   } catch (...) {
@@ -525,6 +564,14 @@ void WorldNode::clearWorld() {
   markers_sent_.clear();
   markers_removed_.clear();
   markers_cleared_ = true;
+  entity_states_.markChanged();
+}
+
+void WorldNode::resetWorld() {
+  clearWorld();
+  const stc::Pose camera_pose = loadScene();  // a new World: the camera is set again (tf overrides it next tick)
+  world_.perception().setCamera(cameraAt(params_.camera, camera_pose));
+  ROS_INFO("reset: %zu entities of the start scene", world_.entityCount());
 }
 
 void WorldNode::setFixation(double x, double y, const ros::Time& stamp, const char* x_field, const char* y_field) {
@@ -539,7 +586,7 @@ void WorldNode::setFixation(double x, double y, const ros::Time& stamp, const ch
   }
   // In doubles: ros::Time / ros::Duration arithmetic throws near the ends of
   // their range (stamp.sec = 4294967295), a double difference never does.
-  const double now = ros::Time::now().toSec();
+  const double now = clock_.now().toSec();
   const double when = stamp.isZero() ? now : stamp.toSec();
   const double age = now - when;
   if (age > params_.gaze_timeout) {

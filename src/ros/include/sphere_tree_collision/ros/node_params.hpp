@@ -31,6 +31,8 @@ struct NodeParams {
   std::string world_frame = "world";
   double rate = 60.0;                // Hz, ticks
   double marker_rate = 10.0;         // Hz
+  double entity_states_rate = 10.0;  // Hz, ~entity_states (only while subscribed)
+  bool publish_clock = false;        // ticks on the wall clock, stamps with physics time, which goes on /clock
   std::vector<int> marker_levels{1, 2};
   // incremental: entity geometry sent once per entity, frame-locked in its tf
   // frame (new subscribers get a snapshot); full: everything re-sent in the

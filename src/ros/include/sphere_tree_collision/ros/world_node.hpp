@@ -6,8 +6,11 @@
 // escapes is logged, counted (tick_stats.callback_errors) and the node goes on.
 #pragma once
 
+#include "sphere_tree_collision/ros/entity_state_publisher.hpp"
 #include "sphere_tree_collision/ros/marker_builder.hpp"
 #include "sphere_tree_collision/ros/node_params.hpp"
+#include "sphere_tree_collision/ros/tick_clock.hpp"
+#include "sphere_tree_collision/ros/world_services.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <geometry_msgs/PointStamped.h>
@@ -53,12 +56,25 @@ class WorldNode {
   const stc::World& world() const { return world_; }
   std::uint64_t tickCount() const { return tick_; }
 
+  // What the services (world_services.hpp) and the input topics do. The throwing
+  // ones throw stc::InputError naming the message field and change nothing.
+  stc::EntityId spawnEntity(const sphere_tree_collision::SpawnEntity& msg);  // pose in ~world_frame
+  void despawnEntity(stc::EntityId id, const std::string& name);              // by name unless empty
+  void clearWorld();
+  void resetWorld();  // the start scene again (~scene); ticks and physics time go on
+  void setPaused(bool paused);
+  bool paused() const { return paused_; }
+  // Paused: n more ticks; returns the tick number reached after them.
+  std::uint64_t queueSteps(std::uint32_t n);
+  const std::string& frameOf(stc::EntityId id) { return frames_[id]; }
+  const std::string& worldFrame() const { return params_.world_frame; }
+  void publishEntityList() { entity_states_.publishListIfChanged(world_, frames_, clock_.now()); }
+
  private:
   enum class Input { Spawn, Despawn, Gaze, ClickedPoint };
   void onSpawn(const sphere_tree_collision::SpawnEntity& msg);
   void onDespawn(const sphere_tree_collision::Despawn& msg);
   void onClear(const std_msgs::Empty& msg);
-  void clearWorld();
   void onGaze(const sphere_tree_collision::GazePoint& msg);
   void onClickedPoint(const geometry_msgs::PointStamped& msg);
   void reject(Input input, const std::string& field, const std::string& reason);
@@ -88,11 +104,17 @@ class WorldNode {
 
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
+  TickClock clock_;
   stc::World world_;
   stc::Budget budget_;
   double dt_ = 0.0;
   std::uint64_t tick_ = 0;
   std::uint64_t ticks_per_marker_ = 1;
+  std::uint64_t ticks_per_states_ = 1;
+  bool paused_ = false;
+  std::uint64_t steps_pending_ = 0;  // paused: ticks ~step still asks for
+  EntityStatePublisher entity_states_;
+  std::unique_ptr<WorldServices> services_;
 
   // Per entity, by id: what the World does not keep.
   std::unordered_map<stc::EntityId, Rgba> colors_;
@@ -134,7 +156,6 @@ class WorldNode {
 
   ros::Publisher markers_pub_, contacts_pub_, stats_pub_, tf_pub_, quarantined_pub_;
   ros::Subscriber spawn_sub_, despawn_sub_, clear_sub_, gaze_sub_, clicked_sub_;
-  ros::SteadyTimer tick_timer_;
 };
 
 }  // namespace stc_ros

@@ -1,0 +1,48 @@
+// WorldServices: the world node's services, in its private namespace. Each answers
+// success and, on failure, "<field>: <reason>"; nothing changes on failure.
+//   ~spawn (Spawn): the spawn topic's path, with the pose and twist in header.frame_id
+//     (tf to ~world_frame); answers the id and tf frame.
+//   ~despawn (DespawnEntity): by name, else by id.
+//   ~clear, ~pause, ~unpause, ~reset (std_srvs/Trigger): reset rebuilds the start scene.
+//   ~step (Step): while paused, queues n ticks and answers at once with the tick
+//     number tick_stats reaches when they are done.
+#pragma once
+
+#include <ros/ros.h>
+#include <sphere_tree_collision/DespawnEntity.h>
+#include <sphere_tree_collision/Spawn.h>
+#include <sphere_tree_collision/Step.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <memory>
+#include <vector>
+
+namespace stc_ros {
+
+class WorldNode;
+
+class WorldServices {
+ public:
+  WorldServices(ros::NodeHandle& private_nh, WorldNode& node);
+
+ private:
+  bool spawn(sphere_tree_collision::Spawn::Request& req, sphere_tree_collision::Spawn::Response& res);
+  bool despawn(sphere_tree_collision::DespawnEntity::Request& req, sphere_tree_collision::DespawnEntity::Response& res);
+  bool clear(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool pause(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool unpause(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool reset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool step(sphere_tree_collision::Step::Request& req, sphere_tree_collision::Step::Response& res);
+  // The request's entity with its pose and twist in ~world_frame; throws InputError("header.frame_id").
+  sphere_tree_collision::SpawnEntity inWorldFrame(const sphere_tree_collision::Spawn::Request& req);
+
+  WorldNode& node_;
+  // Created at the first spawn in another frame: the node's own /tf is not read otherwise.
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::vector<ros::ServiceServer> servers_;
+};
+
+}  // namespace stc_ros

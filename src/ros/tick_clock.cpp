@@ -1,0 +1,55 @@
+#include "sphere_tree_collision/ros/tick_clock.hpp"
+
+#include <rosgraph_msgs/Clock.h>
+
+namespace stc_ros {
+namespace {
+
+constexpr double kRealTimeWindowSeconds = 1.0;
+
+}  // namespace
+
+TickClock::TickClock(ros::NodeHandle& nh, bool publish_clock)
+    : publish_clock_(publish_clock), follows_clock_(!publish_clock && ros::Time::isSimTime()) {
+  if (publish_clock_) clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
+}
+
+void TickClock::start(ros::NodeHandle& nh, double period, std::function<void()> tick) {
+  if (follows_clock_) {
+    ros_timer_ = nh.createTimer(ros::Duration(period), [tick](const ros::TimerEvent&) { tick(); });
+  } else {
+    steady_timer_ = nh.createSteadyTimer(ros::WallDuration(period), [tick](const ros::SteadyTimerEvent&) { tick(); });
+  }
+}
+
+ros::Time TickClock::beginTick(double dt) {
+  const ros::WallTime wall = ros::WallTime::now();
+  physics_s_ += dt;
+  if (!window_open_) {  // measured from the first tick on
+    window_open_ = true;
+    window_wall_ = wall;
+    window_physics_s_ = physics_s_;
+  }
+  const double wall_s = (wall - window_wall_).toSec();
+  // The first window reports as it fills; later ones once complete.
+  if (wall_s > 0.0 && (first_window_ || wall_s >= kRealTimeWindowSeconds)) {
+    real_time_factor_ = (physics_s_ - window_physics_s_) / wall_s;
+  }
+  if (wall_s >= kRealTimeWindowSeconds) {
+    first_window_ = false;
+    window_wall_ = wall;
+    window_physics_s_ = physics_s_;
+  }
+  if (!publish_clock_) return ros::Time::now();
+  rosgraph_msgs::Clock clock;
+  clock.clock.fromSec(physics_s_);
+  clock_pub_.publish(clock);
+  return clock.clock;
+}
+
+ros::Time TickClock::now() const {
+  if (publish_clock_) return ros::Time().fromSec(physics_s_);
+  return ros::Time::now();
+}
+
+}  // namespace stc_ros

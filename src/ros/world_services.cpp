@@ -1,0 +1,125 @@
+#include "sphere_tree_collision/ros/world_services.hpp"
+
+#include "sphere_tree_collision/ros/conversions.hpp"
+#include "sphere_tree_collision/ros/world_node.hpp"
+
+#include <exception>
+
+namespace stc_ros {
+namespace {
+
+// How long a spawn in another frame waits for tf to know that frame.
+constexpr double kTfWaitSeconds = 1.0;
+constexpr std::uint32_t kMaxStepTicks = 100000;
+
+// Runs `action`; a failure becomes success = false and "<field>: <reason>".
+template <typename Response, typename F>
+void answer(Response& res, const char* service, F&& action) {
+  try {
+    action();
+    res.success = true;
+    res.message = "";
+  } catch (const stc::InputError& e) {
+    res.success = false;
+    res.message = e.field() + ": " + reasonOf(e);
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = std::string("message: ") + e.what();
+  }
+  if (!res.success) ROS_WARN("~%s refused: %s", service, res.message.c_str());
+}
+
+}  // namespace
+
+WorldServices::WorldServices(ros::NodeHandle& pnh, WorldNode& node) : node_(node) {
+  servers_.push_back(pnh.advertiseService("spawn", &WorldServices::spawn, this));
+  servers_.push_back(pnh.advertiseService("despawn", &WorldServices::despawn, this));
+  servers_.push_back(pnh.advertiseService("clear", &WorldServices::clear, this));
+  servers_.push_back(pnh.advertiseService("pause", &WorldServices::pause, this));
+  servers_.push_back(pnh.advertiseService("unpause", &WorldServices::unpause, this));
+  servers_.push_back(pnh.advertiseService("reset", &WorldServices::reset, this));
+  servers_.push_back(pnh.advertiseService("step", &WorldServices::step, this));
+}
+
+sphere_tree_collision::SpawnEntity WorldServices::inWorldFrame(const sphere_tree_collision::Spawn::Request& req) {
+  const std::string& frame = req.header.frame_id;
+  if (frame.empty() || frame == node_.worldFrame()) return req.entity;
+  if (!tf_buffer_) {
+    tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
+    tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
+  }
+  geometry_msgs::TransformStamped t;
+  try {
+    t = tf_buffer_->lookupTransform(node_.worldFrame(), frame, req.header.stamp, ros::Duration(kTfWaitSeconds));
+  } catch (const tf2::TransformException& e) {
+    throw stc::InputError("header.frame_id", e.what());
+  }
+  const stc::Quat rotation = toEigen(t.transform.rotation).normalized();
+  const stc::Vec3 translation = toEigen(t.transform.translation);
+  sphere_tree_collision::SpawnEntity m = req.entity;
+  // A unit rotation keeps the quaternion's norm: a bad orientation stays bad for the topic's check.
+  const stc::Quat q = toEigen(m.pose.orientation);
+  m.pose.position = toPointMsg(rotation * toEigen(m.pose.position) + translation);
+  m.pose.orientation = toQuaternionMsg(rotation * q);
+  m.twist.linear = toVector3Msg(rotation * toEigen(m.twist.linear));  // the frame is taken as not moving
+  m.twist.angular = toVector3Msg(rotation * toEigen(m.twist.angular));
+  return m;
+}
+
+bool WorldServices::spawn(sphere_tree_collision::Spawn::Request& req, sphere_tree_collision::Spawn::Response& res) {
+  res.id = 0;
+  answer(res, "spawn", [&] {
+    const sphere_tree_collision::SpawnEntity entity = inWorldFrame(req);
+    try {
+      res.id = node_.spawnEntity(entity);
+    } catch (const stc::InputError& e) {  // named as fields of the request's `entity`
+      throw stc::InputError(e.field() == "max_entities" ? e.field() : "entity." + e.field(), reasonOf(e));
+    }
+    res.frame_id = node_.frameOf(res.id);
+  });
+  if (res.success) node_.publishEntityList();
+  return true;  // false would hide the message from the caller
+}
+
+bool WorldServices::despawn(sphere_tree_collision::DespawnEntity::Request& req,
+                            sphere_tree_collision::DespawnEntity::Response& res) {
+  answer(res, "despawn", [&] { node_.despawnEntity(req.id, req.name); });
+  if (res.success) node_.publishEntityList();
+  return true;
+}
+
+bool WorldServices::clear(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  answer(res, "clear", [&] { node_.clearWorld(); });
+  node_.publishEntityList();
+  return true;
+}
+
+bool WorldServices::pause(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  answer(res, "pause", [&] { node_.setPaused(true); });
+  return true;
+}
+
+bool WorldServices::unpause(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  answer(res, "unpause", [&] { node_.setPaused(false); });
+  return true;
+}
+
+bool WorldServices::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  answer(res, "reset", [&] { node_.resetWorld(); });
+  node_.publishEntityList();
+  return true;
+}
+
+bool WorldServices::step(sphere_tree_collision::Step::Request& req, sphere_tree_collision::Step::Response& res) {
+  answer(res, "step", [&] {
+    if (req.ticks == 0 || req.ticks > kMaxStepTicks) {
+      throw stc::InputError("ticks", "must be in [1, " + std::to_string(kMaxStepTicks) + "]");
+    }
+    if (!node_.paused()) throw stc::InputError("ticks", "the world is not paused (call ~pause first)");
+    res.tick = node_.queueSteps(req.ticks);
+  });
+  if (!res.success) res.tick = node_.tickCount();
+  return true;
+}
+
+}  // namespace stc_ros
