@@ -16,7 +16,12 @@ TickClock::TickClock(ros::NodeHandle& nh, bool publish_clock)
 
 void TickClock::start(ros::NodeHandle& nh, double period, std::function<void()> tick) {
   if (follows_clock_) {
-    ros_timer_ = nh.createTimer(ros::Duration(period), [tick](const ros::TimerEvent&) { tick(); });
+    // From the first /clock on: a timer started at time 0 would fire once for 0 + period.
+    ros::Time::waitForValid();
+    ros_timer_ = nh.createTimer(ros::Duration(period), [this, tick](const ros::TimerEvent& e) {
+      due_ = e.current_expected;
+      tick();
+    });
   } else {
     steady_timer_ = nh.createSteadyTimer(ros::WallDuration(period), [tick](const ros::SteadyTimerEvent&) { tick(); });
   }
@@ -40,6 +45,7 @@ ros::Time TickClock::beginTick(double dt) {
     window_wall_ = wall;
     window_physics_s_ = physics_s_;
   }
+  if (follows_clock_) return due_;
   if (!publish_clock_) return ros::Time::now();
   rosgraph_msgs::Clock clock;
   clock.clock.fromSec(physics_s_);

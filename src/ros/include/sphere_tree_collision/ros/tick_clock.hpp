@@ -1,6 +1,7 @@
 // TickClock: when the world node ticks and what time its messages carry.
 //   - default: a steady (wall) timer at ~rate, stamps from ros::Time::now();
-//   - /use_sim_time: a ROS-time timer, so ticks follow /clock (none while /clock stands);
+//   - /use_sim_time: a ROS-time timer, so ticks follow /clock (none while /clock stands;
+//     ticking starts at the first /clock), each stamped with the clock time it was due at;
 //   - ~publish_clock: a steady timer at ~rate, stamps in physics time (ticks x dt from 0),
 //     which the clock also publishes on /clock before each tick's messages. The node
 //     then never reads /clock itself: it is the source.
@@ -17,7 +18,7 @@ class TickClock {
  public:
   TickClock(ros::NodeHandle& nh, bool publish_clock);
 
-  // Calls `tick` every `period` s of the clock above.
+  // Calls `tick` every `period` s of the clock above (with /use_sim_time: waits for /clock).
   void start(ros::NodeHandle& nh, double period, std::function<void()> tick);
   // Advances physics time by dt and returns the stamp of that tick (published on
   // /clock first with ~publish_clock).
@@ -38,6 +39,7 @@ class TickClock {
   ros::Publisher clock_pub_;
   ros::SteadyTimer steady_timer_;
   ros::Timer ros_timer_;
+  ros::Time due_;  // /use_sim_time: when the current tick was due
   // Real-time factor window: wall and physics time at its start.
   bool window_open_ = false, first_window_ = true;
   ros::WallTime window_wall_;
