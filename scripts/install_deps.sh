@@ -6,6 +6,8 @@ packages=(
   catkin ros-base-dev ros-message-generation ros-message-runtime
   libroscpp-dev libtf2-ros-dev libtf2-dev libvisualization-msgs-dev libgeometry-msgs-dev libstd-msgs-dev
   librostest-dev python3-rostest python3-roslaunch libtf2-msgs-dev
+  libstd-srvs-dev libros-rosgraph-msgs-dev
+  python3-rospy python3-geometry-msgs python3-std-srvs  # scripts/example_client.py
   libeigen3-dev libyaml-cpp-dev libfcl-dev libgtest-dev googletest
   python3-matplotlib
   libbullet-dev  # benchmarks only: bench_bullet_compare (skipped when absent)
