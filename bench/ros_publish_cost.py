@@ -124,15 +124,15 @@ def measure(node, n, seconds, rate, marker_rate):
         rospy.init_node("publish_cost", anonymous=True, disable_signals=True)
         for _ in range(600):
             topics = dict(rospy.get_published_topics())
-            if "/markers" in topics and "/tf" in topics:
+            if "/collision_world/markers" in topics and "/tf" in topics:
                 break
             if world.poll() is not None:
                 sys.exit(f"collision_world_node exited ({world.returncode}) with {n} entities")
             time.sleep(0.1)
         time.sleep(2.0)
         rows = {}
-        for name, topics in [("none", []), ("markers", ["/markers"]), ("tf", ["/tf"]),
-                             ("both", ["/markers", "/tf"])]:
+        for name, topics in [("none", []), ("markers", ["/collision_world/markers"]), ("tf", ["/tf"]),
+                             ("both", ["/collision_world/markers", "/tf"])]:
             rows[name] = window(world.pid, topics, seconds)
         return rows
     finally:
@@ -184,7 +184,7 @@ def rows_markdown(n, rows):
     out = ""
     for name in ["none", "markers", "tf", "both"]:
         cpu, topics, wall = rows[name]
-        m = topics.get("/markers", (0, 0))
+        m = topics.get("/collision_world/markers", (0, 0))
         t = topics.get("/tf", (0, 0))
         extra_m = (cpu - base) * wall / m[0] * 1e3 if name == "markers" and m[0] else None
         extra_t = (cpu - base) * wall / t[0] * 1e3 if name == "tf" and t[0] else None

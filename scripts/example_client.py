@@ -2,7 +2,7 @@
 """A client of collision_world_node, as another program would drive it (rospy).
 
 Spawns two touching cubes through the ~spawn service (and learns their ids),
-reads their states on ~entity_states and their contacts on contacts, moves the
+reads their states on ~entity_states and their contacts on ~contacts, moves the
 gaze to the image centre, then removes them through ~despawn. Prints what it
 got. With --check it also verifies it (for a world without gravity and with
 response off, as test/rostest/example_client.test runs it) and exits 1 on a
@@ -19,30 +19,29 @@ from sphere_tree_collision.msg import ContactArray, EntityList, EntityStates, Ga
 from sphere_tree_collision.srv import DespawnEntity, Spawn, SpawnRequest
 
 TIMEOUT = 60.0  # s: only guards against a node that is not there
-# Where the node's topics are, relative to its namespace (--world).
-TOPICS = {"contacts": "/contacts", "tick_stats": "/tick_stats", "gaze": "/gaze"}
 
 
 def topic(world, name):
-    return TOPICS[name] if TOPICS[name].startswith("/") else world + "/" + TOPICS[name]
+    """The node's topics and services are in its private namespace (--world)."""
+    return world + "/" + name
 
 
 class Client:
     def __init__(self, world):
         self.world = world
         for service in ("spawn", "despawn"):
-            rospy.wait_for_service(world + "/" + service, timeout=TIMEOUT)
-        self.spawn_srv = rospy.ServiceProxy(world + "/spawn", Spawn)
-        self.despawn_srv = rospy.ServiceProxy(world + "/despawn", DespawnEntity)
+            rospy.wait_for_service(topic(world, service), timeout=TIMEOUT)
+        self.spawn_srv = rospy.ServiceProxy(topic(world, "spawn"), Spawn)
+        self.despawn_srv = rospy.ServiceProxy(topic(world, "despawn"), DespawnEntity)
         self.gaze_pub = rospy.Publisher(topic(world, "gaze"), GazePoint, queue_size=10)
         self.states = None
         self.contacts = None
         self.stats = None
         self.entities = None
-        rospy.Subscriber(world + "/entity_states", EntityStates, self._keep("states"))
+        rospy.Subscriber(topic(world, "entity_states"), EntityStates, self._keep("states"))
         rospy.Subscriber(topic(world, "contacts"), ContactArray, self._keep("contacts"))
         rospy.Subscriber(topic(world, "tick_stats"), TickStats, self._keep("stats"))
-        rospy.Subscriber(world + "/entities", EntityList, self._keep("entities"))
+        rospy.Subscriber(topic(world, "entities"), EntityList, self._keep("entities"))
 
     def _keep(self, name):
         def callback(msg):

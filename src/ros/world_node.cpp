@@ -105,22 +105,23 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
   marker_options_.contact_size = params_.contact_marker_size;
   if (params_.marker_mode == NodeParams::MarkerMode::Incremental) {
-    markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>(
+    markers_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>(
         "markers", 100, [this](const ros::SingleSubscriberPublisher& s) {
           guarded("marker snapshot", [&] { sendMarkerSnapshot(s); });
         });
   } else {
-    markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
+    markers_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
   }
-  quarantined_pub_ = nh_.advertise<sphere_tree_collision::Quarantined>("quarantined", 100);
-  contacts_pub_ = nh_.advertise<sphere_tree_collision::ContactArray>("contacts", 10);
+  quarantined_pub_ = pnh_.advertise<sphere_tree_collision::Quarantined>("quarantined", 100);
+  contacts_pub_ = pnh_.advertise<sphere_tree_collision::ContactArray>("contacts", 10);
+  // The node's topics are private (~name); /tf and /clicked_point are the shared ones.
   // tick_stats last but /tf: smoke.test waits for tick_stats, then expects the rest advertised.
-  stats_pub_ = nh_.advertise<sphere_tree_collision::TickStats>("tick_stats", 10);
+  stats_pub_ = pnh_.advertise<sphere_tree_collision::TickStats>("tick_stats", 10);
   if (params_.publish_tf) tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
-  spawn_sub_ = nh_.subscribe("spawn", 1000, &WorldNode::onSpawn, this);
-  despawn_sub_ = nh_.subscribe("despawn", 1000, &WorldNode::onDespawn, this);
-  clear_sub_ = nh_.subscribe("clear", 10, &WorldNode::onClear, this);
-  gaze_sub_ = nh_.subscribe("gaze", 10, &WorldNode::onGaze, this);
+  spawn_sub_ = pnh_.subscribe("spawn", 1000, &WorldNode::onSpawn, this);
+  despawn_sub_ = pnh_.subscribe("despawn", 1000, &WorldNode::onDespawn, this);
+  clear_sub_ = pnh_.subscribe("clear", 10, &WorldNode::onClear, this);
+  gaze_sub_ = pnh_.subscribe("gaze", 10, &WorldNode::onGaze, this);
   clicked_sub_ = nh_.subscribe("/clicked_point", 10, &WorldNode::onClickedPoint, this);
 
   // Markers are published from the tick, every ticks_per_marker_ ticks, so that

@@ -178,8 +178,8 @@ class WorldUnderTest {
  public:
   explicit WorldUnderTest(const std::string& ns) : ns_(ns) {
     ros::NodeHandle nh(ns);
-    spawn_pub_ = nh.advertise<SpawnEntity>("spawn", 100);
-    contacts_sub_ = nh.subscribe<ContactArray>("contacts", 1000, [this](const ContactArray::ConstPtr& m) {
+    spawn_pub_ = nh.advertise<SpawnEntity>("collision_world/spawn", 100);
+    contacts_sub_ = nh.subscribe<ContactArray>("collision_world/contacts", 1000, [this](const ContactArray::ConstPtr& m) {
       if (recording_) contacts_[m->header.stamp] = *m;
     });
     // The node's /tf is remapped into the namespace (two worlds, one tf tree each).
@@ -190,7 +190,7 @@ class WorldUnderTest {
       }
       if (recording_) tf_[m->transforms.front().header.stamp] = *m;
     });
-    stats_sub_ = nh.subscribe<TickStats>("tick_stats", 1000, [this](const TickStats::ConstPtr& m) {
+    stats_sub_ = nh.subscribe<TickStats>("collision_world/tick_stats", 1000, [this](const TickStats::ConstPtr& m) {
       if (!recording_) return;
       ++stats_ticks_;
       sphere_tests_ += m->sphere_tests;

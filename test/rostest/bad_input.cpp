@@ -61,11 +61,11 @@ struct Case {
 class BadInput : public testing::Test {
  protected:
   BadInput()
-      : spawn_(nh_.advertise<SpawnEntity>("/spawn", 100)),
-        despawn_(nh_.advertise<sphere_tree_collision::Despawn>("/despawn", 100)),
-        gaze_(nh_.advertise<sphere_tree_collision::GazePoint>("/gaze", 100)),
+      : spawn_(nh_.advertise<SpawnEntity>("/collision_world/spawn", 100)),
+        despawn_(nh_.advertise<sphere_tree_collision::Despawn>("/collision_world/despawn", 100)),
+        gaze_(nh_.advertise<sphere_tree_collision::GazePoint>("/collision_world/gaze", 100)),
         clicked_(nh_.advertise<geometry_msgs::PointStamped>("/clicked_point", 100)),
-        stats_(nh_, "/tick_stats"),
+        stats_(nh_, "/collision_world/tick_stats"),
         rosout_(nh_, "/rosout", 1000),
         listener_(tf_, nh_, false) {
     rosout_.keep_all = true;

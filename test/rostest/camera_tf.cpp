@@ -27,7 +27,7 @@ geometry_msgs::PointStamped click(double x, double y, double z) {
 TEST(CameraTf, ParametersUntilTheFrameExistsThenTf) {
   ros::NodeHandle nh;
   ros::Publisher clicked = nh.advertise<geometry_msgs::PointStamped>("/clicked_point", 10);
-  stc_test::Recorder<sphere_tree_collision::TickStats> stats(nh, "/tick_stats");
+  stc_test::Recorder<sphere_tree_collision::TickStats> stats(nh, "/collision_world/tick_stats");
   ASSERT_TRUE(stc_test::spinUntil([&] { return clicked.getNumSubscribers() > 0 && stats.count() > 0; }, stc_test::kLivenessSeconds));
 
   // No test_camera in tf yet: the parameter camera sees the point.

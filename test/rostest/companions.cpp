@@ -108,7 +108,7 @@ TEST(Companions, FollowGazeTracksTheEntitysProjection) {
   ros::NodeHandle nh;
   tf2_ros::Buffer tf;
   tf2_ros::TransformListener listener(tf, nh, false);
-  ros::Publisher spawn = nh.advertise<sphere_tree_collision::SpawnEntity>("/spawn", 10);
+  ros::Publisher spawn = nh.advertise<sphere_tree_collision::SpawnEntity>("/collision_world/spawn", 10);
   ASSERT_TRUE(stc_test::spinUntil([&] { return spawn.getNumSubscribers() > 0; }, stc_test::kLivenessSeconds));
   sphere_tree_collision::SpawnEntity probe;
   probe.name = "probe";
@@ -161,9 +161,9 @@ TEST(Companions, FollowGazeTracksTheEntitysProjection) {
 
 TEST(Companions, RockfallDropsValidRocksAndKeepsAtMostMaxRocks) {
   ros::NodeHandle nh;
-  Recorder<sphere_tree_collision::SpawnEntity> spawns(nh, "/spawn");
-  Recorder<sphere_tree_collision::Despawn> despawns(nh, "/despawn");
-  Recorder<sphere_tree_collision::TickStats> stats(nh, "/tick_stats");
+  Recorder<sphere_tree_collision::SpawnEntity> spawns(nh, "/collision_world/spawn");
+  Recorder<sphere_tree_collision::Despawn> despawns(nh, "/collision_world/despawn");
+  Recorder<sphere_tree_collision::TickStats> stats(nh, "/collision_world/tick_stats");
   spawns.keep_all = true;
   despawns.keep_all = true;
   ASSERT_TRUE(spawns.waitFor(8, stc_test::kLivenessSeconds));

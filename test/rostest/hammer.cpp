@@ -154,11 +154,11 @@ bool finiteContact(const sphere_tree_collision::Contact& c) {
 
 TEST(Hammer, MalformedFloodIsRejectedByTopicWhileTheWorldRuns) {
   ros::NodeHandle nh;
-  ros::Publisher spawn = nh.advertise<SpawnEntity>("/spawn", 1000);
-  ros::Publisher despawn = nh.advertise<Despawn>("/despawn", 1000);
-  ros::Publisher gaze = nh.advertise<GazePoint>("/gaze", 1000);
+  ros::Publisher spawn = nh.advertise<SpawnEntity>("/collision_world/spawn", 1000);
+  ros::Publisher despawn = nh.advertise<Despawn>("/collision_world/despawn", 1000);
+  ros::Publisher gaze = nh.advertise<GazePoint>("/collision_world/gaze", 1000);
   ros::Publisher clicked = nh.advertise<geometry_msgs::PointStamped>("/clicked_point", 1000);
-  Recorder<TickStats> stats(nh, "/tick_stats");
+  Recorder<TickStats> stats(nh, "/collision_world/tick_stats");
   std::size_t tf_seen = 0, tf_non_finite = 0, contacts_seen = 0, contacts_non_finite = 0;
   ros::Subscriber tf_sub = nh.subscribe<tf2_msgs::TFMessage>("/tf", 100, [&](const auto& m) {
     for (const auto& t : m->transforms) {
@@ -166,7 +166,7 @@ TEST(Hammer, MalformedFloodIsRejectedByTopicWhileTheWorldRuns) {
       tf_non_finite += finiteTransform(t.transform) ? 0 : 1;
     }
   });
-  ros::Subscriber contacts_sub = nh.subscribe<sphere_tree_collision::ContactArray>("/contacts", 100, [&](const auto& m) {
+  ros::Subscriber contacts_sub = nh.subscribe<sphere_tree_collision::ContactArray>("/collision_world/contacts", 100, [&](const auto& m) {
     for (const auto& c : m->contacts) {
       ++contacts_seen;
       contacts_non_finite += finiteContact(c) ? 0 : 1;
@@ -267,9 +267,9 @@ TEST(Hammer, MalformedFloodIsRejectedByTopicWhileTheWorldRuns) {
 
 TEST(Hammer, ABodyLeavingTheWorldIsRemovedAndReportedByName) {
   ros::NodeHandle nh;
-  ros::Publisher spawn = nh.advertise<SpawnEntity>("/spawn", 10);
-  Recorder<TickStats> stats(nh, "/tick_stats");
-  Recorder<sphere_tree_collision::Quarantined> quarantined(nh, "/quarantined");
+  ros::Publisher spawn = nh.advertise<SpawnEntity>("/collision_world/spawn", 10);
+  Recorder<TickStats> stats(nh, "/collision_world/tick_stats");
+  Recorder<sphere_tree_collision::Quarantined> quarantined(nh, "/collision_world/quarantined");
   quarantined.keep_all = true;
   ASSERT_TRUE(stc_test::spinUntil(
       [&] { return spawn.getNumSubscribers() > 0 && stats.count() > 0 && quarantined.sub_.getNumPublishers() > 0; },

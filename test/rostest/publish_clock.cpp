@@ -27,8 +27,8 @@ class PublishClock : public testing::Test {
  protected:
   PublishClock()
       : clock_(nh_, "/clock", 1000),
-        stats_(nh_, "/tick_stats", 1000),
-        contacts_(nh_, "/contacts", 1000),
+        stats_(nh_, "/collision_world/tick_stats", 1000),
+        contacts_(nh_, "/collision_world/contacts", 1000),
         states_(nh_, "/collision_world/entity_states", 1000),
         list_(nh_, "/collision_world/entities"),
         listener_(tf_, nh_, false) {

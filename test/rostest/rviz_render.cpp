@@ -214,7 +214,7 @@ TEST(RvizRender, DemoIsDrawn) {
   const std::string screenshot = dir + "/screenshot.ppm";
 
   ros::NodeHandle nh;
-  stc_test::Recorder<visualization_msgs::MarkerArray> markers(nh, "/markers", 2);
+  stc_test::Recorder<visualization_msgs::MarkerArray> markers(nh, "/collision_world/markers", 2);
   ASSERT_TRUE(markers.waitFor(1, kMarkersTimeout)) << "the world node published no markers within " << kMarkersTimeout << " s";
   std::size_t voxel_markers = 0;
   for (const auto& m : markers.last.markers) voxel_markers += m.ns == "voxels";

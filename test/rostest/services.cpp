@@ -30,7 +30,7 @@ const std::string kNode = "/collision_world/";
 
 class Services : public testing::Test {
  protected:
-  Services() : stats_(nh_, "/tick_stats"), list_(nh_, kNode + "entities"), listener_(tf_, nh_, false) {
+  Services() : stats_(nh_, "/collision_world/tick_stats"), list_(nh_, kNode + "entities"), listener_(tf_, nh_, false) {
     for (const char* name : {"spawn", "despawn", "clear", "pause", "unpause", "step", "reset"}) {
       EXPECT_TRUE(ros::service::waitForService(kNode + name, ros::Duration(stc_test::kLivenessSeconds))) << name;
     }

@@ -16,7 +16,7 @@ constexpr double kDt = 0.1;  // sim_time.test: ~rate 10
 TEST(SimTime, TicksFollowTheClock) {
   ros::NodeHandle nh;
   ros::Publisher clock_pub = nh.advertise<rosgraph_msgs::Clock>("/clock", 100);
-  stc_test::Recorder<sphere_tree_collision::TickStats> stats(nh, "/tick_stats", 1000);
+  stc_test::Recorder<sphere_tree_collision::TickStats> stats(nh, "/collision_world/tick_stats", 1000);
   stats.keep_all = true;
   std::set<std::uint64_t> published;
   rosgraph_msgs::Clock clock;

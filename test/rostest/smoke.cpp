@@ -36,7 +36,7 @@ std::vector<std::string> entityFrames() {
 
 // Stamp of every tick_stats message seen, by tick number.
 struct TickStamps {
-  explicit TickStamps(ros::NodeHandle& nh) : stats(nh, "/tick_stats", 1000) { stats.keep_all = true; }
+  explicit TickStamps(ros::NodeHandle& nh) : stats(nh, "/collision_world/tick_stats", 1000) { stats.keep_all = true; }
   std::optional<std::uint64_t> tickAt(const ros::Time& stamp) const {
     for (const auto& s : stats.all) {
       if (s.header.stamp == stamp) return s.tick;
@@ -49,9 +49,9 @@ struct TickStamps {
 TEST(Smoke, AdvertisedTypes) {
   ros::NodeHandle nh;
   const std::vector<std::pair<std::string, std::string>> expected = {
-      {"/markers", "visualization_msgs/MarkerArray"},
-      {"/tick_stats", "sphere_tree_collision/TickStats"},
-      {"/contacts", "sphere_tree_collision/ContactArray"},
+      {"/collision_world/markers", "visualization_msgs/MarkerArray"},
+      {"/collision_world/tick_stats", "sphere_tree_collision/TickStats"},
+      {"/collision_world/contacts", "sphere_tree_collision/ContactArray"},
       {"/tf", "tf2_msgs/TFMessage"}};
   // The node advertises them one after the other at start-up: wait for all.
   ASSERT_TRUE(stc_test::spinUntil(
@@ -68,13 +68,13 @@ TEST(Smoke, AdvertisedTypes) {
 TEST(Smoke, MarkersEveryFewTicks) {
   ros::NodeHandle nh;
   const auto ticks_per_marker = static_cast<std::uint64_t>(std::lround(param("tick_rate") / param("marker_rate")));
-  stc_test::MarkerState state(nh, "/markers");
+  stc_test::MarkerState state(nh, "/collision_world/markers");
   TickStamps ticks(nh);
-  Recorder<visualization_msgs::MarkerArray> markers(nh, "/markers", 1000);
+  Recorder<visualization_msgs::MarkerArray> markers(nh, "/collision_world/markers", 1000);
   markers.keep_all = true;
   // A gaze puts a stamped marker in every array (entity geometry is
   // frame-locked and carries no stamp).
-  ros::Publisher gaze = nh.advertise<sphere_tree_collision::GazePoint>("/gaze", 10);
+  ros::Publisher gaze = nh.advertise<sphere_tree_collision::GazePoint>("/collision_world/gaze", 10);
   ros::SteadyTimer gazer = nh.createSteadyTimer(ros::WallDuration(0.05), [&](const ros::SteadyTimerEvent&) {
     sphere_tree_collision::GazePoint g;
     g.header.stamp = ros::Time::now();
@@ -153,7 +153,7 @@ TEST(Smoke, TickStatsAndContactsEveryTick) {
   ros::NodeHandle nh;
   TickStamps ticks(nh);
   auto& stats = ticks.stats;
-  Recorder<sphere_tree_collision::ContactArray> contacts(nh, "/contacts", 1000);
+  Recorder<sphere_tree_collision::ContactArray> contacts(nh, "/collision_world/contacts", 1000);
   contacts.keep_all = true;
   // Every contacts message belongs to a tick (same stamp as its tick_stats),
   // and the ticks seen are numbered in order with stamps in order.

@@ -30,13 +30,13 @@ constexpr double kPairSpacing = 0.7;
 class SpawnAndGaze : public testing::Test {
  protected:
   SpawnAndGaze()
-      : spawn_(nh_.advertise<SpawnEntity>("/spawn", 100)),
-        despawn_(nh_.advertise<sphere_tree_collision::Despawn>("/despawn", 10)),
-        clear_(nh_.advertise<std_msgs::Empty>("/clear", 10)),
-        gaze_(nh_.advertise<sphere_tree_collision::GazePoint>("/gaze", 10)),
-        stats_(nh_, "/tick_stats"),
-        contacts_(nh_, "/contacts"),
-        markers_(nh_, "/markers"),
+      : spawn_(nh_.advertise<SpawnEntity>("/collision_world/spawn", 100)),
+        despawn_(nh_.advertise<sphere_tree_collision::Despawn>("/collision_world/despawn", 10)),
+        clear_(nh_.advertise<std_msgs::Empty>("/collision_world/clear", 10)),
+        gaze_(nh_.advertise<sphere_tree_collision::GazePoint>("/collision_world/gaze", 10)),
+        stats_(nh_, "/collision_world/tick_stats"),
+        contacts_(nh_, "/collision_world/contacts"),
+        markers_(nh_, "/collision_world/markers"),
         listener_(tf_, nh_, false) {
     EXPECT_TRUE(stc_test::spinUntil(
         [&] { return spawn_.getNumSubscribers() > 0 && clear_.getNumSubscribers() > 0 && stats_.count() > 0; }, stc_test::kLivenessSeconds));
