@@ -1,5 +1,6 @@
 // WorldNode: the ROS face of one stc::World. Loads the scene, ticks the World
-// on a steady timer, turns input messages into World calls (rejecting bad ones
+// on its TickClock (wall clock, /clock, or its own physics time), turns input
+// messages and service calls (WorldServices) into World calls (rejecting bad ones
 // by field name, counted in tick_stats) and World state into messages. Every
 // algorithm lives in the core; this class is glue only. Single-threaded: all
 // callbacks run from one spinner, so no locking. No callback throws: whatever
@@ -66,7 +67,7 @@ class WorldNode {
   bool paused() const { return paused_; }
   // Paused: n more ticks; returns the tick number reached after them.
   std::uint64_t queueSteps(std::uint32_t n);
-  const std::string& frameOf(stc::EntityId id) { return frames_[id]; }
+  const std::string& frameOf(stc::EntityId id) const { return frames_.at(id); }
   const std::string& worldFrame() const { return params_.world_frame; }
   void publishEntityList() { entity_states_.publishListIfChanged(world_, frames_, clock_.now()); }
 
