@@ -67,6 +67,11 @@ bool isFinite(const stc::Contact& c) {
          std::isfinite(c.priority);
 }
 
+// A message every this many ticks: round(tick rate / message rate), at least 1.
+std::uint64_t ticksPerMessage(double tick_rate, double message_rate) {
+  return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(tick_rate / message_rate)));
+}
+
 // Unknown names are warned about first: a typo may be why a value is missing.
 NodeParams readParamsWarningUnknown(const ros::NodeHandle& private_nh) {
   for (const std::string& name : unknownParams(private_nh)) {
@@ -126,8 +131,8 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
   // Markers are published from the tick, every ticks_per_marker_ ticks, so that
   // each array shows the state of one tick and carries that tick's stamp.
-  ticks_per_marker_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(params_.rate / params_.marker_rate)));
-  ticks_per_states_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(params_.rate / params_.entity_states_rate)));
+  ticks_per_marker_ = ticksPerMessage(params_.rate, params_.marker_rate);
+  ticks_per_states_ = ticksPerMessage(params_.rate, params_.entity_states_rate);
   entity_states_.advertise(pnh_, params_.world_frame);
   services_ = std::make_unique<WorldServices>(pnh_, *this);
   clock_.start(nh_, dt_, [this] { tick(); });
