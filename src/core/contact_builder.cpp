@@ -1,5 +1,7 @@
 // Contacts from the intersecting sphere pairs of a PairTest (paper 3.5, Fig. 4).
-#include "sphere_tree_collision/response.hpp"
+#include "sphere_tree_collision/contact_builder.hpp"
+
+#include "sphere_tree_collision/contact_solver.hpp"  // tangentBasis
 
 #include <algorithm>
 #include <cmath>

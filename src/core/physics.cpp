@@ -1,6 +1,7 @@
 // Physics: the World's integrate and response phases over its flat arrays.
-#include "sphere_tree_collision/response.hpp"
+#include "sphere_tree_collision/physics.hpp"
 
+#include "sphere_tree_collision/dynamics.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <algorithm>
