@@ -1,5 +1,6 @@
 // The World's physics: integrate and respond, keeping what lasts between
-// ticks (warm-start impulses by entity id, sweep data, scratch).
+// ticks (warm-start impulses by entity id, sweep data, scratch), and the
+// step context its phases read.
 #pragma once
 
 #include "sphere_tree_collision/contact_builder.hpp"
@@ -10,12 +11,34 @@
 
 #include <array>
 #include <cstdint>
-#include <functional>
+#include <deque>
 #include <vector>
 
 namespace stc {
 
-struct ShapeInfo;  // world.hpp
+// One tick's view of the World, recreated at each physics phase (as Box2D's
+// step context): the tick's parameters and pointers to the World's flat
+// arrays, so that the phases share one seam instead of long argument lists.
+// Each phase reads what it names below; the pointers must outlive the call.
+struct StepContext {
+  double dt = 0.0;
+  Vec3 gravity = Vec3::Zero();
+  const ResponseOptions* options = nullptr;
+  // Bodies by dense index, their shape ids, and the bounds of each shape id
+  // (built once per shape: World::addShape).
+  std::vector<BodyState>* bodies = nullptr;
+  const std::vector<std::uint32_t>* body_shapes = nullptr;
+  const std::deque<ShapeBounds>* shape_bounds = nullptr;
+  // The narrow phase's pairs: tests[0..pair_count), the dense indices of each
+  // test's bodies, and their perceptual priorities (sweep: pair_bodies only).
+  const std::vector<PairTest>* tests = nullptr;
+  std::size_t pair_count = 0;
+  const std::vector<std::array<std::uint32_t, 2>>* pair_bodies = nullptr;
+  const std::vector<double>* priorities = nullptr;
+  bool accept_unresolved = true;  // policy accept: unresolved pairs give contacts too
+  SolveBudget budget;             // what the solver may spend (respond)
+  std::vector<Contact>* contacts = nullptr;  // respond's output
+};
 
 struct PhysicsReport {
   SweepStats sweep;
@@ -24,13 +47,9 @@ struct PhysicsReport {
 
 class Physics {
  public:
-  // Voxels, tree and body origin of a shape id; called once per new shape.
-  using ShapeOf = std::function<const ShapeInfo&(std::uint32_t shape)>;
-
   // Tick phase 1: positions, velocities (gravity), and which bodies are fast.
-  void integrate(std::vector<BodyState>& bodies, const std::vector<std::uint32_t>& body_shapes,
-                 const ShapeOf& shape_of, const Vec3& gravity, const ResponseOptions& options,
-                 double dt);
+  // Reads dt, gravity, options, bodies, body_shapes, shape_bounds.
+  void integrate(const StepContext& step);
   // After integrate: fast bodies need swept boxes in the broad phase, from
   // their start pose of the tick to their pose now.
   bool isFast(std::size_t body) const {
@@ -38,29 +57,20 @@ class Physics {
   }
   const Pose& startPose(std::size_t body) const { return start_[body]; }
   // Tick phase 2b, after the broad phase: sweep of the fast bodies against
-  // their broad-phase partners pair_bodies[0..count) (sweepFastBodies).
-  void sweep(std::vector<BodyState>& bodies, const std::vector<std::array<std::uint32_t, 2>>& pair_bodies,
-             std::size_t count, const ResponseOptions& options);
-  // Tick phase 4: contacts of tests[0..count) (pair_bodies: dense indices of
-  // each test's bodies; the same pairs the sweep saw), plus the sweep's hit
-  // for a pair whose test gave no contact, then impulses when options.enabled,
-  // within `budget`.
-  void respond(const std::vector<PairTest>& tests, std::size_t count,
-               const std::vector<std::array<std::uint32_t, 2>>& pair_bodies,
-               const std::vector<double>& priorities, bool accept_unresolved,
-               const std::vector<std::uint32_t>& body_shapes, const ShapeOf& shape_of,
-               std::vector<BodyState>& bodies, const ResponseOptions& options, double dt,
-               std::vector<Contact>& contacts, const SolveBudget& budget = SolveBudget{});
+  // their broad-phase partners pair_bodies[0..pair_count) (sweepFastBodies).
+  // Reads options, bodies, pair_bodies, pair_count.
+  void sweep(const StepContext& step);
+  // Tick phase 4: contacts of tests[0..pair_count) (pair_bodies: the same
+  // pairs the sweep saw), plus the sweep's hit for a pair whose test gave no
+  // contact, into contacts; then impulses when options->enabled, within budget.
+  void respond(const StepContext& step);
   const PhysicsReport& lastReport() const { return report_; }
   void forget() { solver_.forget(); }
 
  private:
-  const ShapeBounds& boundsOf(std::uint32_t shape, const ShapeOf& shape_of);
-
   ContactBuilder builder_;
   ContactSolver solver_;
   double gravity_speed_ = 0.0;  // |g| dt of the last integrate
-  std::vector<ShapeBounds> bounds_;  // by shape id, built on first use
   std::vector<Pose> start_;
   std::vector<const ShapeBounds*> body_bounds_;
   SweepScratch sweep_scratch_;

@@ -181,12 +181,16 @@ class World {
   double narrowPhase(const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
   void response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report);
   void quarantine(TickReport& report);  // first and last: removes bodies beyond the limits
+  // What the physics phases read and write this tick (physics.hpp); each
+  // phase sets what is its own (dt, the solver's budget).
+  StepContext physicsStep();
   Aabb boxOf(std::size_t index) const;
   Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
 
   WorldConfig config_;
   std::deque<ShapeInfo> shapes_;  // deque: trees keep their address as shapes are added
+  std::deque<ShapeBounds> shape_bounds_;  // by shape id, built in addShape; they point at the trees
   std::unordered_map<std::string, ShapeId> shape_by_key_;
 
   // Entities: flat arrays indexed densely; ids_ maps dense -> id.
@@ -210,7 +214,7 @@ class World {
   std::vector<std::array<std::uint32_t, 2>> pair_bodies_;  // dense indices of each pair test's bodies
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
   std::vector<Contact> contacts_;
-  Physics physics_;  // integration and response (response.hpp), warm-start state
+  Physics physics_;  // integration, sweep and response (physics.hpp), warm-start state
   SecondsClock clock_ = steadySeconds;
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step
