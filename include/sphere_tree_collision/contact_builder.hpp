@@ -74,9 +74,9 @@ double deepestOverlap(const std::vector<ContactCandidate>& candidates);
 void refineDeepCandidates(std::vector<ContactCandidate>& candidates, double deepest, const PairGeometry& geometry,
                           bool face_normals);
 // 3. Up to `limit` (clamped to 1..16) representatives spread out among the
-// refined candidates: first the deepest (within 1e-3 of the smallest reach)
+// refined candidates: first the deepest (within 1e-3 times the smallest reach)
 // farthest from the centroid, then the farthest from it, then the largest
-// triangle, then the farthest from all picked; points closer than 1e-6 of the
+// triangle, then the farthest from all picked; points closer than 1e-6 times the
 // smallest reach count as one. Fills `reps` with candidate indices.
 void pickRepresentatives(const std::vector<ContactCandidate>& candidates, double deepest, int limit,
                          std::vector<int>& reps);
