@@ -214,7 +214,7 @@ class World {
   std::vector<std::array<std::uint32_t, 2>> pair_bodies_;  // dense indices of each pair test's bodies
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
   std::vector<Contact> contacts_;
-  Physics physics_;  // integration, sweep and response (physics.hpp), warm-start state
+  Physics physics_;  // integration and response (response.hpp), warm-start state
   SecondsClock clock_ = steadySeconds;
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step
