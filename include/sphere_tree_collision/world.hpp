@@ -181,12 +181,16 @@ class World {
   double narrowPhase(const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
   void response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report);
   void quarantine(TickReport& report);  // first and last: removes bodies beyond the limits
+  // What the physics phases read and write this tick (physics.hpp); each
+  // phase sets what is its own (dt, the solver's budget).
+  StepContext physicsStep();
   Aabb boxOf(std::size_t index) const;
   Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
 
   WorldConfig config_;
   std::deque<ShapeInfo> shapes_;  // deque: trees keep their address as shapes are added
+  std::deque<ShapeBounds> shape_bounds_;  // by shape id, built in addShape; they point at the trees
   std::unordered_map<std::string, ShapeId> shape_by_key_;
 
   // Entities: flat arrays indexed densely; ids_ maps dense -> id.

@@ -94,10 +94,15 @@ ShapeId World::addShape(const std::string& key, VoxelShape voxels) {
   info.tree = SphereTree::build(voxels, info.body_origin, config_.tree);
   info.bounding_radius = boundingRadius(voxels, info.body_origin);
   info.elongated = isElongated(voxels);
+
+  // Bounds of every node, once per shape (contacts and sweeps read them each tick).
+  ShapeBounds bounds = makeShapeBounds(info.tree, &voxels, info.body_origin);
   info.voxels = std::move(voxels);
 
   const auto id = static_cast<ShapeId>(shapes_.size());
   shapes_.push_back(std::move(info));  // deque: earlier shapes (and trees) stay put
+  bounds.tree = &shapes_.back().tree;  // the tree moved into the deque
+  shape_bounds_.push_back(std::move(bounds));
   shape_by_key_.emplace(key, id);
   return id;
 }
@@ -261,10 +266,27 @@ TickReport World::step(double dt, const Budget& budget) {
   return report;
 }
 
-// Semi-implicit Euler; marks the fast bodies (response.hpp).
+StepContext World::physicsStep() {
+  StepContext step;
+  step.gravity = config_.gravity;
+  step.options = &config_.response;
+  step.bodies = &bodies_;
+  step.body_shapes = &body_shapes_;
+  step.shape_bounds = &shape_bounds_;
+  step.tests = &pair_tests_;
+  step.pair_count = pair_count_;
+  step.pair_bodies = &pair_bodies_;
+  step.priorities = &pair_priority_;
+  step.accept_unresolved = config_.unresolved_policy == UnresolvedPolicy::Accept;
+  step.contacts = &contacts_;
+  return step;
+}
+
+// Semi-implicit Euler; marks the fast bodies (physics.hpp).
 void World::integrate(double dt, TickReport& /*report*/) {
-  physics_.integrate(bodies_, body_shapes_, [this](ShapeId s) -> const ShapeInfo& { return shapes_[s]; },
-                     config_.gravity, config_.response, dt);
+  StepContext step = physicsStep();
+  step.dt = dt;
+  physics_.integrate(step);
 }
 
 Aabb World::boxOf(std::size_t index) const {
@@ -338,9 +360,9 @@ void World::broadPhase(TickReport& report) {
 }
 
 // Fast bodies put back at their first contact with a broad-phase partner
-// (response.hpp, sweepFastBodies); the pair tests read the poses when they run.
+// (continuous.hpp, sweepFastBodies); the pair tests read the poses when they run.
 void World::continuousCollision(TickReport& /*report*/) {
-  physics_.sweep(bodies_, pair_bodies_, pair_count_, config_.response);
+  physics_.sweep(physicsStep());
 }
 
 double World::narrowPhase(const Budget& budget, const Deadline& tick_end, double start,
@@ -390,16 +412,14 @@ double World::narrowPhase(const Budget& budget, const Deadline& tick_end, double
 }
 
 // Contacts from the deepest sphere pairs of each colliding or accepted pair,
-// then impulses and position correction (response.hpp), refined until the
-// tick's deadline or the iteration budget.
+// then impulses and position correction (contact_builder.hpp,
+// contact_solver.hpp), refined until the tick's deadline or the iteration budget.
 void World::response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report) {
-  SolveBudget solve;
-  solve.max_iterations = budget.solver_iterations;
-  solve.deadline = tick_end;
-  physics_.respond(pair_tests_, pair_count_, pair_bodies_, pair_priority_,
-                   config_.unresolved_policy == UnresolvedPolicy::Accept, body_shapes_,
-                   [this](ShapeId s) -> const ShapeInfo& { return shapes_[s]; }, bodies_,
-                   config_.response, dt, contacts_, solve);
+  StepContext step = physicsStep();
+  step.dt = dt;
+  step.budget.max_iterations = budget.solver_iterations;
+  step.budget.deadline = tick_end;
+  physics_.respond(step);
   const SolveStats& stats = physics_.lastReport().solve;
   report.velocity_passes = stats.velocity_passes;
   report.position_passes = stats.position_passes;

@@ -1,6 +1,8 @@
 // Impulse solver: non-penetration + Coulomb friction, restitution, split-impulse
 // position correction; sequential (Gauss-Seidel) or simultaneous (Jacobi).
-#include "sphere_tree_collision/response.hpp"
+#include "sphere_tree_collision/contact_solver.hpp"
+
+#include "sphere_tree_collision/dynamics.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,37 +14,6 @@ void tangentBasis(const Vec3& n, Vec3& t1, Vec3& t2) {
   t1 = std::abs(n.x()) < 0.57735 ? Vec3(0.0, n.z(), -n.y()) : Vec3(n.y(), -n.x(), 0.0);
   t1.normalize();
   t2 = n.cross(t1);
-}
-
-SolverKind parseSolverKind(const std::string& name) {
-  if (name == "sequential") return SolverKind::Sequential;
-  if (name == "jacobi") return SolverKind::Jacobi;
-  throw InputError("solver", "unknown solver '" + name + "' (sequential | jacobi)");
-}
-
-const char* toString(SolverKind kind) {
-  return kind == SolverKind::Jacobi ? "jacobi" : "sequential";
-}
-
-void validateResponseOptions(const ResponseOptions& o) {
-  if (o.iterations < 1 || o.iterations > 1000) {
-    throw InputError("response.iterations", "must be in [1, 1000]");
-  }
-  if (!(o.restitution_threshold >= 0.0 && std::isfinite(o.restitution_threshold))) {
-    throw InputError("response.restitution_threshold", "must be finite and >= 0");
-  }
-  if (!(o.position_correction >= 0.0 && o.position_correction <= 1.0)) {
-    throw InputError("response.position_correction", "must be in [0, 1]");
-  }
-  if (!(o.allowed_penetration >= 0.0 && std::isfinite(o.allowed_penetration))) {
-    throw InputError("response.allowed_penetration", "must be finite and >= 0");
-  }
-  if (o.max_contacts_per_pair < 1 || o.max_contacts_per_pair > 16) {
-    throw InputError("response.max_contacts_per_pair", "must be in [1, 16]");
-  }
-  if (!(o.sweep_threshold > 0.0 && std::isfinite(o.sweep_threshold))) {
-    throw InputError("response.sweep_threshold", "must be finite and > 0");
-  }
 }
 
 void ContactSolver::prepare(const std::vector<BodyState>& bodies,

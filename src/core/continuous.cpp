@@ -1,7 +1,9 @@
 // Anti-tunnelling: fast bodies are swept from their start to their end pose
 // and put back at their first contact (paper 3.5: backtracking to the instant
 // of collision).
-#include "sphere_tree_collision/response.hpp"
+#include "sphere_tree_collision/continuous.hpp"
+
+#include "sphere_tree_collision/dynamics.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,129 @@
+// Contacts from the intersecting sphere pairs of a PairTest (paper 3.5, Fig. 4).
+#pragma once
+
+#include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/pair_test.hpp"
+#include "sphere_tree_collision/shape_bounds.hpp"
+#include "sphere_tree_collision/sphere_tree.hpp"
+#include "sphere_tree_collision/types.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace stc {
+
+struct ContactBuildOptions {
+  int max_contacts_per_pair = 4;
+  bool accept_unresolved = true;  // policy accept: unresolved pairs give contacts too
+  bool face_normals = true;       // see ContactBuilder; false: the paper's line of centres only
+};
+
+// One intersecting sphere pair a contact may be built from (world frame).
+struct ContactCandidate {
+  Vec3 ca, cb;                 // the two spheres' centres
+  Vec3 point, normal;          // normal: unit, a -> b
+  double overlap = 0.0;        // r_a + r_b - |c_b - c_a|
+  double separation = 0.0;     // gap between the surfaces along normal (once refined)
+  std::int32_t node_a = 0, node_b = 0;
+  int cluster = 0;             // position of its representative among the picked ones
+  bool refined = false;        // separation and face normal evaluated (deep enough)
+};
+
+// The two bodies of a pair as the contact steps see them: trees, node bounds
+// (nullptr: the surface is the sphere) and poses.
+class PairGeometry {
+ public:
+  PairGeometry(const PairTest& test, const ShapeBounds* bounds_a, const ShapeBounds* bounds_b);
+
+  // Paper Fig. 4: normal along the line of centres a -> b (coincident: the
+  // body centres, then +Z), point dividing the centres in proportion to the radii.
+  ContactCandidate candidate(std::int32_t node_a, std::int32_t node_b) const;
+  // Gap between the two nodes' surfaces along unit n (world, a -> b).
+  double gapAlong(const ContactCandidate& c, const Vec3& n) const;
+  // Separation along the candidate's normal; with face_normals and bounds, a
+  // face axis of either voxel box that separates the nodes more becomes the
+  // normal, and the point moves to the middle of the faces' overlap.
+  void refine(ContactCandidate& c, bool face_normals) const;
+
+ private:
+  // Surface of a node towards a direction in its own body frame / the world.
+  double localSupportA(std::int32_t node, const Vec3& dir_a) const;
+  double localSupportB(std::int32_t node, const Vec3& dir_b) const;
+  double supportA(std::int32_t node, const Vec3& dir) const { return localSupportA(node, rot_a_.transpose() * dir); }
+  double supportB(std::int32_t node, const Vec3& dir) const { return localSupportB(node, rot_b_.transpose() * dir); }
+  Vec3 faceContactPoint(const ContactCandidate& c) const;
+
+  const SphereTree& tree_a_;
+  const SphereTree& tree_b_;
+  const ShapeBounds* bounds_a_;
+  const ShapeBounds* bounds_b_;
+  Mat3 rot_a_, rot_b_;
+  Mat3 b_in_a_;  // B's axes in A's frame (columns)
+  Vec3 pos_a_, pos_b_;
+};
+
+// The steps of ContactBuilder::append, each usable alone.
+
+// 1. Candidates: the test's lastPairs(), or the roots when no sphere was tested.
+void gatherCandidates(const PairTest& test, const PairGeometry& geometry, std::vector<ContactCandidate>& out);
+// Largest overlap of the candidates (-infinity when there are none).
+double deepestOverlap(const std::vector<ContactCandidate>& candidates);
+// 2. Refines (PairGeometry::refine) the candidates with at least half the
+// deepest overlap (all of them when nothing overlaps); only those can
+// represent the pair, the others only join clusters.
+void refineDeepCandidates(std::vector<ContactCandidate>& candidates, double deepest, const PairGeometry& geometry,
+                          bool face_normals);
+// 3. Up to `limit` (clamped to 1..16) representatives spread out among the
+// refined candidates: first the deepest (within 1e-3 times the smallest reach)
+// farthest from the centroid, then the farthest from it, then the largest
+// triangle, then the farthest from all picked; points closer than 1e-6 times the
+// smallest reach count as one. Fills `reps` with candidate indices.
+void pickRepresentatives(const std::vector<ContactCandidate>& candidates, double deepest, int limit,
+                         std::vector<int>& reps);
+// 4. Every candidate joins its nearest representative (cluster = position in reps).
+void assignClusters(std::vector<ContactCandidate>& candidates, const std::vector<int>& reps);
+// 5. A cluster's normal: the mean over its refined members with sphere
+// overlap within 10% of its deepest (the pairs straight across the contact);
+// `fallback` (the representative's) when that mean is zero or not finite.
+Vec3 clusterNormal(const std::vector<ContactCandidate>& candidates, int cluster, const Vec3& fallback);
+// ... and its separation along `normal`: the smallest gap of the members whose
+// own normal lies within about 18 degrees of it; `fallback` when none does.
+double clusterSeparation(const std::vector<ContactCandidate>& candidates, int cluster, const Vec3& normal,
+                         const PairGeometry& geometry, double fallback);
+
+// Builds the contacts of PairTests. Candidates are the test's lastPairs()
+// (leaf pairs when Colliding, the frontier when accepted Unresolved, the roots
+// when no sphere was tested). Per candidate (paper Fig. 4): normal along the
+// line of centres a -> b, point dividing the centres in proportion to the
+// radii. With face_normals and ShapeBounds, a face axis of either node's voxel
+// box replaces the line of centres when it separates the two nodes more (the
+// separating-axis rule): face-on, the line of centres of two voxel spheres
+// tilts by up to 45 degrees, making floors bumpy and balls sit in dimples;
+// the point is then the middle of the two boxes' overlap on the face plane,
+// halfway between the surfaces. Only candidates with at least half the
+// deepest sphere overlap are refined so and can represent the pair.
+// Up to max_contacts_per_pair representatives are picked spread out among the
+// deep candidates (deepest corner first, then farthest, then largest
+// triangle); every candidate joins its nearest representative; the cluster's
+// normal is the mean over its deepest members (sphere overlap within 10% of
+// its deepest: the pairs straight across the contact). separation is
+// measured along that normal between the nodes' surfaces
+// (ShapeBounds::support; the sphere itself without bounds). Coincident
+// centres: the direction between the body centres, then +Z; never NaN.
+class ContactBuilder {
+ public:
+  // Appends the contacts of one test (none when Separate, or Unresolved and not accepted).
+  // bounds_a/bounds_b: of the test's trees, or nullptr (surface at the spheres).
+  // The steps, in order: gatherCandidates, refineDeepCandidates,
+  // pickRepresentatives, assignClusters, then one contact per cluster
+  // (clusterNormal, clusterSeparation).
+  void append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b, double priority,
+              const ShapeBounds* bounds_a, const ShapeBounds* bounds_b,
+              const ContactBuildOptions& options, std::vector<Contact>& out);
+
+ private:
+  std::vector<ContactCandidate> candidates_;  // scratch kept between pairs: no allocation per tick
+  std::vector<int> reps_;
+};
+
+}  // namespace stc

@@ -1,0 +1,81 @@
+// The World's physics: integrate and respond, keeping what lasts between
+// ticks (warm-start impulses by entity id, sweep data, scratch), and the
+// step context its phases read.
+#pragma once
+
+#include "sphere_tree_collision/contact_builder.hpp"
+#include "sphere_tree_collision/contact_solver.hpp"
+#include "sphere_tree_collision/continuous.hpp"
+#include "sphere_tree_collision/response_options.hpp"
+#include "sphere_tree_collision/shape_bounds.hpp"
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <vector>
+
+namespace stc {
+
+// One tick's view of the World, recreated at each physics phase (as Box2D's
+// step context): the tick's parameters and pointers to the World's flat
+// arrays, so that the phases share one seam instead of long argument lists.
+// Each phase reads what it names below; the pointers must outlive the call.
+struct StepContext {
+  double dt = 0.0;
+  Vec3 gravity = Vec3::Zero();
+  const ResponseOptions* options = nullptr;
+  // Bodies by dense index, their shape ids, and the bounds of each shape id
+  // (built once per shape: World::addShape).
+  std::vector<BodyState>* bodies = nullptr;
+  const std::vector<std::uint32_t>* body_shapes = nullptr;
+  const std::deque<ShapeBounds>* shape_bounds = nullptr;
+  // The narrow phase's pairs: tests[0..pair_count), the dense indices of each
+  // test's bodies, and their perceptual priorities (sweep: pair_bodies only).
+  const std::vector<PairTest>* tests = nullptr;
+  std::size_t pair_count = 0;
+  const std::vector<std::array<std::uint32_t, 2>>* pair_bodies = nullptr;
+  const std::vector<double>* priorities = nullptr;
+  bool accept_unresolved = true;  // policy accept: unresolved pairs give contacts too
+  SolveBudget budget;             // what the solver may spend (respond)
+  std::vector<Contact>* contacts = nullptr;  // respond's output
+};
+
+struct PhysicsReport {
+  SweepStats sweep;
+  SolveStats solve;
+};
+
+class Physics {
+ public:
+  // Tick phase 1: positions, velocities (gravity), and which bodies are fast.
+  // Reads dt, gravity, options, bodies, body_shapes, shape_bounds.
+  void integrate(const StepContext& step);
+  // After integrate: fast bodies need swept boxes in the broad phase, from
+  // their start pose of the tick to their pose now.
+  bool isFast(std::size_t body) const {
+    return body < sweep_scratch_.fast.size() && sweep_scratch_.fast[body] != 0;
+  }
+  const Pose& startPose(std::size_t body) const { return start_[body]; }
+  // Tick phase 2b, after the broad phase: sweep of the fast bodies against
+  // their broad-phase partners pair_bodies[0..pair_count) (sweepFastBodies).
+  // Reads options, bodies, pair_bodies, pair_count.
+  void sweep(const StepContext& step);
+  // Tick phase 4: contacts of tests[0..pair_count) (pair_bodies: the same
+  // pairs the sweep saw), plus the sweep's hit for a pair whose test gave no
+  // contact, into contacts; then impulses when options->enabled, within budget.
+  void respond(const StepContext& step);
+  const PhysicsReport& lastReport() const { return report_; }
+  void forget() { solver_.forget(); }
+
+ private:
+  ContactBuilder builder_;
+  ContactSolver solver_;
+  double gravity_speed_ = 0.0;  // |g| dt of the last integrate
+  std::vector<Pose> start_;
+  std::vector<const ShapeBounds*> body_bounds_;
+  SweepScratch sweep_scratch_;
+  std::vector<std::int32_t> sweep_hit_of_pair_;  // body whose sweep hit that pair, or -1
+  PhysicsReport report_;
+};
+
+}  // namespace stc

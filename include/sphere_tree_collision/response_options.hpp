@@ -1,0 +1,47 @@
+// What the response phase does and how (paper 3.5, 4): the options of the
+// contacts, the impulse solver and the swept test, checked in one place.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace stc {
+
+// How the impulses of one tick are iterated (docs/response.md has the measurements).
+enum class SolverKind : std::uint8_t {
+  Sequential,  // projected Gauss-Seidel (sequential impulses): each contact sees the last one's impulse
+  Jacobi,      // the paper's simultaneous scheme: every iteration computes all impulses from
+               // one state, then applies them together (mass splitting keeps it convergent)
+};
+// "sequential" | "jacobi"; throws InputError("solver") otherwise.
+SolverKind parseSolverKind(const std::string& name);
+const char* toString(SolverKind kind);
+
+struct ResponseOptions {
+  bool enabled = true;
+  int iterations = 20;                  // velocity (and position) iterations per tick, >= 1
+  // m/s: slower approach is treated as resting. The World raises it to at
+  // least 4 |g| dt: a body resting under gravity falls that fast within a
+  // speculative gap in one or two ticks, and bouncing on that would never settle.
+  double restitution_threshold = 0.2;
+  double position_correction = 0.2;     // fraction of penetration removed per tick, [0, 1]
+  double allowed_penetration = 0.0;     // metres kept as slop (0: 2% of the contact's gap bound h_a + h_b)
+  SolverKind solver = SolverKind::Sequential;
+  bool warm_starting = true;            // start from last tick's impulses of matching contacts
+  // After the iterations, one sweep up the contact graph from the static
+  // bodies in which each supporting body counts as immovable for what rests
+  // on it (shock propagation, Guendelman et al. 2003): stacks and heavy-on-light
+  // hold; only approach towards the support is removed, never added.
+  bool shock_propagation = true;
+  int max_contacts_per_pair = 4;        // spread-out representatives of the sphere pairs, 1..16
+  bool face_normals = true;             // voxel-box face axis when it separates more (ContactBuilder)
+  bool continuous = true;               // sweep fast bodies back to their first contact
+  // A body is fast when it moves (incl. rotation at its farthest sphere) more
+  // than this fraction of its smallest leaf radius in one tick.
+  double sweep_threshold = 0.5;
+  bool gyroscopic = true;               // implicit-midpoint w x Iw (see dynamics.hpp)
+};
+// Throws InputError naming the field ("response.iterations", ...).
+void validateResponseOptions(const ResponseOptions& options);
+
+}  // namespace stc

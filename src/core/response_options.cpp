@@ -1,0 +1,41 @@
+// Response options: names of the solver kinds and the checks of every field.
+#include "sphere_tree_collision/response_options.hpp"
+
+#include "sphere_tree_collision/types.hpp"
+
+#include <cmath>
+
+namespace stc {
+
+SolverKind parseSolverKind(const std::string& name) {
+  if (name == "sequential") return SolverKind::Sequential;
+  if (name == "jacobi") return SolverKind::Jacobi;
+  throw InputError("solver", "unknown solver '" + name + "' (sequential | jacobi)");
+}
+
+const char* toString(SolverKind kind) {
+  return kind == SolverKind::Jacobi ? "jacobi" : "sequential";
+}
+
+void validateResponseOptions(const ResponseOptions& o) {
+  if (o.iterations < 1 || o.iterations > 1000) {
+    throw InputError("response.iterations", "must be in [1, 1000]");
+  }
+  if (!(o.restitution_threshold >= 0.0 && std::isfinite(o.restitution_threshold))) {
+    throw InputError("response.restitution_threshold", "must be finite and >= 0");
+  }
+  if (!(o.position_correction >= 0.0 && o.position_correction <= 1.0)) {
+    throw InputError("response.position_correction", "must be in [0, 1]");
+  }
+  if (!(o.allowed_penetration >= 0.0 && std::isfinite(o.allowed_penetration))) {
+    throw InputError("response.allowed_penetration", "must be finite and >= 0");
+  }
+  if (o.max_contacts_per_pair < 1 || o.max_contacts_per_pair > 16) {
+    throw InputError("response.max_contacts_per_pair", "must be in [1, 16]");
+  }
+  if (!(o.sweep_threshold > 0.0 && std::isfinite(o.sweep_threshold))) {
+    throw InputError("response.sweep_threshold", "must be finite and > 0");
+  }
+}
+
+}  // namespace stc
