@@ -21,15 +21,17 @@
 //   estimate, the projected distance of the entity origins.
 // - After a step, g is the reach r_a + r_b of a frontier sphere pair times the
 //   pair's pixels per metre, and c the exact tests of the next step: both kept
-//   by the PairTest as it steps. A re-measure is a multiply, a divide and two
-//   comparisons with the neighbouring bin edges; no projection after the start.
+//   by the PairTest as it steps and copied beside the queued index. A
+//   re-measure is a multiply, a divide and K - 1 branch-free comparisons with
+//   the bin edges; no projection after the start.
 //   (The reach is an upper bound of the paper's g: the distance of two
 //   intersecting centres is at most their reach.)
 // - Queue 0 is the end of the line: its pairs (the rest, and weight 0 when a
 //   body is behind the camera) go round-robin and are not re-measured (a
 //   step rarely raises a priority: the reach shrinks and the cost grows).
 // - Queues are vectors reused across runs: appending is O(1), a pass
-//   compacts in place, and nothing is sorted.
+//   compacts in place, and nothing is sorted. A pass prefetches the
+//   PairTests it will step (a queue is in no memory order).
 // Without a fixation, or with one queue, every pair sits in queue 0: plain
 // round-robin in list order, and no projection work.
 #include "scheduler_detail.hpp"
@@ -38,6 +40,17 @@
 #include <cmath>
 
 namespace stc::detail {
+namespace {
+
+// A queue holds pairs in no memory order, so the hardware does not see the
+// next PairTest coming: ask for it a few steps ahead (a step reads most of it).
+constexpr std::size_t kPrefetchAhead = 4;
+inline void prefetch(const PairTest& test) {
+  const char* p = reinterpret_cast<const char*>(&test);
+  for (std::size_t offset = 0; offset < sizeof(PairTest); offset += 64) __builtin_prefetch(p + offset);
+}
+
+}  // namespace
 
 PriorityQueueScheduler::PriorityQueueScheduler(const SchedulerOptions& options)
     : queue_count_(options.queue_count),
@@ -46,9 +59,8 @@ PriorityQueueScheduler::PriorityQueueScheduler(const SchedulerOptions& options)
       queues_(static_cast<std::size_t>(options.queue_count)),
       lower_edge_(static_cast<std::size_t>(options.queue_count)) {}
 
-const PriorityQueueScheduler::BodyGaze& PriorityQueueScheduler::gazeOf(std::uint32_t body,
-                                                                       const PairBody& pair_body,
-                                                                       const Perception& perception) {
+inline const PriorityQueueScheduler::BodyGaze& PriorityQueueScheduler::gazeOf(
+    std::uint32_t body, const PairBody& pair_body, const Perception& perception) {
   BodyGaze& gaze = gaze_[body];
   if (gaze.run == run_) return gaze;
   const Perception::GazeWeight gw = perception.gazeWeight(pair_body.pose->position);
@@ -137,6 +149,7 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
     std::size_t kept = 0;
     bool out_of_budget = false;
     for (std::size_t r = 0; r < queue.size(); ++r) {
+      if (r + kPrefetchAhead < queue.size()) prefetch(tests[queue[r + kPrefetchAhead].pair]);
       PairTest& test = tests[queue[r].pair];
       if (!budgetedStep(test, budget, stats)) {
         out_of_budget = true;
