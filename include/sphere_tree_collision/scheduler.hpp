@@ -58,6 +58,7 @@ struct ScheduleStats {
 
 // The two bodies of each pair test as dense indices in [0, body_count): a
 // perceptual scheduler projects each body once per run, not once per pair.
+// Without them (of_pair null) priority queues run as round-robin.
 struct PairBodies {
   const std::array<std::uint32_t, 2>* of_pair = nullptr;  // [count], parallel to the tests
   std::size_t body_count = 0;

@@ -32,8 +32,9 @@
 // - Queues are vectors reused across runs: appending is O(1), a pass
 //   compacts in place, and nothing is sorted. A pass prefetches the
 //   PairTests it will step (a queue is in no memory order).
-// Without a fixation, or with one queue, every pair sits in queue 0: plain
-// round-robin in list order, and no projection work.
+// Without a fixation, with one queue, or without the pairs' body indices,
+// every pair sits in queue 0: plain round-robin in list order, and no
+// projection work.
 #include "scheduler_detail.hpp"
 
 #include <algorithm>
@@ -128,7 +129,7 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
   SampledClock requeue(run_);  // the re-measuring after each pass
   overhead.start();
   for (auto& q : queues_) q.clear();
-  stats.used_perception = perceptionActive(perception) && queue_count_ > 1;
+  stats.used_perception = perceptionActive(perception) && queue_count_ > 1 && bodies.of_pair != nullptr;
   if (stats.used_perception) {
     binAll(tests, count, bodies, *perception);
   } else {

@@ -348,6 +348,11 @@ TEST_F(SchedulerTest, WithoutPerceptionTheModelIsNotUsedAndListOrderHolds) {
   EXPECT_EQ(finishOrder(*pq, false), finishOrder(*rr, false));
   camera_.setFixation(Vec2(100, 360));
   EXPECT_TRUE(runWith(*pq, Budget::unlimited(), true).used_perception);
+  {  // without the pairs' body indices there is nothing to project per body
+    resetAll();
+    BudgetTracker tracker(Budget::unlimited());
+    EXPECT_FALSE(pq->run(tests_, tests_.size(), PairBodies{}, &camera_, tracker).used_perception);
+  }
   EXPECT_TRUE(runWith(*pseq, Budget::unlimited(), true).used_perception);
   EXPECT_FALSE(runWith(*rr, Budget::unlimited(), true).used_perception);
 }
