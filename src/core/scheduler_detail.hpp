@@ -133,8 +133,9 @@ class PriorityQueueScheduler final : public Scheduler {
   double log_ratio_;
   double cost_exponent_;
   std::vector<std::vector<Queued>> queues_;  // [0] lowest .. [K-1] highest; capacity reused
-  std::vector<double> lower_edge_;                  // f at the bottom of each queue, this run
-  // Capacity reused: per body, its projection; per pair, this run's initial priority.
+  std::vector<double> lower_edge_;           // f at the bottom of each queue, this run
+  // Capacity reused: per body, its projection; per pair, this run's initial
+  // priority and weight x pixels per metre.
   std::vector<BodyGaze> gaze_;
   std::uint32_t run_ = 0;
   std::vector<double> priorities_;
