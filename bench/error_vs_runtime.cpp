@@ -1,13 +1,13 @@
-// Error against run time (issue 6, paper 3.4.2-3.4.3): for each scheduler and
-// a sweep of budgets, what the narrow phase leaves wrong, measured against
-// FCL's exact collide/distance on the same poses.
+// Error against run time (issues 6 and 11, paper 3.4.2-3.4.3): for each
+// scheduler and a sweep of budgets, what the narrow phase leaves wrong,
+// measured against FCL's exact collide/distance on the same poses.
 //
 // A simulation World (dynamics on, unlimited budget) runs the scene and
-// snapshots its poses; an evaluation World (same scene, response off) takes
-// each snapshot and runs step(dt = 0, budget) once per scheduler and budget,
-// so every scheduler sees exactly the same poses, pairs and gaze. Accepted =
-// colliding at the leaves, or unresolved at interruption (policy accept: the
-// paper's repulsion case). For every accepted pair FCL gives the truth:
+// snapshots its poses (the "ticks"). One evaluation World per scheduler (same
+// scene, response off, its scheduler warm) takes each snapshot and runs
+// step(dt = 0, budget): every scheduler sees the same poses, pairs and gaze.
+// Accepted = colliding at the leaves, or unresolved at interruption (policy
+// accept: the paper's repulsion case). For every accepted pair FCL gives the truth:
 //   false positive  accepted, but FCL says the bodies do not touch
 //   true gap        FCL distance (metres), summed
 //   true P          sum of f(e, g_true), e from the centre of collision, and
@@ -15,15 +15,22 @@
 // "unres" columns sum over accepted *unresolved* pairs only (the paper's P and
 // nabla are defined over those); "acc" columns over all accepted pairs.
 //
+// Repeats: every (snapshot, budget) is run `repeats` times, the schedulers
+// interleaved (A B C D A B C D ...) so the load of a shared machine hits all
+// alike. Repeat r of every scheduler sums its errors over the snapshots: one
+// CSV row per scene x scheduler x budget x repeat. Ratios are of those sums,
+// repeat by repeat; the headline gives their median and min-max.
+//
 // Usage: bench_error_vs_runtime [--quick] [--csv FILE] [--markdown FILE]
-//                               [--queues K] [--ratio R] [--snapshots N]
+//          [--snapshots N] [--repeats R] [--scene packed_box|rockfall]
+//          [--gaze entity|screen] [--queues K] [--ratio R] [--cost-exponent A]
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include "fcl_mesh.hpp"
+#include "tick_clock.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -32,6 +39,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -43,14 +51,14 @@ struct Options {
   bool quick = false;
   std::string csv = "docs/error_vs_runtime.csv";
   std::string markdown;
+  int snapshots = 12;
+  int repeats = 7;
+  std::string scene;            // empty: both
+  std::string gaze = "entity";  // entity | screen
   // Priority-queue settings: the library's defaults unless given.
   int queues = SchedulerOptions{}.queue_count;
   double ratio = SchedulerOptions{}.queue_ratio;
-  int snapshots = 16;
   double cost_exponent = SchedulerOptions{}.cost_exponent;
-  bool only_tests = false;
-  std::string scene;  // empty: both
-  std::string gaze = "entity";  // entity | screen
   SchedulerOptions schedulerOptions(SchedulerKind kind) const {
     SchedulerOptions o;
     o.kind = kind;
@@ -64,30 +72,53 @@ struct Options {
 constexpr SchedulerKind kKinds[] = {SchedulerKind::RoundRobin, SchedulerKind::Sequential,
                                     SchedulerKind::PerceptualSequential,
                                     SchedulerKind::PriorityQueues};
-// Budgets as fractions of the snapshot's unlimited cost (sphere tests; RR's
-// unlimited narrow-phase time for wall-clock budgets). Negative: unlimited.
-const std::vector<double> kTestFractions = {0.0, 0.01, 0.02, 0.05, 0.1, 0.15, 0.2,
-                                            0.3, 0.4, 0.5, 0.6, 0.8, -1.0};
-const std::vector<double> kTimeFractions = {0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0};
+constexpr std::size_t kKindCount = sizeof(kKinds) / sizeof(kKinds[0]);
+// Budgets as fractions of the snapshot's unlimited cost: its sphere tests, or
+// round-robin's unlimited narrow-phase time for wall-clock budgets. Negative: unlimited.
+const std::vector<double> kTestFractions = {0.01, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3,
+                                            0.4,  0.5,  0.6,  0.8, -1.0};
+const std::vector<double> kTimeFractions = {0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.85, 1.0};
 
 struct Truth {
   bool collide = false;
   double distance = 0.0;
 };
 
-struct Row {
-  std::string scene;
-  int snapshot = 0;
-  std::string scheduler;
-  std::string budget_kind;  // tests | seconds | unlimited
-  double budget = 0.0;      // sphere tests or seconds (inf when unlimited)
-  double fraction = 1.0;    // of the snapshot's unlimited cost
-  double tick_s = 0, narrow_s = 0, overhead_s = 0;
-  double sphere_tests = 0, pairs = 0, unresolved = 0, accepted = 0;
-  double false_pos = 0, false_pos_unres = 0;
-  double true_gap_unres = 0, true_gap_acc = 0, true_p_unres = 0, true_p_acc = 0;
-  double est_nabla = 0, est_bound = 0, est_p = 0;
+// What one step under one budget leaves wrong (one tick of one repeat).
+struct TickErrors {
+  double narrow_s = 0, overhead_s = 0, sphere_tests = 0, pairs = 0, unresolved = 0, accepted = 0;
+  double false_pos = 0, true_gap_unres = 0, true_p_unres = 0, true_p_acc = 0, est_nabla = 0, est_p = 0;
+  TickErrors& operator+=(const TickErrors& o) {
+    for (double TickErrors::*f :
+         {&TickErrors::narrow_s, &TickErrors::overhead_s, &TickErrors::sphere_tests, &TickErrors::pairs,
+          &TickErrors::unresolved, &TickErrors::accepted, &TickErrors::false_pos, &TickErrors::true_gap_unres,
+          &TickErrors::true_p_unres, &TickErrors::true_p_acc, &TickErrors::est_nabla, &TickErrors::est_p}) {
+      this->*f += o.*f;
+    }
+    return *this;
+  }
 };
+
+// One CSV row: a repeat's errors summed over the snapshots, with its ticks' narrow times.
+struct Row {
+  std::string scene, scheduler, budget_kind;  // tests | seconds | unlimited
+  double fraction = 1.0;
+  int repeat = 0;
+  TickErrors sum;
+  // Per tick: times are medians over the ticks, not sums (a tick the OS
+  // descheduled on the shared machine would otherwise weigh on every figure).
+  std::vector<double> narrow_s, overhead_share;
+  void add(const TickErrors& t) {
+    sum += t;
+    narrow_s.push_back(t.narrow_s);
+    overhead_share.push_back(t.narrow_s > 0 ? t.overhead_s / t.narrow_s : 0.0);
+  }
+  double overheadPercent() const { return 100.0 * stc_bench::percentile(overhead_share, 0.5); }
+  double unresolvedShare() const { return sum.unresolved / std::max(1.0, sum.pairs); }
+};
+
+// (scene, scheduler, budget kind, fraction, repeat) -> row
+using RowKey = std::tuple<std::string, std::string, std::string, double, int>;
 
 class Evaluator {
  public:
@@ -97,152 +128,131 @@ class Evaluator {
     sim_config.scheduler.kind = SchedulerKind::RoundRobin;
     sim_ = std::make_unique<World>(sim_config);
     spec_ = populateScene(*sim_, kind, params);
+    sim_->perception().setCamera(spec_.camera);
 
     WorldConfig eval_config = sim_config;
     eval_config.response.enabled = false;
     eval_config.unresolved_policy = UnresolvedPolicy::Accept;
-    eval_ = std::make_unique<World>(eval_config);
-    populateScene(*eval_, kind, params);
-    eval_->perception().setCamera(spec_.camera);
-    sim_->perception().setCamera(spec_.camera);
+    for (SchedulerKind k : kKinds) {
+      eval_config.scheduler = opt.schedulerOptions(k);
+      evals_.push_back(std::make_unique<World>(eval_config));
+      populateScene(*evals_.back(), kind, params);
+      evals_.back()->perception().setCamera(spec_.camera);
+    }
   }
 
   const SceneSpec& spec() const { return spec_; }
   World& sim() { return *sim_; }
 
-  void evaluateSnapshot(const std::string& scene, int index, double t, GazeModel& gaze,
-                        std::vector<Row>& rows) {
-    // Same poses in the evaluation world (same scene, same creation order).
-    for (std::size_t i = 0; i < sim_->entityCount(); ++i) {
-      eval_->bodies()[i].pose = sim_->bodies()[i].pose;
+  void evaluateSnapshot(const std::string& scene, double t, GazeModel& gaze,
+                        std::map<RowKey, Row>& rows) {
+    const Vec2 fixation = gaze.fixationAt(t, *sim_);
+    for (auto& eval : evals_) {  // same poses, same creation order
+      for (std::size_t i = 0; i < sim_->entityCount(); ++i) eval->bodies()[i].pose = sim_->bodies()[i].pose;
+      eval->perception().setFixation(fixation);
+      eval->step(0.0, Budget::unlimited());  // warm
     }
-    eval_->perception().setFixation(gaze.fixationAt(t, *sim_));
     truth_.clear();
 
     // Unlimited cost of this snapshot: sphere tests (the same for every
-    // scheduler) and RR's narrow-phase time (median of 3 warm runs).
-    eval_->setScheduler(opt_.schedulerOptions(SchedulerKind::RoundRobin));
+    // scheduler) and round-robin's narrow-phase time (median of 5).
     std::vector<double> times;
     std::int64_t total_tests = 0;
-    for (int r = 0; r < 4; ++r) {
-      const TickReport rep = eval_->step(0.0, Budget::unlimited());
-      if (r > 0) times.push_back(rep.narrow_s);
+    for (int r = 0; r < 5; ++r) {
+      const TickReport rep = evals_[0]->step(0.0, Budget::unlimited());
+      times.push_back(rep.narrow_s);
       total_tests = rep.sphere_tests;
     }
-    std::sort(times.begin(), times.end());
-    const double full_time = times[times.size() / 2];
+    const double full_time = stc_bench::percentile(times, 0.5);
 
-    for (SchedulerKind kind : kKinds) {
-      eval_->setScheduler(opt_.schedulerOptions(kind));
-      eval_->step(0.0, Budget::unlimited());  // warm the scheduler's vectors
-      for (double f : kTestFractions) {
-        const bool unlimited = f < 0.0;
-        const auto tests = static_cast<std::int64_t>(std::llround(f * static_cast<double>(total_tests)));
-        const Budget b = unlimited ? Budget::unlimited() : Budget::ofSphereTests(tests);
-        rows.push_back(measure(scene, index, kind, b, unlimited ? "unlimited" : "tests",
-                               unlimited ? INFINITY : static_cast<double>(tests), unlimited ? 1.0 : f));
+    auto sweep = [&](const char* budget_kind, double f, const Budget& budget) {
+      for (int rep = 0; rep < opt_.repeats; ++rep) {
+        for (std::size_t k = 0; k < kKindCount; ++k) {  // interleaved: A B C D, A B C D, ...
+          const TickReport report = evals_[k]->step(0.0, budget);
+          Row& row = rows[RowKey{scene, toString(kKinds[k]), budget_kind, f, rep}];
+          if (row.scene.empty()) {
+            row.scene = scene;
+            row.scheduler = toString(kKinds[k]);
+            row.budget_kind = budget_kind;
+            row.fraction = f;
+            row.repeat = rep;
+          }
+          row.add(errorsOf(*evals_[k], report));
+        }
       }
-      for (double f : kTimeFractions) {
-        if (opt_.only_tests) break;
-        rows.push_back(measure(scene, index, kind, Budget::ofSeconds(f * full_time), "seconds",
-                               f * full_time, f));
+    };
+    for (double f : kTestFractions) {
+      if (f < 0.0) {
+        sweep("unlimited", 1.0, Budget::unlimited());
+      } else {
+        sweep("tests", f, Budget::ofSphereTests(std::llround(f * static_cast<double>(total_tests))));
       }
     }
+    for (double f : kTimeFractions) sweep("seconds", f, Budget::ofSeconds(f * full_time));
   }
 
  private:
   // One FCL mesh per shape, in the same body frame as the tree; built on first use.
-  const truth::FclMesh& meshOf(ShapeId id) {
+  const truth::FclMesh& meshOf(const World& world, ShapeId id) {
     if (meshes_.size() <= id) meshes_.resize(id + 1);
-    if (!meshes_[id]) meshes_[id] = truth::makeFclMesh(eval_->shape(id).voxels, eval_->shape(id).body_origin);
+    if (!meshes_[id]) meshes_[id] = truth::makeFclMesh(world.shape(id).voxels, world.shape(id).body_origin);
     return *meshes_[id];
   }
 
-  const Truth& truthOf(const PairTest& test) {
+  const Truth& truthOf(const World& world, const PairTest& test) {
     const std::uint64_t key = (static_cast<std::uint64_t>(test.bodyA().id) << 32) | test.bodyB().id;
     const auto found = truth_.find(key);
     if (found != truth_.end()) return found->second;
-    const std::size_t ia = *eval_->indexOf(test.bodyA().id);
-    const std::size_t ib = *eval_->indexOf(test.bodyB().id);
-    const truth::FclMesh& ma = meshOf(eval_->bodyShapes()[ia]);
-    const truth::FclMesh& mb = meshOf(eval_->bodyShapes()[ib]);
+    const std::size_t ia = *world.indexOf(test.bodyA().id);
+    const std::size_t ib = *world.indexOf(test.bodyB().id);
+    const truth::FclMesh& ma = meshOf(world, world.bodyShapes()[ia]);
+    const truth::FclMesh& mb = meshOf(world, world.bodyShapes()[ib]);
     Truth t;
     t.collide = truth::exactCollide(ma, *test.bodyA().pose, mb, *test.bodyB().pose);
     t.distance = t.collide ? 0.0 : truth::exactDistance(ma, *test.bodyA().pose, mb, *test.bodyB().pose);
     return truth_.emplace(key, t).first->second;
   }
 
-  // Three runs per point, on a shared machine. Sphere-test budgets give the
-  // same result every run: keep the fastest (least disturbed) timing. Wall
-  // budgets do not: keep the run that got the most sphere tests done (the
-  // least disturbed), with its own timing and errors.
-  Row measure(const std::string& scene, int index, SchedulerKind kind, const Budget& budget,
-              const char* budget_kind, double budget_value, double fraction) {
-    Row best;
-    const bool timed = std::isfinite(budget.seconds);
-    for (int rep = 0; rep < 3; ++rep) {
-      const TickReport report = eval_->step(0.0, budget);
-      if (rep == 0 || (timed && report.sphere_tests > best.sphere_tests)) {
-        best = rowOf(report, scene, index, kind, budget_kind, budget_value, fraction);
-      } else if (!timed && report.narrow_s < best.narrow_s) {
-        best.tick_s = report.total_s;
-        best.narrow_s = report.narrow_s;
-        best.overhead_s = report.scheduling_overhead_s;
-      }
-    }
-    return best;
-  }
-
-  Row rowOf(const TickReport& rep, const std::string& scene, int index, SchedulerKind kind,
-            const char* budget_kind, double budget_value, double fraction) {
-    Row row;
-    row.scene = scene;
-    row.snapshot = index;
-    row.scheduler = toString(kind);
-    row.budget_kind = budget_kind;
-    row.budget = budget_value;
-    row.fraction = fraction;
-    row.tick_s = rep.total_s;
-    row.narrow_s = rep.narrow_s;
-    row.overhead_s = rep.scheduling_overhead_s;
-    row.sphere_tests = static_cast<double>(rep.sphere_tests);
-    row.pairs = static_cast<double>(eval_->pairCount());
-    row.unresolved = static_cast<double>(rep.unresolved);
-    row.est_nabla = rep.geometric_inaccuracy;
-    row.est_bound = rep.geometric_bound;
-    row.est_p = rep.perceived_inaccuracy;
-    const Perception& perception = eval_->perception();
-    for (std::size_t i = 0; i < eval_->pairCount(); ++i) {
-      const PairTest& test = eval_->pairTests()[i];
+  TickErrors errorsOf(const World& world, const TickReport& rep) {
+    TickErrors e;
+    e.narrow_s = rep.narrow_s;
+    e.overhead_s = rep.scheduling_overhead_s;
+    e.sphere_tests = static_cast<double>(rep.sphere_tests);
+    e.pairs = static_cast<double>(world.pairCount());
+    e.unresolved = static_cast<double>(rep.unresolved);
+    e.est_nabla = rep.geometric_inaccuracy;
+    e.est_p = rep.perceived_inaccuracy;
+    const Perception& perception = world.perception();
+    for (std::size_t i = 0; i < world.pairCount(); ++i) {
+      const PairTest& test = world.pairTests()[i];
       const bool unresolved = test.status() == PairStatus::Unresolved;
       if (!unresolved && test.status() != PairStatus::Colliding) continue;  // separate: rejected
-      row.accepted += 1;
-      const Truth& truth = truthOf(test);
+      e.accepted += 1;
+      const Truth& truth = truthOf(world, test);
       double f = 0.0;
       if (const auto depth = perception.depthOf(test.centreOfCollision())) {
         const double g_true_px = truth.distance * perception.focalPx() / *depth;
         f = perceivedInaccuracy(perception.measure(test).eccentricity_px, g_true_px);
       }
-      if (!truth.collide) row.false_pos += 1;
-      row.true_gap_acc += truth.distance;
-      row.true_p_acc += f;
+      if (!truth.collide) e.false_pos += 1;
+      e.true_p_acc += f;
       if (unresolved) {
-        if (!truth.collide) row.false_pos_unres += 1;
-        row.true_gap_unres += truth.distance;
-        row.true_p_unres += f;
+        e.true_gap_unres += truth.distance;
+        e.true_p_unres += f;
       }
     }
-    return row;
+    return e;
   }
 
   Options opt_;
-  std::unique_ptr<World> sim_, eval_;
+  std::unique_ptr<World> sim_;
+  std::vector<std::unique_ptr<World>> evals_;  // one per scheduler, kKinds order
   SceneSpec spec_;
   std::vector<std::shared_ptr<truth::FclMesh>> meshes_;
   std::unordered_map<std::uint64_t, Truth> truth_;
 };
 
-void runScene(SceneKind kind, const Options& opt, std::vector<Row>& rows) {
+void runScene(SceneKind kind, const Options& opt, std::map<RowKey, Row>& rows) {
   SceneParams params;
   int warmup = 30, every = 6;
   if (kind == SceneKind::Rockfall) warmup = 75;  // rocks are falling and piling by then
@@ -266,152 +276,127 @@ void runScene(SceneKind kind, const Options& opt, std::vector<Row>& rows) {
     follow.mode = GazeMode::Follow;
     follow.target = ev.spec().movers[pick() % ev.spec().movers.size()];
     GazeModel entity_gaze(follow);
-    ev.evaluateSnapshot(toString(kind), s, t, opt.gaze == "screen" ? screen_gaze : entity_gaze, rows);
+    ev.evaluateSnapshot(toString(kind), t, opt.gaze == "screen" ? screen_gaze : entity_gaze, rows);
     std::fprintf(stderr, "  %s snapshot %d/%d (t = %.2f s, %zu pairs)\n", toString(kind), s + 1,
                  snapshots, t, ev.sim().pairCount());
   }
 }
 
 // ---------------------------------------------------------------------------
-// Aggregation over snapshots, CSV, table.
+// CSV and tables.
 
-struct Key {
-  std::string scene, scheduler, budget_kind;
-  double fraction;
-  bool operator<(const Key& o) const {
-    return std::tie(scene, budget_kind, fraction, scheduler) <
-           std::tie(o.scene, o.budget_kind, o.fraction, o.scheduler);
-  }
-};
-
-struct Mean {
-  int n = 0;
-  Row sum;
-  void add(const Row& r) {
-    ++n;
-    sum.tick_s += r.tick_s;
-    sum.narrow_s += r.narrow_s;
-    sum.overhead_s += r.overhead_s;
-    sum.sphere_tests += r.sphere_tests;
-    sum.pairs += r.pairs;
-    sum.unresolved += r.unresolved;
-    sum.accepted += r.accepted;
-    sum.false_pos += r.false_pos;
-    sum.false_pos_unres += r.false_pos_unres;
-    sum.true_gap_unres += r.true_gap_unres;
-    sum.true_gap_acc += r.true_gap_acc;
-    sum.true_p_unres += r.true_p_unres;
-    sum.true_p_acc += r.true_p_acc;
-    sum.est_nabla += r.est_nabla;
-    sum.est_bound += r.est_bound;
-    sum.est_p += r.est_p;
-  }
-  double m(double Row::*field) const { return n ? sum.*field / n : 0.0; }
-};
-
-void writeCsv(const std::string& path, const std::vector<Row>& rows) {
+void writeCsv(const std::string& path, const std::map<RowKey, Row>& rows) {
   std::ofstream out(path);
-  out << "scene,snapshot,scheduler,budget_kind,budget,fraction,tick_s,narrow_s,overhead_s,"
-         "sphere_tests,pairs,unresolved,accepted,false_pos,false_pos_unres,true_gap_unres,"
-         "true_gap_acc,true_p_unres,true_p_acc,est_nabla,est_bound,est_p\n";
+  out << "scene,scheduler,budget_kind,fraction,repeat,ticks,narrow_ms_median,narrow_ms_mean,"
+         "overhead_share_median,sphere_tests,pairs,unresolved,accepted,false_pos,true_gap_unres,"
+         "true_p_unres,true_p_acc,est_nabla,est_p\n";
   char buf[1024];
-  for (const Row& r : rows) {
+  for (const auto& [key, r] : rows) {
+    const double n = static_cast<double>(r.narrow_s.size());
     std::snprintf(buf, sizeof buf,
-                  "%s,%d,%s,%s,%.9g,%.4g,%.6g,%.6g,%.6g,%.0f,%.0f,%.0f,%.0f,%.0f,%.0f,%.6g,%.6g,%.6g,"
-                  "%.6g,%.6g,%.6g,%.6g\n",
-                  r.scene.c_str(), r.snapshot, r.scheduler.c_str(), r.budget_kind.c_str(), r.budget,
-                  r.fraction, r.tick_s, r.narrow_s, r.overhead_s, r.sphere_tests, r.pairs,
-                  r.unresolved, r.accepted, r.false_pos, r.false_pos_unres, r.true_gap_unres,
-                  r.true_gap_acc, r.true_p_unres, r.true_p_acc, r.est_nabla, r.est_bound, r.est_p);
+                  "%s,%s,%s,%.4g,%d,%zu,%.6g,%.6g,%.5f,%.0f,%.0f,%.0f,%.0f,%.0f,%.6g,%.6g,%.6g,%.6g,%.6g\n",
+                  r.scene.c_str(), r.scheduler.c_str(), r.budget_kind.c_str(), r.fraction, r.repeat,
+                  r.narrow_s.size(), 1e3 * stc_bench::percentile(r.narrow_s, 0.5), 1e3 * r.sum.narrow_s / n,
+                  r.overheadPercent() / 100.0, r.sum.sphere_tests,
+                  r.sum.pairs, r.sum.unresolved, r.sum.accepted, r.sum.false_pos, r.sum.true_gap_unres,
+                  r.sum.true_p_unres, r.sum.true_p_acc, r.sum.est_nabla, r.sum.est_p);
     out << buf;
   }
 }
 
-std::string report(const std::vector<Row>& rows, const Options& opt) {
-  std::map<Key, Mean> means;
-  for (const Row& r : rows) {
-    means[Key{r.scene, r.scheduler, r.budget_kind == "unlimited" ? "tests" : r.budget_kind,
-              r.fraction}]
-        .add(r);
-  }
+struct Spread {
+  double median = NAN, min = NAN, max = NAN;
+};
+Spread spreadOf(const std::vector<double>& v) {
+  if (v.empty()) return {};
+  return {stc_bench::percentile(v, 0.5), *std::min_element(v.begin(), v.end()),
+          *std::max_element(v.begin(), v.end())};
+}
+
+std::string fmtSpread(const Spread& s) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%.2f (%.2f-%.2f)", s.median, s.min, s.max);
+  return buf;
+}
+
+std::string report(const std::map<RowKey, Row>& rows, const Options& opt) {
+  auto rowOf = [&](const std::string& scene, const std::string& sched, const std::string& kind,
+                   double f, int rep) -> const Row* {
+    const auto it = rows.find(RowKey{scene, sched, kind, f, rep});
+    return it == rows.end() ? nullptr : &it->second;
+  };
+  // Per repeat: a field's sum for `sched` over round-robin's; and a row field per repeat.
+  auto ratios = [&](const std::string& scene, const std::string& sched, const std::string& kind, double f) {
+    std::vector<double> out;
+    for (int rep = 0; rep < opt.repeats; ++rep) {
+      const Row* a = rowOf(scene, sched, kind, f, rep);
+      const Row* rr = rowOf(scene, "round_robin", kind, f, rep);
+      if (a && rr && rr->sum.true_p_unres > 0) out.push_back(a->sum.true_p_unres / rr->sum.true_p_unres);
+    }
+    return spreadOf(out);
+  };
+  auto perRepeat = [&](const std::string& scene, const std::string& sched, const std::string& kind,
+                       double f, auto field) {
+    std::vector<double> out;
+    for (int rep = 0; rep < opt.repeats; ++rep) {
+      if (const Row* r = rowOf(scene, sched, kind, f, rep)) out.push_back(field(*r));
+    }
+    return spreadOf(out);
+  };
+  const auto narrowMs = [](const Row& r) { return 1e3 * stc_bench::percentile(r.narrow_s, 0.5); };
+
   std::string md;
-  char buf[512];
+  char buf[1024];
   std::snprintf(buf, sizeof buf,
-                "Settings: priority queues K = %d, bin ratio %.3g, priority f(e,g) / next-step cost^%.2g; gaze %s; policy accept; means over snapshots.\n\n",
+                "Settings: priority queues K = %d, bin ratio %.3g, priority f(e,g) / next-step cost^%.2g; "
+                "gaze %s; policy accept; %d snapshots per scene; %d repeats, schedulers interleaved. "
+                "Ratios: true P (sum over the snapshots, accepted unresolved pairs) of the scheduler over "
+                "round-robin's, repeat by repeat: median (min-max).\n",
                 opt.queues, opt.ratio, opt.cost_exponent,
                 opt.gaze == "screen" ? "saccades to random screen points every 0.3 s"
-                                     : "on a random moving entity, a new one every snapshot");
+                                     : "on a random moving entity, a new one every snapshot",
+                opt.quick ? 3 : opt.snapshots, opt.repeats);
   md += buf;
   for (const char* scene : {"packed_box", "rockfall"}) {
-    for (const char* budget_kind : {"tests", "seconds"}) {
-      std::snprintf(buf, sizeof buf,
-                    "\n### %s, budget in %s\n\n| budget | scheduler | narrow ms | overhead %% | "
-                    "unresolved %% | false pos | true gap (m) unres | true P unres | true P acc | "
-                    "est. nabla | est. P |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
-                    scene, std::strcmp(budget_kind, "tests") == 0 ? "sphere tests" : "wall time");
+    if (!rowOf(scene, "round_robin", "unlimited", 1.0, 0)) continue;
+    // Overhead at unlimited budget (identical work for every scheduler).
+    std::snprintf(buf, sizeof buf,
+                  "\n### %s: scheduling overhead, unlimited budget\n\n| scheduler | narrow ms (median tick) | "
+                  "overhead / narrow %% (median tick) | narrow / round-robin's |\n|---|---|---|---|\n",
+                  scene);
+    md += buf;
+    const Spread rr_ms = perRepeat(scene, "round_robin", "unlimited", 1.0, narrowMs);
+    for (SchedulerKind k : kKinds) {
+      const Spread ms = perRepeat(scene, toString(k), "unlimited", 1.0, narrowMs);
+      const Spread share =
+          perRepeat(scene, toString(k), "unlimited", 1.0, [](const Row& r) { return r.overheadPercent(); });
+      std::snprintf(buf, sizeof buf, "| %s | %s | %s | %.2f |\n", toString(k), fmtSpread(ms).c_str(),
+                    fmtSpread(share).c_str(), ms.median / rr_ms.median);
       md += buf;
-      for (const auto& [key, mean] : means) {
-        if (key.scene != scene || key.budget_kind != budget_kind) continue;
-        const double pairs = std::max(1.0, mean.m(&Row::pairs));
-        const double narrow = mean.m(&Row::narrow_s);
-        std::snprintf(buf, sizeof buf,
-                      "| %s | %s | %.3f | %.1f | %.1f | %.1f | %.3f | %.2f | %.2f | %.3f | %.2f |\n",
-                      key.fraction >= 1.0 && std::strcmp(budget_kind, "tests") == 0
-                          ? "unlimited"
-                          : (std::to_string(static_cast<int>(std::lround(key.fraction * 100))) + "%").c_str(),
-                      key.scheduler.c_str(), 1e3 * narrow,
-                      narrow > 0 ? 100.0 * mean.m(&Row::overhead_s) / narrow : 0.0,
-                      100.0 * mean.m(&Row::unresolved) / pairs, mean.m(&Row::false_pos),
-                      mean.m(&Row::true_gap_unres), mean.m(&Row::true_p_unres),
-                      mean.m(&Row::true_p_acc), mean.m(&Row::est_nabla), mean.m(&Row::est_p));
-        md += buf;
-      }
     }
-  }
-
-  // Headline: true P (unresolved) of PQ over RR at equal budget, over the
-  // budgets where RR leaves >= 20% of the pairs unresolved.
-  md += "\n### Headline: true P(priority queues) / true P(round robin), equal budget\n\n";
-  md += "| scene | budget | RR unresolved % | ratio (true P unres) | ratio (true P acc) | "
-        "ratio PSeq/RR | ratio Seq/RR |\n|---|---|---|---|---|---|---|\n";
-  for (const char* scene : {"packed_box", "rockfall"}) {
-    for (const char* budget_kind : {"tests", "seconds"}) {
-      double pq_sum = 0, rr_sum = 0, pq_acc = 0, rr_acc = 0, log_sum = 0;
-      int log_n = 0;
-      for (const auto& [key, rr] : means) {
-        if (key.scene != scene || key.budget_kind != budget_kind || key.scheduler != "round_robin") continue;
-        const double unres = rr.m(&Row::unresolved) / std::max(1.0, rr.m(&Row::pairs));
-        // Budget 0 steps nothing for anyone: the ratio is 1 by construction, not a measurement.
-        if (unres < 0.2 || key.fraction == 0.0) continue;
-        Key k = key;
-        k.scheduler = "priority_queues";
-        const Mean& pq = means[k];
-        k.scheduler = "perceptual_sequential";
-        const Mean& ps = means[k];
-        k.scheduler = "sequential";
-        const Mean& sq = means[k];
-        const double r = rr.m(&Row::true_p_unres);
-        std::snprintf(buf, sizeof buf, "| %s | %s %.0f%% | %.1f | %.3f | %.3f | %.3f | %.3f |\n", scene,
-                      budget_kind, 100 * key.fraction, 100 * unres,
-                      r > 0 ? pq.m(&Row::true_p_unres) / r : NAN,
-                      rr.m(&Row::true_p_acc) > 0 ? pq.m(&Row::true_p_acc) / rr.m(&Row::true_p_acc) : NAN,
-                      r > 0 ? ps.m(&Row::true_p_unres) / r : NAN, r > 0 ? sq.m(&Row::true_p_unres) / r : NAN);
-        md += buf;
-        if (r > 0 && pq.m(&Row::true_p_unres) > 0) {
-          log_sum += std::log(pq.m(&Row::true_p_unres) / r);
-          ++log_n;
-        }
-        pq_sum += pq.m(&Row::true_p_unres);
-        rr_sum += r;
-        pq_acc += pq.m(&Row::true_p_acc);
-        rr_acc += rr.m(&Row::true_p_acc);
-      }
+    for (const char* kind : {"seconds", "tests"}) {
       std::snprintf(buf, sizeof buf,
-                    "| **%s** | **%s: ratio of sums (geometric mean of ratios)** | | **%.3f (%.3f)** | "
-                    "**%.3f** | | |\n",
-                    scene, budget_kind, rr_sum > 0 ? pq_sum / rr_sum : NAN,
-                    log_n ? std::exp(log_sum / log_n) : NAN, rr_acc > 0 ? pq_acc / rr_acc : NAN);
+                    "\n### %s: equal %s, budgets where round-robin leaves >= 20%% unresolved\n\n"
+                    "| budget | RR narrow ms | PQ narrow ms | RR unresolved %% | PQ overhead %% | "
+                    "**PQ / RR** | PSeq / RR | Seq / RR |\n|---|---|---|---|---|---|---|---|\n",
+                    scene, std::strcmp(kind, "seconds") == 0 ? "wall time" : "sphere-test budget");
       md += buf;
+      const auto& fractions = std::strcmp(kind, "seconds") == 0 ? kTimeFractions : kTestFractions;
+      for (double f : fractions) {
+        if (f < 0.0) continue;
+        const Spread unres = perRepeat(scene, "round_robin", kind, f,
+                                       [](const Row& r) { return 100.0 * r.unresolvedShare(); });
+        if (!(unres.median >= 20.0)) continue;
+        const Spread pq_share =
+            perRepeat(scene, "priority_queues", kind, f, [](const Row& r) { return r.overheadPercent(); });
+        std::snprintf(buf, sizeof buf, "| %.0f%% | %.3f | %.3f | %.0f | %.1f | **%s** | %s | %s |\n", 100 * f,
+                      perRepeat(scene, "round_robin", kind, f, narrowMs).median,
+                      perRepeat(scene, "priority_queues", kind, f, narrowMs).median, unres.median,
+                      pq_share.median, fmtSpread(ratios(scene, "priority_queues", kind, f)).c_str(),
+                      fmtSpread(ratios(scene, "perceptual_sequential", kind, f)).c_str(),
+                      fmtSpread(ratios(scene, "sequential", kind, f)).c_str());
+        md += buf;
+      }
     }
   }
   return md;
@@ -427,19 +412,19 @@ int main(int argc, char** argv) {
     if (a == "--quick") opt.quick = true;
     else if (a == "--csv") opt.csv = next();
     else if (a == "--markdown") opt.markdown = next();
-    else if (a == "--queues") opt.queues = std::stoi(next());
-    else if (a == "--ratio") opt.ratio = std::stod(next());
     else if (a == "--snapshots") opt.snapshots = std::stoi(next());
-    else if (a == "--cost-exponent") opt.cost_exponent = std::stod(next());
-    else if (a == "--only-tests") opt.only_tests = true;
+    else if (a == "--repeats") opt.repeats = std::max(1, std::stoi(next()));
     else if (a == "--scene") opt.scene = next();
     else if (a == "--gaze") opt.gaze = next();
+    else if (a == "--queues") opt.queues = std::stoi(next());
+    else if (a == "--ratio") opt.ratio = std::stod(next());
+    else if (a == "--cost-exponent") opt.cost_exponent = std::stod(next());
     else {
       std::fprintf(stderr, "unknown argument %s\n", a.c_str());
       return 2;
     }
   }
-  std::vector<Row> rows;
+  std::map<RowKey, Row> rows;
   for (SceneKind kind : {SceneKind::PackedBox, SceneKind::Rockfall}) {
     if (opt.scene.empty() || opt.scene == toString(kind)) runScene(kind, opt, rows);
   }

@@ -76,10 +76,12 @@ class Perception {
   PairPerception measure(const PairTest& test) const;
   // What f(e, g) needs of a point besides g, for schedulers that re-measure g
   // often: weight = exp(-e / 100) with e the point's eccentricity, and the
-  // pixels per metre at its depth. Both 0 behind the camera or without a fixation.
+  // pixels per metre at its depth, and its pixel. All 0 behind the camera or
+  // without a fixation.
   struct GazeWeight {
     double weight = 0.0;
     double px_per_metre = 0.0;
+    Vec2 pixel = Vec2::Zero();
   };
   GazeWeight gazeWeight(const Vec3& world) const;
   // The paper's on-screen gap estimate alone: |proj(cA) - proj(cB)| of the

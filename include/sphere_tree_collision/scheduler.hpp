@@ -6,6 +6,7 @@
 #include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -55,13 +56,21 @@ struct ScheduleStats {
   bool used_perception = false;   // false when there is no fixation: no projection work done
 };
 
+// The two bodies of each pair test as dense indices in [0, body_count): a
+// perceptual scheduler projects each body once per run, not once per pair.
+// Without them (of_pair null) priority queues run as round-robin.
+struct PairBodies {
+  const std::array<std::uint32_t, 2>* of_pair = nullptr;  // [count], parallel to the tests
+  std::size_t body_count = 0;
+};
+
 // One call per tick. Steps tests[0..count) under the budget. Without a
 // perception (nullptr or no fixation) the perceptual schedulers fall back to
 // their non-perceptual order and say so in ScheduleStats::used_perception.
 class Scheduler {
  public:
   virtual ~Scheduler() = default;
-  virtual ScheduleStats run(std::vector<PairTest>& tests, std::size_t count,
+  virtual ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
                             const Perception* perception, BudgetTracker& budget) = 0;
 };
 // Validates the options (see validateSchedulerOptions).

@@ -91,6 +91,8 @@ void PairTest::reset(const PairBody& a, const PairBody& b, PairArena* arena) {
   best_valid_ = false;
   status_ = PairStatus::Unresolved;
   steps_ = 0;
+  next_tests_ = 1;
+  frontier_reach_ = 0.0;
   deepest_level_ = -1;
   sphere_tests_ = 0;
 }
@@ -118,8 +120,7 @@ int PairTest::step() {
   // New hits and this step's intersecting pairs are appended to the arena,
   // with room for the worst case (every test intersects) made first.
   PairArena& store = arena();
-  std::size_t most = 0;  // tests if every hit is done
-  for (std::size_t h = hits_begin_; h < hits_begin_ + hits_count_; ++h) most += store.hits[h].test_count;
+  const auto most = static_cast<std::size_t>(next_tests_);  // tests if every hit is done
   const std::size_t new_hits_begin = store.hits_used;
   const std::size_t pairs_begin = store.pairs_used;
   SphereHit* hit_out = roomFor(store.hits, new_hits_begin, most);
@@ -159,14 +160,19 @@ int PairTest::step() {
     // Colliding: the last pairs are the leaf pairs; the new hits are dropped.
     status_ = PairStatus::Colliding;
     hits_count_ = 0;
+    next_tests_ = 0;
   } else if (hit_count > 0) {
     // Every intersection made one new hit, whose target and the parent of
     // its test list are the two spheres that intersected.
+    int next_tests = 0;
     for (std::size_t i = 0; i < hit_count; ++i) {
       const SphereHit& next = hit_out[i];
       const std::int32_t other = nodes[1 - next.target_side][next.test_first].parent;
       pair_out[i] = next.target_side == 0 ? SpherePair{next.target, other} : SpherePair{other, next.target};
+      next_tests += next.test_count;
     }
+    next_tests_ = next_tests;
+    frontier_reach_ = nodes[0][pair_out[0].a].radius + nodes[1][pair_out[0].b].radius;
     pair_count = hit_count;
     store.hits_used = new_hits_begin + hit_count;
     hits_begin_ = new_hits_begin;
@@ -175,6 +181,7 @@ int PairTest::step() {
     // Nothing intersects: lastPairs() keeps the deepest pairs found before.
     status_ = PairStatus::Separate;
     hits_count_ = 0;
+    next_tests_ = 0;
     return tests;
   }
   store.pairs_used = pairs_begin + pair_count;

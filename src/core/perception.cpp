@@ -123,9 +123,9 @@ Perception::GazeWeight Perception::gazeWeight(const Vec3& world) const {
   const Vec3 c = world_to_camera_rotation_ * (world - camera_position_);
   if (!(c.z() > kNearDepth) || !fixation_) return out;
   out.px_per_metre = focal_px_ / c.z();
-  const Vec2 pixel(0.5 * camera_.width + out.px_per_metre * c.x(),
+  out.pixel = Vec2(0.5 * camera_.width + out.px_per_metre * c.x(),
                    0.5 * camera_.height + out.px_per_metre * c.y());
-  out.weight = std::exp(-(pixel - *fixation_).norm() / 100.0);
+  out.weight = std::exp(-(out.pixel - *fixation_).norm() / 100.0);
   return out;
 }
 

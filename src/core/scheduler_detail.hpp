@@ -31,10 +31,13 @@ class OverheadClock {
 
 // Times one in kEvery blocks and scales the total up by the block count: an
 // unbiased estimate for many short blocks (the re-queueing after each pass)
-// at an eighth of the clock reads.
+// at a quarter of the clock reads.
 class SampledClock {
  public:
-  static constexpr std::uint32_t kEvery = 8;
+  static constexpr std::uint32_t kEvery = 4;
+  // Which block of every kEvery is timed; vary it from run to run so blocks
+  // that come in a fixed order each run are all sampled.
+  explicit SampledClock(std::uint32_t phase = 0) : blocks_(phase % kEvery), first_(blocks_) {}
   void start() {
     timing_ = blocks_++ % kEvery == 0;
     if (timing_) started_ = OverheadClock::Clock::now();
@@ -46,13 +49,13 @@ class SampledClock {
   }
   double seconds() const {
     if (timed_ == 0) return 0.0;
-    return std::chrono::duration<double>(total_).count() * blocks_ / timed_;
+    return std::chrono::duration<double>(total_).count() * (blocks_ - first_) / timed_;
   }
 
  private:
   OverheadClock::Clock::time_point started_{};
   OverheadClock::Clock::duration total_{0};
-  std::uint32_t blocks_ = 0, timed_ = 0;
+  std::uint32_t blocks_ = 0, first_ = 0, timed_ = 0;
   bool timing_ = false;
 };
 
@@ -72,8 +75,8 @@ inline bool perceptionActive(const Perception* perception) {
 // Hubbard: one level for every unresolved pair in list order, then again.
 class RoundRobinScheduler final : public Scheduler {
  public:
-  ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const Perception* perception,
-                    BudgetTracker& budget) override;
+  ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
+                    const Perception* perception, BudgetTracker& budget) override;
 
  private:
   std::vector<std::uint32_t> active_;  // unresolved pairs, list order; capacity reused
@@ -85,8 +88,8 @@ class RoundRobinScheduler final : public Scheduler {
 class SequentialScheduler final : public Scheduler {
  public:
   explicit SequentialScheduler(bool sort_by_priority) : sort_by_priority_(sort_by_priority) {}
-  ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const Perception* perception,
-                    BudgetTracker& budget) override;
+  ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
+                    const Perception* perception, BudgetTracker& budget) override;
 
  private:
   bool sort_by_priority_;
@@ -98,28 +101,45 @@ class SequentialScheduler final : public Scheduler {
 class PriorityQueueScheduler final : public Scheduler {
  public:
   explicit PriorityQueueScheduler(const SchedulerOptions& options);
-  ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const Perception* perception,
-                    BudgetTracker& budget) override;
+  ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
+                    const Perception* perception, BudgetTracker& budget) override;
 
  private:
-  struct Refined {
-    double cost = 1.0;   // sphere tests of the next step
-    double reach = 0.0;  // r_a + r_b of a frontier pair; 0 before any step
+  // A body's projection, made once per run however many pairs share the body.
+  struct BodyGaze {
+    Vec2 pixel = Vec2::Zero();
+    double root_weight = 0.0;  // exp(-e / 200): a pair's weight is the product of its two bodies'
+    double root_scale = 0.0;   // root_weight * sqrt(pixels per metre)
+    std::uint32_t run = 0;     // the run that made it
   };
-  static Refined refine(const PairTest& test);
-  double perCost(double f, double cost) const;
-  double remeasure(const PairTest& test, const Perception& perception, double weight,
-                   double px_per_metre) const;
-  int binOf(double priority, double reference) const;
-  int rebin(double priority, int from) const;
+  const BodyGaze& gazeOf(std::uint32_t body, const PairBody& pair_body, const Perception& perception);
+  // Measures every unresolved pair, sets the bin edges from the largest priority, bins.
+  void binAll(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
+              const Perception& perception);
+  double perCost(double f, int cost) const;
+  int binOf(double priority) const;
+
+  // A queued pair and what its re-measure needs, copied from the PairTest as
+  // the pass steps it, so the re-measure reads one array and no PairTest:
+  // its weight x pixels per metre, and the reach and cost of its next step.
+  struct Queued {
+    std::uint32_t pair = 0;
+    float scale = 0.0f;
+    float reach = 0.0f;
+    std::int32_t cost = 1;
+  };
 
   int queue_count_;
   double log_ratio_;
   double cost_exponent_;
-  std::vector<std::vector<std::uint32_t>> queues_;  // [0] lowest .. [K-1] highest; capacity reused
-  std::vector<double> lower_edge_;                  // f at the bottom of each queue, this run
-  // Per pair, this run (capacity reused): initial priority, exp(-e/100), pixels per metre.
-  std::vector<double> priorities_, weight_, scale_;
+  std::vector<std::vector<Queued>> queues_;  // [0] lowest .. [K-1] highest; capacity reused
+  std::vector<double> lower_edge_;           // f at the bottom of each queue, this run
+  // Capacity reused: per body, its projection; per pair, this run's initial
+  // priority and weight x pixels per metre.
+  std::vector<BodyGaze> gaze_;
+  std::uint32_t run_ = 0;
+  std::vector<double> priorities_;
+  std::vector<float> scale_;
 };
 
 }  // namespace stc::detail

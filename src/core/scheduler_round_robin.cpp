@@ -6,7 +6,8 @@
 namespace stc::detail {
 
 ScheduleStats RoundRobinScheduler::run(std::vector<PairTest>& tests, std::size_t count,
-                                       const Perception* /*perception*/, BudgetTracker& budget) {
+                                       const PairBodies& /*bodies*/, const Perception* /*perception*/,
+                                       BudgetTracker& budget) {
   ScheduleStats stats;
   OverheadClock overhead;
   overhead.start();

@@ -378,7 +378,8 @@ double World::narrowPhase(const Budget& budget, const Deadline& tick_end, double
   const bool gaze = perception_.hasFixation();
   BudgetTracker tracker(budget.sphere_tests, Deadline(&clock_, end));
   const ScheduleStats stats =
-      scheduler_->run(pair_tests_, pair_count_, gaze ? &perception_ : nullptr, tracker);
+      scheduler_->run(pair_tests_, pair_count_, PairBodies{pair_bodies_.data(), bodies_.size()},
+                      gaze ? &perception_ : nullptr, tracker);
   const double scheduled = clock_();
   report.sphere_tests = stats.sphere_tests;
   report.interrupted = stats.interrupted;

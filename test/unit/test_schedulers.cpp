@@ -1,18 +1,22 @@
 // Schedulers: each one's defining order under a sphere-test budget, identical
 // results with an unlimited budget, zero budget, no perception, no allocation.
 // PairTests are built directly from preset sphere-trees and poses (no World).
+#include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/scheduler.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
+#include "sphere_tree_collision/world.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstdlib>
 #include <new>
 #include <numeric>
 #include <random>
+#include <tuple>
 #include <vector>
 
 // Counts heap allocations so a test can assert a warm run makes none.
@@ -71,6 +75,8 @@ class SchedulerTest : public ::testing::Test {
   void build(const std::vector<Vec3>& centres, const std::vector<unsigned>& shapes) {
     poses_.assign(2 * centres.size(), Pose{});
     tests_.assign(centres.size(), PairTest{});
+    pair_bodies_.clear();
+    for (std::uint32_t i = 0; i < centres.size(); ++i) pair_bodies_.push_back({2 * i, 2 * i + 1});
     for (std::size_t i = 0; i < centres.size(); ++i) {
       std::mt19937 rng(shapes[i]);
       std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -102,7 +108,8 @@ class SchedulerTest : public ::testing::Test {
   ScheduleStats runWith(Scheduler& s, const Budget& budget, bool perceive = true) {
     resetAll();
     BudgetTracker tracker(budget);
-    return s.run(tests_, tests_.size(), perceive ? &camera_ : nullptr, tracker);
+    return s.run(tests_, tests_.size(), PairBodies{pair_bodies_.data(), poses_.size()},
+                 perceive ? &camera_ : nullptr, tracker);
   }
 
   // Runs with budgets of one more step each time (a run under budget b is a
@@ -136,6 +143,7 @@ class SchedulerTest : public ::testing::Test {
   Perception camera_;
   std::vector<Pose> poses_;
   std::vector<PairTest> tests_;
+  std::vector<std::array<std::uint32_t, 2>> pair_bodies_;  // pair i joins bodies 2i and 2i+1
 };
 
 SphereTree SchedulerTest::tree_;
@@ -340,6 +348,11 @@ TEST_F(SchedulerTest, WithoutPerceptionTheModelIsNotUsedAndListOrderHolds) {
   EXPECT_EQ(finishOrder(*pq, false), finishOrder(*rr, false));
   camera_.setFixation(Vec2(100, 360));
   EXPECT_TRUE(runWith(*pq, Budget::unlimited(), true).used_perception);
+  {  // without the pairs' body indices there is nothing to project per body
+    resetAll();
+    BudgetTracker tracker(Budget::unlimited());
+    EXPECT_FALSE(pq->run(tests_, tests_.size(), PairBodies{}, &camera_, tracker).used_perception);
+  }
   EXPECT_TRUE(runWith(*pseq, Budget::unlimited(), true).used_perception);
   EXPECT_FALSE(runWith(*rr, Budget::unlimited(), true).used_perception);
 }
@@ -356,6 +369,60 @@ TEST_F(SchedulerTest, WarmRunsDoNotAllocate) {
     const ScheduleStats stats = runWith(*s, Budget::unlimited());
     runWith(*s, Budget::ofSphereTests(stats.sphere_tests / 2));
     EXPECT_EQ(g_allocations.load() - before, 0) << toString(kind);
+  }
+}
+
+// The cheaper bookkeeping changes only the order of steps: with no budget
+// every scheduler leaves every pair of a real scene in the same state after
+// the same sphere tests, with the same contacts (round-robin's code is the
+// reference: it has no bookkeeping to change).
+TEST(SchedulerSceneTest, UnlimitedBudgetGivesRoundRobinsResultsOnBothScenes) {
+  for (const auto& [kind, entities, ticks] : {std::tuple{SceneKind::PackedBox, 125, 20},
+                                              std::tuple{SceneKind::Rockfall, 60, 60}}) {
+    SceneParams params;
+    params.entities = entities;
+    WorldConfig config;
+    config.gravity = sceneGravity(kind);
+    World sim(config);
+    const SceneSpec spec = populateScene(sim, kind, params);
+    for (int i = 0; i < ticks; ++i) sim.step(spec.dt, Budget::unlimited());
+
+    config.response.enabled = false;
+    World eval(config);
+    populateScene(eval, kind, params);
+    for (std::size_t i = 0; i < sim.entityCount(); ++i) eval.bodies()[i].pose = sim.bodies()[i].pose;
+    eval.perception().setCamera(spec.camera);
+    const auto fixation = eval.perception().project(sim.bodies()[sim.entityCount() / 2].pose.position);
+    ASSERT_TRUE(fixation && eval.perception().onScreen(*fixation)) << toString(kind);
+    eval.perception().setFixation(*fixation);
+
+    std::vector<PairStatus> reference;
+    std::vector<std::int64_t> reference_tests;
+    std::size_t reference_contacts = 0;
+    for (SchedulerKind scheduler : kAllKinds) {
+      SchedulerOptions options;
+      options.kind = scheduler;
+      eval.setScheduler(options);
+      const TickReport report = eval.step(0.0, Budget::unlimited());
+      EXPECT_FALSE(report.interrupted);
+      std::vector<PairStatus> statuses;
+      std::vector<std::int64_t> tests;
+      for (std::size_t i = 0; i < eval.pairCount(); ++i) {
+        statuses.push_back(eval.pairTests()[i].status());
+        tests.push_back(eval.pairTests()[i].sphereTests());
+      }
+      if (reference.empty()) {
+        reference = statuses;
+        reference_tests = tests;
+        reference_contacts = eval.contacts().size();
+        continue;
+      }
+      EXPECT_EQ(statuses, reference) << toString(kind) << " " << toString(scheduler);
+      EXPECT_EQ(tests, reference_tests) << toString(kind) << " " << toString(scheduler);
+      EXPECT_EQ(eval.contacts().size(), reference_contacts) << toString(kind) << " " << toString(scheduler);
+    }
+    EXPECT_GT(std::count(reference.begin(), reference.end(), PairStatus::Colliding), 10) << toString(kind);
+    EXPECT_GT(std::count(reference.begin(), reference.end(), PairStatus::Separate), 10) << toString(kind);
   }
 }
 
