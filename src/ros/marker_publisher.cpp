@@ -39,10 +39,24 @@ MarkerPublisher::MarkerPublisher(ros::NodeHandle& nh, const NodeParams& params, 
   } else {
     pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 2);
   }
+  bound_options_.frame = params.world_frame;
+  bound_options_.max_bounds = options_.max_contacts;
+  bounds_pub_ = nh.advertise<visualization_msgs::MarkerArray>("error_bounds", 2);
 }
 
-void MarkerPublisher::onTick(std::uint64_t tick, const ros::Time& stamp) {
-  if (tick % ticks_per_marker_ == 0) publish(stamp);
+void MarkerPublisher::onTick(std::uint64_t tick, const stc::TickReport& report, const ros::Time& stamp) {
+  if (tick % ticks_per_marker_ != 0) return;
+  publish(stamp);
+  publishBounds(report, stamp);
+}
+
+void MarkerPublisher::publishBounds(const stc::TickReport& report, const ros::Time& stamp) {
+  if (bounds_pub_.getNumSubscribers() == 0) {
+    bounds_.forget();
+    return;
+  }
+  bounds_.build(world_, report, gaze_(), stamp, bound_options_, bounds_msg_);
+  bounds_pub_.publish(bounds_msg_);
 }
 
 void MarkerPublisher::entityRemoved(stc::EntityId id, stc::ShapeId shape, bool is_static) {

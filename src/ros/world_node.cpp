@@ -207,7 +207,7 @@ void WorldNode::runTick() {
   publishStats(report, now);
   publishContacts(now);
   publishTf(now);
-  markers_->onTick(tick_, now);
+  markers_->onTick(tick_, report, now);
   ROS_INFO_THROTTLE(1.0,
                     "tick %llu: %zu entities, %zu broad pairs, %zu colliding, %zu unresolved (%zu accepted), "
                     "%lld sphere tests, %zu contacts, %.2f ms, gaze %s, %llu rejected inputs",

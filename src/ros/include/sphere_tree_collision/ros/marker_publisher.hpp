@@ -1,5 +1,7 @@
-// MarkerPublisher: the world node's `markers` topic. Decides when an array
-// goes out (every round(~rate / ~marker_rate) ticks, only while subscribed),
+// MarkerPublisher: the world node's marker topics, `markers` (the scene) and
+// `error_bounds` (the proven gap bound of each contact accepted unresolved,
+// ErrorBoundMarkers). Decides when an array goes out (every
+// round(~rate / ~marker_rate) ticks, each topic only while subscribed),
 // and, in incremental mode, what each subscriber already has: entities sent,
 // removals and a clear not yet sent, a snapshot for each new subscriber and a
 // keyframe to all every ~marker_keyframe_period. MarkerBuilder makes the
@@ -8,6 +10,7 @@
 // what left the world.
 #pragma once
 
+#include "sphere_tree_collision/ros/error_bound_markers.hpp"
 #include "sphere_tree_collision/ros/marker_builder.hpp"
 #include "sphere_tree_collision/ros/node_params.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -37,12 +40,13 @@ class MarkerPublisher {
   // and counting what it throws.
   using Guard = std::function<void(const char* what, const std::function<void()>& callback)>;
 
-  // Advertises `markers` on nh. world and looks must outlive this.
+  // Advertises `markers` and `error_bounds` on nh. world and looks must outlive this.
   MarkerPublisher(ros::NodeHandle& nh, const NodeParams& params, const stc::World& world, EntityLooks looks,
                   GazeSource gaze, Guard guard);
 
-  // After tick number `tick` (1 for the first): an array when it is a marker tick.
-  void onTick(std::uint64_t tick, const ros::Time& stamp);
+  // After tick number `tick` (1 for the first), whose report is `report`:
+  // arrays when it is a marker tick.
+  void onTick(std::uint64_t tick, const stc::TickReport& report, const ros::Time& stamp);
   // An entity left the world (despawn, quarantine): its markers go with the next array.
   void entityRemoved(stc::EntityId id, stc::ShapeId shape, bool is_static);
   // The world was cleared: the next array starts with DELETEALL.
@@ -50,6 +54,7 @@ class MarkerPublisher {
 
  private:
   void publish(const ros::Time& stamp);
+  void publishBounds(const stc::TickReport& report, const ros::Time& stamp);
   // Incremental mode: the whole scene (DELETEALL first), to one new subscriber
   // or, as a keyframe, to every subscriber (then it resets what is pending).
   void sendSnapshot(const ros::SingleSubscriberPublisher& subscriber);
@@ -78,6 +83,11 @@ class MarkerPublisher {
   std::vector<Rgba> colors_by_index_;  // full mode: scratch
   visualization_msgs::MarkerArray msg_;  // reused: no allocation per tick once warm
   ros::Publisher pub_;
+
+  ErrorBoundMarkers bounds_;
+  ErrorBoundOptions bound_options_;
+  visualization_msgs::MarkerArray bounds_msg_;
+  ros::Publisher bounds_pub_;
 };
 
 }  // namespace stc_ros
