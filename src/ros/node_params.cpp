@@ -21,7 +21,7 @@ const std::set<std::string>& knownParams() {
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
-      "min_voxel_size", "max_voxel_size"};
+      "min_voxel_size", "max_voxel_size", "error_report"};
   return kNames;
 }
 
@@ -125,6 +125,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   parsed("solver_iterations", [&] { stc::validateResponseOptions(p.world.response); return 0; });
 
   p.gaze_timeout = positiveParam(nh, "gaze_timeout", p.gaze_timeout);
+  readParam(nh, "error_report", p.error_report);  // opened (and so checked) by ErrorReport
   int resolution = static_cast<int>(p.default_resolution);
   p.default_resolution = static_cast<std::uint32_t>(intParamIn(nh, "default_resolution", resolution, 1, 4096));
 

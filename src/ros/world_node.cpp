@@ -97,6 +97,7 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
   budget_ = params_.budget();
   dt_ = 1.0 / params_.rate;
+  if (!params_.error_report.empty()) error_report_ = std::make_unique<ErrorReport>(params_.error_report);
   markers_ = std::make_unique<MarkerPublisher>(
       nh_, params_, world_, EntityLooks{colors_, frames_}, [this] { return gazePoint(); },
       [this](const char* what, const std::function<void()>& callback) { guarded(what, callback); });
@@ -205,6 +206,10 @@ void WorldNode::runTick() {
   ++tick_;
   for (const stc::QuarantinedEntity& q : world_.quarantined()) onQuarantined(q, now);
   publishStats(report, now);
+  if (error_report_) {
+    error_report_->write(now, tick_, report, budget_, stc::toString(params_.world.scheduler.kind),
+                         world_.perception().fixation());
+  }
   publishContacts(now);
   publishTf(now);
   markers_->onTick(tick_, report, now);

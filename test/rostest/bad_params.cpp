@@ -94,6 +94,7 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"max_speed", -1.0}}, "max_speed"},
       {world, {{"min_density", 10.0}, {"max_density", 1.0}}, "min_density"},
       {world, {{"scene", "rockfall"}, {"scene_entities", 30000}}, "scene_entities"},
+      {world, {{"error_report", "/nonexistent_dir/report.csv"}}, "error_report"},
       {"gaze_simulator", {{"mode", "blink"}}, "mode"},
       {"gaze_simulator", {{"mode", "follow"}}, "target"},
       {"rockfall_spawner", {{"rate", 0.0}}, "rate"},

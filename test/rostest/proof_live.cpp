@@ -7,8 +7,12 @@
 #include <sphere_tree_collision/GazePoint.h>
 #include <sphere_tree_collision/TickStats.h>
 
+#include <sphere_tree_collision/ros/error_report.hpp>
+
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <set>
 #include <utility>
@@ -22,6 +26,7 @@ using visualization_msgs::Marker;
 using visualization_msgs::MarkerArray;
 
 constexpr std::size_t kArraysChecked = 5;  // error_bounds arrays with bounds, each against its tick
+constexpr std::size_t kRowsChecked = 30;   // ~error_report rows, each against its tick's tick_stats
 
 // Messages of one topic by stamp.
 template <typename Msg>
@@ -162,6 +167,71 @@ TEST_F(ProofLive, BoundMarkersAreTheContactsBoundsAndTheTextTheTicksFigures) {
   }
   std::printf("[proof_live] %zu arrays checked against their tick, %zu bound spheres\n", checked, spheres);
   EXPECT_GE(checked, kArraysChecked);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream in(line);
+  std::string cell;
+  while (std::getline(in, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+TEST_F(ProofLive, ErrorReportHasARowPerTickWithTheTicksFigures) {
+  std::string path;
+  ASSERT_TRUE(ros::param::get("~report", path));
+  ASSERT_TRUE(stc_test::spinUntil([&] { return stats_.all.size() >= kRowsChecked + 5; }, stc_test::kLivenessSeconds));
+  // Rows are line-buffered: every tick_stats received has its row (the row is
+  // written right after tick_stats is published; spin on a little past).
+  stc_test::spinUntil([] { return false; }, 0.5);
+  std::ifstream in(path);
+  ASSERT_TRUE(in) << "no report at " << path;
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, stc_ros::ErrorReport::kHeader);
+  const std::size_t columns = split(line).size();
+  std::size_t rows = 0, matched = 0, with_gaze = 0;
+  unsigned long long previous_tick = 0;
+  while (std::getline(in, line)) {
+    if (in.eof()) break;  // a row being written: no newline yet
+    const auto c = split(line);
+    ASSERT_EQ(c.size(), columns) << line;
+    ++rows;
+    const unsigned long long tick = std::stoull(c[1]);
+    EXPECT_EQ(tick, previous_tick + 1) << "a row per tick, in order";
+    previous_tick = tick;
+    const auto dot = c[0].find('.');
+    ASSERT_NE(dot, std::string::npos) << c[0];
+    const ros::Time stamp(static_cast<std::uint32_t>(std::stoul(c[0].substr(0, dot))),
+                          static_cast<std::uint32_t>(std::stoul(c[0].substr(dot + 1))));
+    const TickStats* s = stats_.at(stamp);
+    if (!s) continue;  // before the test subscribed
+    ++matched;
+    SCOPED_TRACE(line);
+    EXPECT_EQ(tick, s->tick);
+    EXPECT_EQ(std::stod(c[2]), s->budget_ms);
+    EXPECT_EQ(std::stoll(c[3]), s->budget_sphere_tests);
+    EXPECT_EQ(c[4], s->scheduler);
+    EXPECT_EQ(std::stoul(c[5]), s->broad_pairs);
+    EXPECT_EQ(std::stoul(c[6]), s->unresolved);
+    EXPECT_EQ(std::stoul(c[7]), s->unresolved_accepted);
+    EXPECT_EQ(std::stod(c[8]), s->geometric_inaccuracy);  // %.17g reads back exactly
+    EXPECT_EQ(std::stod(c[9]), s->geometric_bound);
+    EXPECT_EQ(std::stod(c[10]), s->perceived_inaccuracy);
+    EXPECT_EQ(std::stod(c[11]), s->narrow_ms);
+    EXPECT_EQ(std::stoll(c[12]), s->sphere_tests);
+    EXPECT_EQ(c[13].empty(), !s->gaze_active) << "gaze x, y empty exactly when no gaze is set";
+    if (s->gaze_active) {
+      ++with_gaze;
+      EXPECT_EQ(std::stod(c[13]), 640.0);
+      EXPECT_EQ(std::stod(c[14]), 360.0);
+    }
+  }
+  std::printf("[proof_live] %zu report rows, %zu matched with tick_stats (%zu with gaze)\n", rows, matched, with_gaze);
+  EXPECT_GE(matched, kRowsChecked);
+  EXPECT_GT(with_gaze, 0u);
+  if (!::testing::Test::HasFailure()) std::remove(path.c_str());  // kept to look at when the test fails
 }
 
 }  // namespace

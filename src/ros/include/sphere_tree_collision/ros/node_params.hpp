@@ -48,6 +48,7 @@ struct NodeParams {
   double gaze_timeout = 0.5;         // s
   std::uint32_t default_resolution = 8;  // spawn messages with resolution 0
   std::optional<stc::Vec3> gravity;  // overrides the scene's
+  std::string error_report;          // CSV file, a row per tick (ErrorReport); "" = none
   stc::WorldConfig world;            // scheduler, policy, tree, limits, response
   CameraParams camera;
 

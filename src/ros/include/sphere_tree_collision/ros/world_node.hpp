@@ -6,6 +6,7 @@
 // escapes is logged, counted (tick_stats.callback_errors) and the node goes on.
 #pragma once
 
+#include "sphere_tree_collision/ros/error_report.hpp"
 #include "sphere_tree_collision/ros/marker_publisher.hpp"
 #include "sphere_tree_collision/ros/node_params.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -104,6 +105,7 @@ class WorldNode {
   std::string last_quarantine_;
 
   std::unique_ptr<MarkerPublisher> markers_;  // made once the scene is loaded
+  std::unique_ptr<ErrorReport> error_report_;  // with ~error_report only
   // Reused message buffers: no allocation per tick once warm.
   sphere_tree_collision::ContactArray contacts_msg_;
   tf2_msgs::TFMessage tf_msg_;
