@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 namespace stc_ros {
 namespace {
@@ -71,13 +72,6 @@ void ErrorBoundMarkers::build(const stc::World& world, const stc::TickReport& re
     text_anchor_ = centroid / static_cast<double>(bounds);
   }
   Marker& text = add(kTextNs, 0, Marker::TEXT_VIEW_FACING, Marker::ADD);
-  // A quarter of the way from the gaze point to the camera: in front of the
-  // surface the gaze rests on, so no wall cuts into the text.
-  const stc::Vec3 camera = world.perception().camera().camera_to_world.position;
-  const stc::Vec3 at = text_anchor_ + 0.25 * (camera - text_anchor_);
-  text.scale.z = std::max(options.text_height_per_metre * (camera - at).norm(), 1e-3);
-  text.pose.position = toPointMsg(at + stc::Vec3(0.0, 0.0, 2.5 * text.scale.z));  // clear of the gaze dot
-  text.color = toColorMsg(1.0f, 1.0f, 1.0f, 0.95f);
   // nabla is the paper's estimate (distance between the last intersecting
   // centres), not bounded by the bound sum: both are shown, with what they are.
   char line[200];
@@ -85,6 +79,30 @@ void ErrorBoundMarkers::build(const stc::World& world, const stc::TickReport& re
                 report.unresolved_accepted, report.broad_pairs, report.geometric_bound, report.geometric_inaccuracy,
                 report.perceived_inaccuracy);
   text.text = line;
+  text.color = toColorMsg(1.0f, 1.0f, 1.0f, 0.95f);
+  const stc::Perception& perception = world.perception();
+  const stc::Pose& camera = perception.camera().camera_to_world;
+  // A quarter of the way from the gaze point to the camera: in front of the
+  // surface the gaze rests on, so no wall cuts into the text.
+  const stc::Vec3 at = text_anchor_ + 0.25 * (camera.position - text_anchor_);
+  const double height = std::max(options.text_height_per_metre * (camera.position - at).norm(), 1e-3);
+  text.scale.z = height;
+  // Three lines centred on the pose: lifted so the lowest clears the gaze dot.
+  stc::Vec3 local = camera.orientation.conjugate() * (at + stc::Vec3(0.0, 0.0, 3.5 * height) - camera.position);
+  // Kept inside the middle 70 % of the camera's image (optical frame: x right,
+  // y down, z ahead), so a gaze near an edge does not push half the text off
+  // screen, also in a viewer with a narrower window (rviz beside its panels).
+  const double half_width = 0.28 * std::strlen("000 of 0000 pairs accepted unresolved") * height;
+  const double half_height = 1.8 * height;
+  const double tan_x = 0.7 * 0.5 * perception.camera().width / perception.focalPx();
+  const double tan_y = 0.7 * 0.5 * perception.camera().height / perception.focalPx();
+  if (local.z() > 0.0) {
+    const double max_x = std::max(local.z() * tan_x - half_width, 0.0);
+    const double max_y = std::max(local.z() * tan_y - half_height, 0.0);
+    local.x() = std::clamp(local.x(), -max_x, max_x);
+    local.y() = std::clamp(local.y(), -max_y, max_y);
+  }
+  text.pose.position = toPointMsg(camera.position + camera.orientation * local);
   out.markers.resize(used);
 }
 
