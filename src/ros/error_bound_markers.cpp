@@ -87,8 +87,10 @@ void ErrorBoundMarkers::build(const stc::World& world, const stc::TickReport& re
   const stc::Vec3 at = text_anchor_ + 0.25 * (camera.position - text_anchor_);
   const double height = std::max(options.text_height_per_metre * (camera.position - at).norm(), 1e-3);
   text.scale.z = height;
-  // Three lines centred on the pose: lifted so the lowest clears the gaze dot.
-  stc::Vec3 local = camera.orientation.conjugate() * (at + stc::Vec3(0.0, 0.0, 3.5 * height) - camera.position);
+  stc::Vec3 local = camera.orientation.conjugate() * (at - camera.position);
+  // Three lines centred on the pose: lifted up the image (optical -y) so the
+  // lowest clears the gaze dot however steeply the camera looks down.
+  local.y() -= 3.0 * height;
   // Kept inside the middle 70 % of the camera's image (optical frame: x right,
   // y down, z ahead), so a gaze near an edge does not push half the text off
   // screen, also in a viewer with a narrower window (rviz beside its panels).
