@@ -37,6 +37,15 @@ geometry_msgs::Pose toPoseMsg(const stc::Pose& pose) {
   return m;
 }
 
+std_msgs::ColorRGBA toColorMsg(float r, float g, float b, float a) {
+  std_msgs::ColorRGBA c;
+  c.r = r;
+  c.g = g;
+  c.b = b;
+  c.a = a;
+  return c;
+}
+
 std::string reasonOf(const stc::InputError& error) {
   const std::string what = error.what();
   const std::string prefix = error.field() + ": ";

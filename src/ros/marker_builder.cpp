@@ -18,15 +18,6 @@ float levelAlpha(int level) { return level <= 1 ? 0.3f : 0.5f; }
 constexpr double kVoxelFill = 0.94;  // cubes a little smaller than the voxel: the grid shows
 constexpr int kMaxGroups = 512;      // radius groups per level and entity (marker id = entity id * 512 + group)
 
-std_msgs::ColorRGBA rgba(float r, float g, float b, float a) {
-  std_msgs::ColorRGBA c;
-  c.r = r;
-  c.g = g;
-  c.b = b;
-  c.a = a;
-  return c;
-}
-
 // One hue per level, so neighbouring levels read apart.
 std_msgs::ColorRGBA levelColor(int level) {
   static const std::array<std::array<float, 3>, 8> kHues{{{1.0f, 1.0f, 1.0f},
@@ -38,12 +29,12 @@ std_msgs::ColorRGBA levelColor(int level) {
                                                           {0.2f, 0.9f, 0.9f},
                                                           {0.9f, 0.5f, 0.8f}}};
   const auto& h = kHues[static_cast<std::size_t>(level) % kHues.size()];
-  return rgba(h[0], h[1], h[2], levelAlpha(level));
+  return toColorMsg(h[0], h[1], h[2], levelAlpha(level));
 }
 
-const std_msgs::ColorRGBA kResolvedColor = rgba(0.2f, 0.9f, 0.2f, 1.0f);
-const std_msgs::ColorRGBA kUnresolvedColor = rgba(1.0f, 0.45f, 0.0f, 1.0f);
-const std_msgs::ColorRGBA kGazeColor = rgba(1.0f, 0.1f, 0.9f, 0.9f);
+const std_msgs::ColorRGBA kResolvedColor = toColorMsg(0.2f, 0.9f, 0.2f, 1.0f);
+const std_msgs::ColorRGBA kUnresolvedColor = toColorMsg(1.0f, 0.45f, 0.0f, 1.0f);
+const std_msgs::ColorRGBA kGazeColor = toColorMsg(1.0f, 0.1f, 0.9f, 0.9f);
 
 void setPose(Marker& m, const stc::Pose& pose) {
   m.pose.position = toPointMsg(pose.position);
@@ -116,10 +107,10 @@ bool MarkerBuilder::drawsLevel(const ShapeGeometry& g, int level, bool is_static
   return level >= 0 && static_cast<std::size_t>(level) < g.levels.size();
 }
 
-Marker& MarkerBuilder::next(visualization_msgs::MarkerArray& out, const std::string& ns, int id, int type,
-                            const ros::Time& stamp, const std::string& frame) {
-  if (out.markers.size() <= used_) out.markers.resize(used_ + 1);
-  Marker& m = out.markers[used_++];
+Marker& appendMarker(visualization_msgs::MarkerArray& out, std::size_t& used, const std::string& ns, int id, int type,
+                     const ros::Time& stamp, const std::string& frame) {
+  if (out.markers.size() <= used) out.markers.resize(used + 1);
+  Marker& m = out.markers[used++];
   m.header.stamp = stamp;
   m.header.frame_id = frame;
   m.ns = ns;
@@ -136,6 +127,11 @@ Marker& MarkerBuilder::next(visualization_msgs::MarkerArray& out, const std::str
   m.colors.clear();
   m.text.clear();
   return m;
+}
+
+Marker& MarkerBuilder::next(visualization_msgs::MarkerArray& out, const std::string& ns, int id, int type,
+                            const ros::Time& stamp, const std::string& frame) {
+  return appendMarker(out, used_, ns, id, type, stamp, frame);
 }
 
 void MarkerBuilder::begin(visualization_msgs::MarkerArray& out) {
@@ -166,7 +162,7 @@ void MarkerBuilder::addEntity(const stc::World& world, std::size_t index, const 
     Marker& m = next(out, kVoxelsNs, static_cast<int>(id & 0x7fffffffu), Marker::CUBE_LIST, when, frame);
     place(m);
     m.scale.x = m.scale.y = m.scale.z = world.shape(shape).voxels.voxelSize() * kVoxelFill;
-    m.color = rgba(color[0], color[1], color[2], color[3]);
+    m.color = toColorMsg(color[0], color[1], color[2], color[3]);
     m.points.assign(g.surface_voxels.begin(), g.surface_voxels.end());
   }
   for (int level : options.levels) {
@@ -234,7 +230,7 @@ void MarkerBuilder::addDynamic(const stc::World& world, const MarkerOptions& opt
   Marker* normals = slot(kContactClasses, n > 0, kNormalsNs, 0, Marker::LINE_LIST);
   if (normals) {
     normals->scale.x = 0.25 * options.contact_size;
-    normals->color = rgba(1.0f, 1.0f, 1.0f, 0.8f);
+    normals->color = toColorMsg(1.0f, 1.0f, 1.0f, 0.8f);
   }
   const double normal_length = 3.0 * options.contact_size;
   for (std::size_t i = 0; i < n; ++i) {

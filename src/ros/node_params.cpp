@@ -3,6 +3,7 @@
 #include "sphere_tree_collision/ros/conversions.hpp"
 #include "sphere_tree_collision/ros/param_reading.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <set>
@@ -21,7 +22,7 @@ const std::set<std::string>& knownParams() {
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
-      "min_voxel_size", "max_voxel_size", "entity_states_rate", "publish_clock"};
+      "min_voxel_size", "max_voxel_size", "entity_states_rate", "publish_clock", "error_report"};
   return kNames;
 }
 
@@ -43,6 +44,10 @@ stc::Budget NodeParams::budget() const {
   if (sphere_test_budget >= 0) b.sphere_tests = sphere_test_budget;
   if (tick_budget_ms > 0.0) b.tick_seconds = tick_budget_ms * 1e-3;
   return b;
+}
+
+std::uint64_t ticksPerMessage(double tick_rate, double message_rate) {
+  return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(tick_rate / message_rate)));
 }
 
 NodeParams readNodeParams(const ros::NodeHandle& nh) {
@@ -127,6 +132,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   parsed("solver_iterations", [&] { stc::validateResponseOptions(p.world.response); return 0; });
 
   p.gaze_timeout = positiveParam(nh, "gaze_timeout", p.gaze_timeout);
+  readParam(nh, "error_report", p.error_report);  // opened (and so checked) by ErrorReport
   int resolution = static_cast<int>(p.default_resolution);
   p.default_resolution = static_cast<std::uint32_t>(intParamIn(nh, "default_resolution", resolution, 1, 4096));
 

@@ -67,11 +67,6 @@ bool isFinite(const stc::Contact& c) {
          std::isfinite(c.priority);
 }
 
-// A message every this many ticks: round(tick rate / message rate), at least 1.
-std::uint64_t ticksPerMessage(double tick_rate, double message_rate) {
-  return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(tick_rate / message_rate)));
-}
-
 // Unknown names are warned about first: a typo may be why a value is missing.
 NodeParams readParamsWarningUnknown(const ros::NodeHandle& private_nh) {
   for (const std::string& name : unknownParams(private_nh)) {
@@ -102,21 +97,10 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
   budget_ = params_.budget();
   dt_ = 1.0 / params_.rate;
-  marker_options_.frame = params_.world_frame;
-  marker_options_.levels = params_.marker_levels;
-  marker_options_.voxels = params_.show_voxels;
-  marker_options_.static_trees = params_.static_tree_markers;
-  marker_options_.max_contacts = static_cast<std::size_t>(params_.max_contact_markers);
-
-  marker_options_.contact_size = params_.contact_marker_size;
-  if (params_.marker_mode == NodeParams::MarkerMode::Incremental) {
-    markers_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>(
-        "markers", 100, [this](const ros::SingleSubscriberPublisher& s) {
-          guarded("marker snapshot", [&] { sendMarkerSnapshot(s); });
-        });
-  } else {
-    markers_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
-  }
+  if (!params_.error_report.empty()) error_report_ = std::make_unique<ErrorReport>(params_.error_report);
+  markers_ = std::make_unique<MarkerPublisher>(
+      pnh_, params_, world_, EntityLooks{colors_, frames_}, [this] { return gazePoint(); },
+      [this](const char* what, const std::function<void()>& callback) { guarded(what, callback); });
   quarantined_pub_ = pnh_.advertise<sphere_tree_collision::Quarantined>("quarantined", 100);
   contacts_pub_ = pnh_.advertise<sphere_tree_collision::ContactArray>("contacts", 10);
   // The node's topics are private (~name); /tf and /clicked_point are the shared ones.
@@ -129,9 +113,6 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   gaze_sub_ = pnh_.subscribe("gaze", 10, &WorldNode::onGaze, this);
   clicked_sub_ = nh_.subscribe("/clicked_point", 10, &WorldNode::onClickedPoint, this);
 
-  // Markers are published from the tick, every ticks_per_marker_ ticks, so that
-  // each array shows the state of one tick and carries that tick's stamp.
-  ticks_per_marker_ = ticksPerMessage(params_.rate, params_.marker_rate);
   ticks_per_states_ = ticksPerMessage(params_.rate, params_.entity_states_rate);
   entity_states_.advertise(pnh_, params_.world_frame);
   services_ = std::make_unique<WorldServices>(pnh_, *this);
@@ -245,9 +226,13 @@ void WorldNode::runTick() {
   ++tick_;
   for (const stc::QuarantinedEntity& q : world_.quarantined()) onQuarantined(q, now);
   publishStats(report, now);
+  if (error_report_) {
+    error_report_->write(now, tick_, report, budget_, stc::toString(params_.world.scheduler.kind),
+                         world_.perception().fixation());
+  }
   publishContacts(now);
   publishTf(now);
-  if (tick_ % ticks_per_marker_ == 0) publishMarkers(now);
+  markers_->onTick(tick_, report, now);
   entity_states_.publishListIfChanged(world_, frames_, now);
   if (tick_ % ticks_per_states_ == 0) entity_states_.publishStates(world_, frames_, now);
   ROS_INFO_THROTTLE(1.0,
@@ -285,7 +270,7 @@ void WorldNode::onQuarantined(const stc::QuarantinedEntity& q, const ros::Time& 
 }
 
 void WorldNode::forget(stc::EntityId id, stc::ShapeId shape, bool is_static) {
-  if (markers_sent_.erase(id) != 0) markers_removed_.push_back({id, shape, is_static});
+  markers_->entityRemoved(id, shape, is_static);
   colors_.erase(id);
   frames_.erase(id);
   entity_states_.markChanged();
@@ -411,78 +396,6 @@ void WorldNode::publishTf(const ros::Time& stamp) {
   if (n != 0) tf_pub_.publish(tf_msg_);
 }
 
-void WorldNode::publishMarkers(const ros::Time& now) {
-  if (markers_pub_.getNumSubscribers() == 0) {
-    // Nobody to keep up to date: the next subscriber starts from a snapshot.
-    markers_sent_.clear();
-    markers_removed_.clear();
-    markers_cleared_ = false;
-    return;
-  }
-  if (params_.marker_mode == NodeParams::MarkerMode::Full) {
-    colors_by_index_.resize(world_.entityCount());
-    for (std::size_t i = 0; i < world_.entityCount(); ++i) colors_by_index_[i] = colors_[world_.entityIds()[i]];
-    marker_builder_.buildFull(world_, colors_by_index_, marker_options_, gazePoint(), now, markers_msg_);
-    markers_pub_.publish(markers_msg_);
-    return;
-  }
-  // A keyframe now and then repairs what a subscriber dropped (its queue may
-  // overflow while rviz renders slowly); in between, only what changed.
-  const ros::WallTime wall = ros::WallTime::now();
-  if (params_.marker_keyframe_period > 0.0 && (wall - last_keyframe_).toSec() >= params_.marker_keyframe_period) {
-    last_keyframe_ = wall;
-    buildMarkerSnapshot(now, true, markers_msg_);
-    markers_pub_.publish(markers_msg_);
-    return;
-  }
-  marker_builder_.begin(markers_msg_);
-  if (markers_cleared_) {
-    marker_builder_.deleteAll(marker_options_, markers_msg_);
-    marker_builder_.forgetDynamic();
-    markers_cleared_ = false;
-  }
-  for (const Removed& r : markers_removed_) {
-    marker_builder_.deleteEntity(world_, r.id, r.shape, r.is_static, marker_options_, markers_msg_);
-  }
-  markers_removed_.clear();
-  const auto& ids = world_.entityIds();
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    if (!markers_sent_.insert(ids[i]).second) continue;
-    marker_builder_.addEntity(world_, i, colors_[ids[i]], frames_[ids[i]], true, marker_options_, now, markers_msg_);
-  }
-  marker_builder_.addDynamic(world_, marker_options_, gazePoint(), now, true, markers_msg_);
-  marker_builder_.end(markers_msg_);
-  if (!markers_msg_.markers.empty()) markers_pub_.publish(markers_msg_);  // nothing changed: nothing to send
-}
-
-void WorldNode::buildMarkerSnapshot(const ros::Time& now, bool for_everyone, visualization_msgs::MarkerArray& out) {
-  MarkerBuilder& b = marker_builder_;
-  b.begin(out);
-  b.deleteAll(marker_options_, out);
-  if (for_everyone) b.forgetDynamic();
-  const auto& ids = world_.entityIds();
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    b.addEntity(world_, i, colors_[ids[i]], frames_[ids[i]], true, marker_options_, now, out);
-  }
-  b.addDynamic(world_, marker_options_, gazePoint(), now, for_everyone, out);
-  b.end(out);
-  if (for_everyone) {  // every subscriber now has exactly this
-    markers_sent_.clear();
-    markers_sent_.insert(ids.begin(), ids.end());
-    markers_removed_.clear();
-    markers_cleared_ = false;
-  }
-}
-
-void WorldNode::sendMarkerSnapshot(const ros::SingleSubscriberPublisher& subscriber) {
-  // Alone, the newcomer defines what subscribers have. With others, the shared
-  // state stays theirs and the next array brings the newcomer what is pending
-  // as well (twice is harmless: an ADD replaces).
-  visualization_msgs::MarkerArray snapshot;
-  buildMarkerSnapshot(clock_.now(), markers_pub_.getNumSubscribers() <= 1, snapshot);
-  subscriber.publish(snapshot);
-}
-
 std::optional<stc::Vec3> WorldNode::gazePoint() const {
   const stc::Perception& p = world_.perception();
   if (!p.hasFixation()) return std::nullopt;
@@ -567,9 +480,7 @@ void WorldNode::clearWorld() {
   world_.clear();
   colors_.clear();
   frames_.clear();
-  markers_sent_.clear();
-  markers_removed_.clear();
-  markers_cleared_ = true;
+  markers_->worldCleared();
   entity_states_.markChanged();
 }
 

@@ -97,6 +97,7 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"entity_states_rate", 0.0}}, "entity_states_rate"},
       {world, {{"entity_states_rate", "often"}}, "entity_states_rate"},
       {world, {{"publish_clock", "yes"}}, "publish_clock"},
+      {world, {{"error_report", "/nonexistent_dir/report.csv"}}, "error_report"},
       {"gaze_simulator", {{"mode", "blink"}}, "mode"},
       {"gaze_simulator", {{"mode", "follow"}}, "target"},
       {"rockfall_spawner", {{"rate", 0.0}}, "rate"},

@@ -10,6 +10,7 @@
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Vector3.h>
+#include <std_msgs/ColorRGBA.h>
 
 #include <string>
 
@@ -24,6 +25,7 @@ geometry_msgs::Point toPointMsg(const stc::Vec3& v);
 geometry_msgs::Vector3 toVector3Msg(const stc::Vec3& v);
 geometry_msgs::Quaternion toQuaternionMsg(const stc::Quat& q);
 geometry_msgs::Pose toPoseMsg(const stc::Pose& pose);
+std_msgs::ColorRGBA toColorMsg(float r, float g, float b, float a);
 
 // The message of an InputError without its "field: " prefix, for re-raising
 // the error under another field name.

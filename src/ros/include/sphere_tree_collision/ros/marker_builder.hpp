@@ -36,6 +36,13 @@ struct MarkerOptions {
   double contact_size = 0.04;     // metres: diameter of the lowest-priority contact sphere
 };
 
+// out.markers[used] (the array grows when needed) made an ADD of a fresh
+// marker, keeping the storage of its vectors; used is advanced. An array built
+// piecewise is resized to `used` at the end.
+visualization_msgs::Marker& appendMarker(visualization_msgs::MarkerArray& out, std::size_t& used,
+                                         const std::string& ns, int id, int type, const ros::Time& stamp,
+                                         const std::string& frame);
+
 class MarkerBuilder {
  public:
   // An array is begin(), any of the add/delete calls, end().

@@ -6,6 +6,7 @@
 
 #include <ros/node_handle.h>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -50,6 +51,7 @@ struct NodeParams {
   double gaze_timeout = 0.5;         // s
   std::uint32_t default_resolution = 8;  // spawn messages with resolution 0
   std::optional<stc::Vec3> gravity;  // overrides the scene's
+  std::string error_report;          // CSV file, a row per tick (ErrorReport); "" = none
   stc::WorldConfig world;            // scheduler, policy, tree, limits, response
   CameraParams camera;
 
@@ -58,6 +60,10 @@ struct NodeParams {
 
 // Throws stc::InputError whose field is the parameter name (e.g. "rate").
 NodeParams readNodeParams(const ros::NodeHandle& private_nh);
+
+// A message every this many ticks: round(tick rate / message rate), at least 1
+// (markers, entity states).
+std::uint64_t ticksPerMessage(double tick_rate, double message_rate);
 
 // Private parameters the node does not know (likely typos), for a warning.
 std::vector<std::string> unknownParams(const ros::NodeHandle& private_nh);

@@ -8,7 +8,8 @@
 #pragma once
 
 #include "sphere_tree_collision/ros/entity_state_publisher.hpp"
-#include "sphere_tree_collision/ros/marker_builder.hpp"
+#include "sphere_tree_collision/ros/error_report.hpp"
+#include "sphere_tree_collision/ros/marker_publisher.hpp"
 #include "sphere_tree_collision/ros/node_params.hpp"
 #include "sphere_tree_collision/ros/tick_clock.hpp"
 #include "sphere_tree_collision/ros/world_services.hpp"
@@ -27,13 +28,11 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
-#include <visualization_msgs/MarkerArray.h>
 
 #include <memory>
 #include <optional>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
 
 namespace stc_ros {
 
@@ -44,15 +43,8 @@ class WorldNode {
   WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
 
   // One tick: camera, gaze expiry, World::step, quarantined bodies forgotten,
-  // tick_stats / contacts / tf, and markers every ticks_per_marker_ ticks
-  // (~rate / ~marker_rate). Never throws.
+  // tick_stats / contacts / tf, and the markers' turn (MarkerPublisher). Never throws.
   void tick();
-  void publishMarkers(const ros::Time& stamp);
-  // Incremental marker mode: the whole scene (DELETEALL first), to one new
-  // subscriber or, as a keyframe, to every subscriber (then it resets what is
-  // pending).
-  void sendMarkerSnapshot(const ros::SingleSubscriberPublisher& subscriber);
-  void buildMarkerSnapshot(const ros::Time& now, bool for_everyone, visualization_msgs::MarkerArray& out);
 
   const stc::World& world() const { return world_; }
   std::uint64_t tickCount() const { return tick_; }
@@ -110,7 +102,6 @@ class WorldNode {
   stc::Budget budget_;
   double dt_ = 0.0;
   std::uint64_t tick_ = 0;
-  std::uint64_t ticks_per_marker_ = 1;
   std::uint64_t ticks_per_states_ = 1;
   bool paused_ = false;
   std::uint64_t steps_pending_ = 0;  // paused: ticks ~step still asks for
@@ -136,26 +127,13 @@ class WorldNode {
   std::uint64_t quarantined_total_ = 0, left_world_total_ = 0, callback_errors_ = 0;
   std::string last_quarantine_;
 
-  MarkerBuilder marker_builder_;
-  MarkerOptions marker_options_;
-  // Incremental marker mode: entities whose geometry every subscriber has,
-  // removals not yet sent, and a clear not yet sent.
-  struct Removed {
-    stc::EntityId id;
-    stc::ShapeId shape;
-    bool is_static;
-  };
-  std::unordered_set<stc::EntityId> markers_sent_;
-  std::vector<Removed> markers_removed_;
-  bool markers_cleared_ = false;
-  ros::WallTime last_keyframe_;
-  std::vector<Rgba> colors_by_index_;  // full mode: scratch
+  std::unique_ptr<MarkerPublisher> markers_;  // made once the scene is loaded
+  std::unique_ptr<ErrorReport> error_report_;  // with ~error_report only
   // Reused message buffers: no allocation per tick once warm.
-  visualization_msgs::MarkerArray markers_msg_;
   sphere_tree_collision::ContactArray contacts_msg_;
   tf2_msgs::TFMessage tf_msg_;
 
-  ros::Publisher markers_pub_, contacts_pub_, stats_pub_, tf_pub_, quarantined_pub_;
+  ros::Publisher contacts_pub_, stats_pub_, tf_pub_, quarantined_pub_;
   ros::Subscriber spawn_sub_, despawn_sub_, clear_sub_, gaze_sub_, clicked_sub_;
 };
 
