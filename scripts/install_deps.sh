@@ -12,6 +12,7 @@ packages=(
   clang libfuzzer-14-dev
   rviz xvfb xauth imagemagick x11-utils
   catkin-lint
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure  # live tuning (cfg/World.cfg)
 )
 missing=()
 for p in "${packages[@]}"; do

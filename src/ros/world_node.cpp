@@ -51,6 +51,11 @@ stc::Vec3 gazeTarget(const stc::World& world, const stc::Vec3& origin, const stc
   return origin + 5.0 * dir;
 }
 
+// A marker array every round(~rate / ~marker_rate) ticks, at most one per tick.
+std::uint64_t ticksPerMarker(const NodeParams& params) {
+  return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(params.rate / params.marker_rate)));
+}
+
 // What an exception caught by catch (...) says.
 std::string causeOf(const std::exception_ptr& error) {
   try {
@@ -125,7 +130,7 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
   // Markers are published from the tick, every ticks_per_marker_ ticks, so that
   // each array shows the state of one tick and carries that tick's stamp.
-  ticks_per_marker_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(params_.rate / params_.marker_rate)));
+  ticks_per_marker_ = ticksPerMarker(params_);
   tick_timer_ = nh_.createSteadyTimer(ros::WallDuration(dt_), [this](const ros::SteadyTimerEvent&) { tick(); });
   ROS_INFO("collision_world_node: %zu entities from %s, %.1f Hz, scheduler %s, budget %s ms / %s sphere tests, "
            "tick budget %s ms",
@@ -134,6 +139,23 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
            params_.detection_budget_ms < 0 ? "none" : std::to_string(params_.detection_budget_ms).c_str(),
            params_.sphere_test_budget < 0 ? "no limit" : std::to_string(params_.sphere_test_budget).c_str(),
            params_.tick_budget_ms > 0 ? std::to_string(params_.tick_budget_ms).c_str() : "none");
+  tuning_ = std::make_unique<LiveTuning>(pnh_, params_, [this](const NodeParams& next) { retune(next); });
+}
+
+void WorldNode::retune(const NodeParams& next) {
+  world_.setScheduler(next.world.scheduler);  // the only step that can throw: first
+  world_.setResponse(next.world.response);  // checked by applyTunable already
+  world_.setUnresolvedPolicy(next.world.unresolved_policy);
+  budget_ = next.budget();
+  ticks_per_marker_ = ticksPerMarker(next);
+  if (next.marker_levels != marker_options_.levels || next.show_voxels != marker_options_.voxels) {
+    marker_options_.levels = next.marker_levels;
+    marker_options_.voxels = next.show_voxels;
+    markers_sent_.clear();  // incremental mode: DELETEALL, then every entity drawn with the new options
+    markers_removed_.clear();
+    markers_cleared_ = true;
+  }
+  params_ = next;
 }
 
 void WorldNode::remember(stc::EntityId id, const std::string& name, const std::optional<Rgba>& color) {

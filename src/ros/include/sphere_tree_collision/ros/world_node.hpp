@@ -6,6 +6,7 @@
 // escapes is logged, counted (tick_stats.callback_errors) and the node goes on.
 #pragma once
 
+#include "sphere_tree_collision/ros/live_tuning.hpp"
 #include "sphere_tree_collision/ros/marker_builder.hpp"
 #include "sphere_tree_collision/ros/node_params.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -81,6 +82,8 @@ class WorldNode {
   // Fills world_ from ~scene (YAML file, built-in scene name, or the default);
   // returns the camera pose to use when no tf frame gives one.
   stc::Pose loadScene();
+  // Live tuning: checked parameters in effect from the next tick on.
+  void retune(const NodeParams& next);
 
   void publishStats(const stc::TickReport& report, const ros::Time& stamp);
   void publishContacts(const ros::Time& stamp);
@@ -135,6 +138,7 @@ class WorldNode {
   ros::Publisher markers_pub_, contacts_pub_, stats_pub_, tf_pub_, quarantined_pub_;
   ros::Subscriber spawn_sub_, despawn_sub_, clear_sub_, gaze_sub_, clicked_sub_;
   ros::SteadyTimer tick_timer_;
+  std::unique_ptr<LiveTuning> tuning_;
 };
 
 }  // namespace stc_ros
