@@ -13,6 +13,7 @@ packages=(
   rviz xvfb xauth imagemagick x11-utils
   catkin-lint
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure  # live tuning (cfg/World.cfg)
+  libdiagnostic-updater-dev libdiagnostic-msgs-dev  # /diagnostics
 )
 missing=()
 for p in "${packages[@]}"; do

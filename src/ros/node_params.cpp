@@ -23,7 +23,8 @@ const std::set<std::string>& knownParams() {
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
-      "min_voxel_size", "max_voxel_size"};
+      "min_voxel_size", "max_voxel_size",
+      "diagnostic_period"};  // read by diagnostic_updater
   return kNames;
 }
 

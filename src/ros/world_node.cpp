@@ -139,6 +139,7 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
            params_.detection_budget_ms < 0 ? "none" : std::to_string(params_.detection_budget_ms).c_str(),
            params_.sphere_test_budget < 0 ? "no limit" : std::to_string(params_.sphere_test_budget).c_str(),
            params_.tick_budget_ms > 0 ? std::to_string(params_.tick_budget_ms).c_str() : "none");
+  diagnostics_ = std::make_unique<NodeDiagnostics>(nh_, pnh_, params_);
   tuning_ = std::make_unique<LiveTuning>(pnh_, params_, [this](const NodeParams& next) { retune(next); });
 }
 
@@ -307,8 +308,7 @@ void WorldNode::expireGaze(const ros::Time& now) {
 }
 
 void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
-  if (stats_pub_.getNumSubscribers() == 0) return;
-  sphere_tree_collision::TickStats s;
+  sphere_tree_collision::TickStats& s = stats_msg_;  // built every tick: diagnostics read it too
   s.header.stamp = stamp;
   s.header.frame_id = params_.world_frame;
   s.tick = tick_;
@@ -353,7 +353,8 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.left_world_total = left_world_total_;
   s.last_quarantine = last_quarantine_;
   s.callback_errors = callback_errors_;
-  stats_pub_.publish(s);
+  diagnostics_->onTick(s);
+  if (stats_pub_.getNumSubscribers() > 0) stats_pub_.publish(s);
 }
 
 void WorldNode::publishContacts(const ros::Time& stamp) {

@@ -8,6 +8,7 @@
 
 #include "sphere_tree_collision/ros/live_tuning.hpp"
 #include "sphere_tree_collision/ros/marker_builder.hpp"
+#include "sphere_tree_collision/ros/node_diagnostics.hpp"
 #include "sphere_tree_collision/ros/node_params.hpp"
 #include "sphere_tree_collision/world.hpp"
 
@@ -134,11 +135,13 @@ class WorldNode {
   visualization_msgs::MarkerArray markers_msg_;
   sphere_tree_collision::ContactArray contacts_msg_;
   tf2_msgs::TFMessage tf_msg_;
+  sphere_tree_collision::TickStats stats_msg_;
 
   ros::Publisher markers_pub_, contacts_pub_, stats_pub_, tf_pub_, quarantined_pub_;
   ros::Subscriber spawn_sub_, despawn_sub_, clear_sub_, gaze_sub_, clicked_sub_;
   ros::SteadyTimer tick_timer_;
   std::unique_ptr<LiveTuning> tuning_;
+  std::unique_ptr<NodeDiagnostics> diagnostics_;
 };
 
 }  // namespace stc_ros
