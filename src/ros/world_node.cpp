@@ -2,12 +2,12 @@
 
 #include "sphere_tree_collision/ros/conversions.hpp"
 #include "sphere_tree_collision/ros/scene_file.hpp"
+#include "sphere_tree_collision/perception_ray.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <exception>
-#include <limits>
 
 namespace stc_ros {
 namespace {
@@ -30,25 +30,6 @@ stc::Camera cameraAt(const CameraParams& params, const stc::Pose& pose) {
   camera.height = params.height;
   camera.fov_y_deg = params.fov_y_deg;
   return camera;
-}
-
-// First hit of the ray with an entity's bounding ball, else with the ground
-// plane z = 0, else a point 5 m out: where the gaze marker is drawn.
-stc::Vec3 gazeTarget(const stc::World& world, const stc::Vec3& origin, const stc::Vec3& dir) {
-  double best = std::numeric_limits<double>::infinity();
-  const auto& bodies = world.bodies();
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    const double r = world.shape(world.bodyShapes()[i]).bounding_radius;
-    const stc::Vec3 oc = bodies[i].pose.position - origin;
-    const double t_mid = oc.dot(dir);
-    const double d2 = oc.squaredNorm() - t_mid * t_mid;
-    if (d2 > r * r) continue;
-    const double t = t_mid - std::sqrt(r * r - d2);
-    if (t > 0.0 && t < best) best = t;
-  }
-  if (std::isfinite(best)) return origin + best * dir;
-  if (dir.z() < -1e-6 && origin.z() > 0.0) return origin + (-origin.z() / dir.z()) * dir;
-  return origin + 5.0 * dir;
 }
 
 // A marker array every round(~rate / ~marker_rate) ticks, at most one per tick.
@@ -473,16 +454,7 @@ void WorldNode::sendMarkerSnapshot(const ros::SingleSubscriberPublisher& subscri
   subscriber.publish(snapshot);
 }
 
-std::optional<stc::Vec3> WorldNode::gazePoint() const {
-  const stc::Perception& p = world_.perception();
-  if (!p.hasFixation()) return std::nullopt;
-  const stc::Camera& camera = p.camera();
-  const stc::Vec2& f = *p.fixation();
-  const stc::Vec3 dir_camera((f.x() - 0.5 * camera.width) / p.focalPx(), (f.y() - 0.5 * camera.height) / p.focalPx(), 1.0);
-  const stc::Vec3 dir = (camera.camera_to_world.orientation * dir_camera).normalized();
-  const stc::Vec3 origin = camera.camera_to_world.position;
-  return gazeTarget(world_, origin, dir);
-}
+std::optional<stc::Vec3> WorldNode::gazePoint() const { return stc::gazeTarget(world_); }
 
 // ---------------------------------------------------------------------------------
 // Inputs
