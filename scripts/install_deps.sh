@@ -14,6 +14,7 @@ packages=(
   catkin-lint
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure  # live tuning (cfg/World.cfg)
   libdiagnostic-updater-dev libdiagnostic-msgs-dev  # /diagnostics
+  libsensor-msgs-dev libimage-geometry-dev libtf2-eigen-dev  # the perception camera as a camera
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -24,7 +24,7 @@ const std::set<std::string>& knownParams() {
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
       "min_voxel_size", "max_voxel_size",
-      "diagnostic_period"};  // read by diagnostic_updater
+      "diagnostic_period", "camera_info_topic"};  // read by diagnostic_updater
   return kNames;
 }
 
@@ -198,6 +198,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
 
   readParam(nh, "camera_frame", p.camera.frame);
   readParam(nh, "published_camera_frame", p.camera.published_frame);
+  readParam(nh, "camera_info_topic", p.camera.info_topic);
   if (auto v = vec3Param(nh, "camera_position")) {
     p.camera.position = *v;
     p.camera.pose_given = true;

@@ -81,6 +81,9 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     camera_broadcaster_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
     camera_broadcaster_->sendTransform(t);
   }
+  camera_info_ = std::make_unique<PerceptionCameraInfo>(
+      nh_, pnh_, world_, params_.camera.frame.empty() ? params_.camera.published_frame : params_.camera.frame,
+      params_.camera.info_topic);
   budget_ = params_.budget();
   dt_ = 1.0 / params_.rate;
   marker_options_.frame = params_.world_frame;
@@ -270,10 +273,9 @@ void WorldNode::forget(stc::EntityId id, stc::ShapeId shape, bool is_static) {
 void WorldNode::updateCameraFromTf() {
   try {
     const auto t = tf_buffer_->lookupTransform(params_.world_frame, params_.camera.frame, ros::Time(0));
-    stc::Pose pose;
-    pose.position = toEigen(t.transform.translation);
-    pose.orientation = toEigen(t.transform.rotation).normalized();
-    world_.perception().setCamera(cameraAt(params_.camera, pose));
+    stc::Camera camera = world_.perception().camera();  // its size may come from ~camera_info_topic
+    camera.camera_to_world = toPose(t.transform);
+    world_.perception().setCamera(camera);
     if (!camera_from_tf_) ROS_INFO("camera pose now from tf frame '%s'", params_.camera.frame.c_str());
     camera_from_tf_ = true;
   } catch (const tf2::TransformException& e) {
@@ -570,10 +572,7 @@ void WorldNode::onClickedPoint(const geometry_msgs::PointStamped& msg) {
       }
       try {
         const auto t = tf_buffer_->lookupTransform(params_.world_frame, msg.header.frame_id, ros::Time(0));
-        stc::Pose pose;
-        pose.position = toEigen(t.transform.translation);
-        pose.orientation = toEigen(t.transform.rotation).normalized();
-        point = pose.apply(point);
+        point = toPose(t.transform).apply(point);
       } catch (const tf2::TransformException& e) {
         throw stc::InputError("header.frame_id", e.what());
       }

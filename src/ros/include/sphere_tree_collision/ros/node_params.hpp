@@ -17,6 +17,7 @@ struct CameraParams {
   stc::Vec3 position = stc::Vec3(0.0, -2.6, 1.55);   // world frame, used without a frame or while tf has none
   stc::Vec3 look_at = stc::Vec3(0.0, 0.0, 0.5);
   std::string published_frame = "perception_camera";  // camera pose on /tf_static when not from tf; "" = off
+  std::string info_topic;  // sensor_msgs/CameraInfo giving size and field of view; "" = the parameters below
   bool pose_given = false;  // camera_position or camera_look_at set: a built-in scene's camera is not used
   int width = 1280;
   int height = 720;

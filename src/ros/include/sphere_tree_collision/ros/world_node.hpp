@@ -10,6 +10,7 @@
 #include "sphere_tree_collision/ros/marker_builder.hpp"
 #include "sphere_tree_collision/ros/node_diagnostics.hpp"
 #include "sphere_tree_collision/ros/node_params.hpp"
+#include "sphere_tree_collision/ros/perception_camera_info.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <geometry_msgs/PointStamped.h>
@@ -109,6 +110,7 @@ class WorldNode {
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   bool camera_from_tf_ = false;
   std::unique_ptr<tf2_ros::StaticTransformBroadcaster> camera_broadcaster_;  // without ~camera_frame
+  std::unique_ptr<PerceptionCameraInfo> camera_info_;  // ~camera_info, and ~camera_info_topic
 
   // Rejected inputs, total and per topic.
   std::uint64_t rejected_[4] = {0, 0, 0, 0};
