@@ -74,7 +74,8 @@ PerceptionCameraInfo::PerceptionCameraInfo(ros::NodeHandle& nh, ros::NodeHandle&
     : world_(world), frame_(std::move(frame)) {
   pub_ = private_nh.advertise<sensor_msgs::CameraInfo>("camera_info", 1, true);
   publish();
-  if (!source_topic.empty()) sub_ = nh.subscribe(source_topic, 1, &PerceptionCameraInfo::onCameraInfo, this);
+  // A queue of 10, not 1: with 1, roscpp dropped the CameraInfo that followed a refused one (camera_info.test).
+  if (!source_topic.empty()) sub_ = nh.subscribe(source_topic, 10, &PerceptionCameraInfo::onCameraInfo, this);
 }
 
 void PerceptionCameraInfo::publish() {
