@@ -14,6 +14,9 @@ packages=(
   clang libfuzzer-14-dev
   rviz xvfb xauth imagemagick x11-utils
   catkin-lint
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure  # live tuning (cfg/World.cfg)
+  libdiagnostic-updater-dev libdiagnostic-msgs-dev  # /diagnostics
+  libsensor-msgs-dev libimage-geometry-dev libtf2-eigen-dev  # the perception camera as a camera
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -21,6 +21,12 @@ struct Camera {
   int height = 720;
   double fov_y_deg = 60.0;  // vertical field of view
 };
+// A half-line in the world frame: origin + t * direction for t >= 0, direction unit.
+struct Ray {
+  Vec3 origin = Vec3::Zero();
+  Vec3 direction = Vec3::UnitZ();
+};
+
 // Throws InputError naming "width", "height", "fov_y_deg", or "camera_pose"
 // (not finite, a coordinate beyond 1e9 m, not a unit quaternion).
 void validateCamera(const Camera& camera);
@@ -67,6 +73,11 @@ class Perception {
   // Pixel of a world point; nullopt when it is behind (or on) the camera plane
   // or so far out that its pixel is not finite.
   std::optional<Vec2> project(const Vec3& world) const;
+  // The inverse of project: the viewing ray through a pixel (any pixel, on the
+  // image or not), from the camera centre; and the world point of a pixel at a
+  // depth along the optical axis (project(unproject(p, d)) == p for d > kNearDepth).
+  Ray rayThrough(const Vec2& pixel) const;
+  Vec3 unproject(const Vec2& pixel, double depth) const;
   // Depth along the optical axis; nullopt when <= kNearDepth.
   std::optional<double> depthOf(const Vec3& world) const;
   // Pixels per metre at unit depth: a length d at depth z spans d * focalPx() / z pixels.

@@ -152,6 +152,8 @@ class World {
   const WorldConfig& config() const { return config_; }
   void setScheduler(const SchedulerOptions& options);
   void setUnresolvedPolicy(UnresolvedPolicy policy) { config_.unresolved_policy = policy; }
+  // From the next step on; throws InputError (validateResponseOptions) and changes nothing.
+  void setResponse(const ResponseOptions& options);
 
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.

@@ -118,6 +118,19 @@ std::optional<Vec2> Perception::project(const Vec3& world) const {
   return pixel;
 }
 
+Vec3 Perception::unproject(const Vec2& pixel, double depth) const {
+  const Vec3 in_camera((pixel.x() - 0.5 * camera_.width) * depth / focal_px_,
+                       (pixel.y() - 0.5 * camera_.height) * depth / focal_px_, depth);
+  return camera_position_ + world_to_camera_rotation_.transpose() * in_camera;
+}
+
+Ray Perception::rayThrough(const Vec2& pixel) const {
+  Ray ray;
+  ray.origin = camera_position_;
+  ray.direction = (unproject(pixel, 1.0) - camera_position_).normalized();
+  return ray;
+}
+
 Perception::GazeWeight Perception::gazeWeight(const Vec3& world) const {
   GazeWeight out;
   const Vec3 c = world_to_camera_rotation_ * (world - camera_position_);

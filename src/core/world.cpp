@@ -223,6 +223,11 @@ void World::setScheduler(const SchedulerOptions& options) {
   config_.scheduler = options;
 }
 
+void World::setResponse(const ResponseOptions& options) {
+  validateResponseOptions(options);
+  config_.response = options;
+}
+
 // The last tick's pair tests point at bodies and its contacts name dense
 // indices: both go stale when entities are added or removed.
 void World::invalidateLastTick() {

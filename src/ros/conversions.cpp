@@ -1,34 +1,42 @@
 #include "sphere_tree_collision/ros/conversions.hpp"
 
+#include <tf2_eigen/tf2_eigen.h>
+
 #include <climits>
 #include <map>
 
 namespace stc_ros {
 
-geometry_msgs::Point toPointMsg(const stc::Vec3& v) {
-  geometry_msgs::Point p;
-  p.x = v.x();
-  p.y = v.y();
-  p.z = v.z();
-  return p;
+namespace {
+
+template <typename EigenType, typename Msg>
+EigenType fromMsgAs(const Msg& msg) {
+  EigenType out;
+  tf2::fromMsg(msg, out);
+  return out;
 }
+
+}  // namespace
+
+stc::Vec3 toEigen(const geometry_msgs::Point& p) { return fromMsgAs<stc::Vec3>(p); }
+stc::Vec3 toEigen(const geometry_msgs::Vector3& v) { return fromMsgAs<stc::Vec3>(v); }
+stc::Quat toEigen(const geometry_msgs::Quaternion& q) { return fromMsgAs<stc::Quat>(q); }
+
+stc::Pose toPose(const geometry_msgs::Transform& t) {
+  stc::Pose pose;
+  pose.position = toEigen(t.translation);
+  pose.orientation = toEigen(t.rotation).normalized();
+  return pose;
+}
+
+geometry_msgs::Point toPointMsg(const stc::Vec3& v) { return tf2::toMsg(v); }
 
 geometry_msgs::Vector3 toVector3Msg(const stc::Vec3& v) {
   geometry_msgs::Vector3 m;
-  m.x = v.x();
-  m.y = v.y();
-  m.z = v.z();
-  return m;
+  return tf2::toMsg(v, m);
 }
 
-geometry_msgs::Quaternion toQuaternionMsg(const stc::Quat& q) {
-  geometry_msgs::Quaternion m;
-  m.w = q.w();
-  m.x = q.x();
-  m.y = q.y();
-  m.z = q.z();
-  return m;
-}
+geometry_msgs::Quaternion toQuaternionMsg(const stc::Quat& q) { return tf2::toMsg(q); }
 
 geometry_msgs::Pose toPoseMsg(const stc::Pose& pose) {
   geometry_msgs::Pose m;

@@ -1,9 +1,9 @@
 #include "sphere_tree_collision/ros/gaze_simulator.hpp"
 
-#include "sphere_tree_collision/ros/conversions.hpp"
 #include "sphere_tree_collision/ros/param_reading.hpp"
-#include "sphere_tree_collision/ros/node_params.hpp"
 
+#include <ros/topic.h>
+#include <sensor_msgs/CameraInfo.h>
 #include <sphere_tree_collision/GazePoint.h>
 
 #include <algorithm>
@@ -17,15 +17,20 @@ using stc::InputError;
 }  // namespace
 
 GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
-  // The world node's camera: same image, same defaults, same validation.
+  // The world node's perception camera, as it publishes it (latched): the
+  // image for every mode, its tf frame and projection for follow.
   const std::string world_node = paramOr<std::string>(pnh, "world_node", "collision_world");
-  const NodeParams world = readNodeParams(ros::NodeHandle(world_node));
-  world_frame_ = world.world_frame;
-  camera_frame_ = world.camera.frame.empty() ? world.camera.published_frame : world.camera.frame;
-  camera_.width = world.camera.width;
-  camera_.height = world.camera.height;
-  camera_.fov_y_deg = world.camera.fov_y_deg;
-  const stc::Vec2 centre(0.5 * camera_.width, 0.5 * camera_.height);
+  const std::string topic = ros::names::append(world_node, "camera_info");
+  ROS_INFO("gaze_simulator: waiting for the perception camera on %s", nh_.resolveName(topic).c_str());
+  const auto info = ros::topic::waitForMessage<sensor_msgs::CameraInfo>(topic, nh_);
+  if (!info) throw InputError("world_node", "no CameraInfo on " + nh_.resolveName(topic) + " before shutdown");
+  if (!camera_.fromCameraInfo(*info) || info->width == 0 || info->height == 0) {
+    throw InputError("world_node", "the CameraInfo on " + nh_.resolveName(topic) + " has no image");
+  }
+  width_ = static_cast<int>(info->width);
+  height_ = static_cast<int>(info->height);
+  camera_frame_ = info->header.frame_id;
+  const stc::Vec2 centre(0.5 * width_, 0.5 * height_);
 
   const std::string mode = paramOr<std::string>(pnh, "mode", "saccades");
   const double rate = positiveParam(pnh, "rate", 30.0);
@@ -42,15 +47,15 @@ GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) 
     gp.seed = static_cast<std::uint32_t>(paramOr<int>(pnh, "seed", 1));
     model_ = std::make_unique<stc::GazeModel>(gp);
     mode_ = mode == "fixed" ? Mode::Fixed : Mode::Saccades;
-    if (mode_ == Mode::Fixed && !(pixel_.x() >= 0 && pixel_.y() >= 0 && pixel_.x() <= camera_.width &&
-                                  pixel_.y() <= camera_.height)) {
+    if (mode_ == Mode::Fixed && !(pixel_.x() >= 0 && pixel_.y() >= 0 && pixel_.x() <= width_ &&
+                                  pixel_.y() <= height_)) {
       throw InputError("pixel", "must lie on the image");
     }
   } else if (mode == "circle") {
     mode_ = Mode::Circle;
-    circle_radius_ = positiveParam(pnh, "circle_radius", 0.3 * camera_.height);
+    circle_radius_ = positiveParam(pnh, "circle_radius", 0.3 * height_);
     circle_period_ = positiveParam(pnh, "circle_period", circle_period_);
-    if (circle_radius_ > 0.5 * std::min(camera_.width, camera_.height)) {
+    if (circle_radius_ > 0.5 * std::min(width_, height_)) {
       throw InputError("circle_radius", "the circle must fit the image");
     }
   } else if (mode == "follow") {
@@ -66,23 +71,19 @@ GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) 
 
   pub_ = nh_.advertise<sphere_tree_collision::GazePoint>("gaze", 10);
   timer_ = nh_.createSteadyTimer(ros::WallDuration(1.0 / rate), [this](const ros::SteadyTimerEvent&) { publish(); });
-  ROS_INFO("gaze_simulator: %s at %.1f Hz on a %dx%d image", mode.c_str(), rate, camera_.width, camera_.height);
+  ROS_INFO("gaze_simulator: %s at %.1f Hz on a %dx%d image", mode.c_str(), rate, width_, height_);
 }
 
 std::optional<stc::Vec2> GazeSimulator::followPixel() {
   try {
-    const auto cam = tf_->lookupTransform(world_frame_, camera_frame_, ros::Time(0));
-    const auto target = tf_->lookupTransform(world_frame_, target_, ros::Time(0));
-    stc::Camera camera = camera_;
-    camera.camera_to_world.position = toEigen(cam.transform.translation);
-    camera.camera_to_world.orientation = toEigen(cam.transform.rotation).normalized();
-    stc::Perception perception;
-    perception.setCamera(camera);
-    const auto pixel = perception.project(toEigen(target.transform.translation));
-    if (pixel) {
+    // The target in the camera's optical frame, projected by the camera's own model.
+    const auto target = tf_->lookupTransform(camera_frame_, target_, ros::Time(0));
+    const auto& p = target.transform.translation;
+    if (p.z > stc::Perception::kNearDepth) {
+      const cv::Point2d pixel = camera_.project3dToPixel(cv::Point3d(p.x, p.y, p.z));
       follow_stamp_ = target.header.stamp;
-      last_follow_ = stc::Vec2(std::clamp(pixel->x(), 0.0, static_cast<double>(camera_.width)),
-                               std::clamp(pixel->y(), 0.0, static_cast<double>(camera_.height)));
+      last_follow_ = stc::Vec2(std::clamp(pixel.x, 0.0, static_cast<double>(width_)),
+                               std::clamp(pixel.y, 0.0, static_cast<double>(height_)));
     }
   } catch (const tf2::TransformException& e) {
     ROS_WARN_THROTTLE(5.0, "gaze_simulator: cannot follow '%s': %s", target_.c_str(), e.what());
@@ -106,8 +107,7 @@ void GazeSimulator::publish() {
     }
     case Mode::Circle: {
       const double a = 2.0 * M_PI * t / circle_period_;
-      pixel = stc::Vec2(0.5 * camera_.width + circle_radius_ * std::cos(a),
-                        0.5 * camera_.height + circle_radius_ * std::sin(a));
+      pixel = stc::Vec2(0.5 * width_ + circle_radius_ * std::cos(a), 0.5 * height_ + circle_radius_ * std::sin(a));
       break;
     }
     case Mode::Follow:

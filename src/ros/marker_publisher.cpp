@@ -69,6 +69,14 @@ void MarkerPublisher::worldCleared() {
   cleared_ = true;
 }
 
+void MarkerPublisher::retune(const NodeParams& next) {
+  ticks_per_marker_ = ticksPerMessage(next.rate, next.marker_rate);
+  if (next.marker_levels == options_.levels && next.show_voxels == options_.voxels) return;
+  options_.levels = next.marker_levels;
+  options_.voxels = next.show_voxels;
+  worldCleared();
+}
+
 void MarkerPublisher::publish(const ros::Time& stamp) {
   if (pub_.getNumSubscribers() == 0) {
     // Nobody to keep up to date: the next subscriber starts from a snapshot.

@@ -7,6 +7,7 @@
 #include <climits>
 #include <cmath>
 #include <set>
+#include <sstream>
 
 namespace stc_ros {
 namespace {
@@ -22,7 +23,8 @@ const std::set<std::string>& knownParams() {
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
-      "min_voxel_size", "max_voxel_size", "entity_states_rate", "publish_clock", "error_report"};
+      "min_voxel_size", "max_voxel_size", "entity_states_rate", "publish_clock", "error_report",
+      "diagnostic_period", "camera_info_topic"};  // diagnostic_period: read by diagnostic_updater
   return kNames;
 }
 
@@ -50,6 +52,78 @@ std::uint64_t ticksPerMessage(double tick_rate, double message_rate) {
   return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::lround(tick_rate / message_rate)));
 }
 
+TunableParams tunableOf(const NodeParams& p) {
+  TunableParams t;
+  t.detection_budget = p.detection_budget_ms;
+  t.sphere_test_budget = static_cast<int>(p.sphere_test_budget);
+  t.tick_budget = p.tick_budget_ms;
+  t.scheduler = stc::toString(p.world.scheduler.kind);
+  t.queue_count = p.world.scheduler.queue_count;
+  t.queue_ratio = p.world.scheduler.queue_ratio;
+  t.unresolved_policy = stc::toString(p.world.unresolved_policy);
+  t.response = p.world.response.enabled;
+  t.solver_iterations = p.world.response.iterations;
+  t.marker_levels = p.marker_levels;
+  t.show_voxels = p.show_voxels;
+  t.marker_rate = p.marker_rate;
+  t.gaze_timeout = p.gaze_timeout;
+  return t;
+}
+
+void applyTunable(const TunableParams& t, NodeParams& params) {
+  NodeParams p = params;
+  if (std::isnan(t.detection_budget)) throw InputError("detection_budget", "is NaN");
+  p.detection_budget_ms = t.detection_budget;
+  if (t.sphere_test_budget < -1) throw InputError("sphere_test_budget", "must be >= 0, or -1 for none");
+  p.sphere_test_budget = t.sphere_test_budget;
+  p.tick_budget_ms = requireNonNegative("tick_budget", t.tick_budget);
+
+  p.world.scheduler.kind = parsed("scheduler", [&] { return stc::parseScheduler(t.scheduler); });
+  p.world.scheduler.queue_count = requireIn("queue_count", t.queue_count, 1, 64);
+  p.world.scheduler.queue_ratio = requirePositive("queue_ratio", t.queue_ratio);
+  stc::validateSchedulerOptions(p.world.scheduler);  // its fields are named as the parameters
+  p.world.unresolved_policy = parsed("unresolved_policy", [&] { return stc::parseUnresolvedPolicy(t.unresolved_policy); });
+
+  p.world.response.enabled = t.response;
+  p.world.response.iterations = requireIn("solver_iterations", t.solver_iterations, 1, 1000);
+  parsed("solver_iterations", [&] { stc::validateResponseOptions(p.world.response); return 0; });
+
+  for (int level : t.marker_levels) {
+    if (level < 0 || level > 7) throw InputError("marker_levels", "levels must be in [0, 7]");
+  }
+  p.marker_levels = t.marker_levels;
+  p.show_voxels = t.show_voxels;
+  p.marker_rate = requirePositive("marker_rate", t.marker_rate);
+  p.gaze_timeout = requirePositive("gaze_timeout", t.gaze_timeout);
+  params = std::move(p);
+}
+
+std::vector<int> parseMarkerLevels(const std::string& text) {
+  std::string spaced = text;  // "1,2", "1 2" and "[1, 2]" alike
+  std::replace_if(spaced.begin(), spaced.end(), [](char c) { return c == ',' || c == '[' || c == ']'; }, ' ');
+  std::vector<int> levels;
+  std::istringstream in(spaced);
+  std::string token;
+  while (in >> token) {
+    std::size_t used = 0;
+    int level = -1;
+    try {
+      level = std::stoi(token, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != token.size()) throw InputError("marker_levels", "'" + token + "' is not a level number");
+    levels.push_back(level);
+  }
+  return levels;
+}
+
+std::string formatMarkerLevels(const std::vector<int>& levels) {
+  std::string text;
+  for (int level : levels) text += (text.empty() ? "" : ",") + std::to_string(level);
+  return text;
+}
+
 NodeParams readNodeParams(const ros::NodeHandle& nh) {
   NodeParams p;
   readParam(nh, "scene", p.scene);
@@ -60,15 +134,8 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   if (p.world_frame.empty()) throw InputError("world_frame", "must not be empty");
   p.rate = positiveParam(nh, "rate", p.rate);
   if (p.rate > 10000.0 || p.rate < 0.01) throw InputError("rate", "must be in [0.01, 10000] Hz");
-  p.marker_rate = positiveParam(nh, "marker_rate", p.marker_rate);
   p.entity_states_rate = positiveParam(nh, "entity_states_rate", p.entity_states_rate);
   readParam(nh, "publish_clock", p.publish_clock);
-  if (readParam(nh, "marker_levels", p.marker_levels)) {
-    for (int level : p.marker_levels) {
-      if (level < 0 || level > 7) throw InputError("marker_levels", "levels must be in [0, 7]");
-    }
-  }
-  readParam(nh, "show_voxels", p.show_voxels);
   readParam(nh, "static_tree_markers", p.static_tree_markers);
   readParam(nh, "publish_tf", p.publish_tf);
   p.marker_keyframe_period = nonNegativeParam(nh, "marker_keyframe_period", p.marker_keyframe_period);
@@ -85,23 +152,28 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   p.max_contact_markers = intParamIn(nh, "max_contact_markers", p.max_contact_markers, 0, 1000000);
   p.contact_marker_size = positiveParam(nh, "contact_marker_size", p.contact_marker_size);
 
-  readParam(nh, "detection_budget", p.detection_budget_ms);
-  if (std::isnan(p.detection_budget_ms)) throw InputError("detection_budget", "is NaN");
-  int sphere_tests = -1;
-  if (readParam(nh, "sphere_test_budget", sphere_tests)) p.sphere_test_budget = sphere_tests;
-  if (p.sphere_test_budget < -1) throw InputError("sphere_test_budget", "must be >= 0, or -1 for none");
-  p.tick_budget_ms = nonNegativeParam(nh, "tick_budget", p.tick_budget_ms);
+  TunableParams t = tunableOf(p);  // the defaults
+  readParam(nh, "detection_budget", t.detection_budget);
+  readParam(nh, "sphere_test_budget", t.sphere_test_budget);
+  readParam(nh, "tick_budget", t.tick_budget);
+  readParam(nh, "scheduler", t.scheduler);
+  readParam(nh, "queue_count", t.queue_count);
+  readParam(nh, "queue_ratio", t.queue_ratio);
+  readParam(nh, "unresolved_policy", t.unresolved_policy);
+  readParam(nh, "response", t.response);
+  readParam(nh, "solver_iterations", t.solver_iterations);
+  std::string levels;  // a list, or text once live tuning has written it back
+  if (nh.getParam("marker_levels", levels)) {
+    t.marker_levels = parseMarkerLevels(levels);
+  } else {
+    readParam(nh, "marker_levels", t.marker_levels);
+  }
+  readParam(nh, "show_voxels", t.show_voxels);
+  readParam(nh, "marker_rate", t.marker_rate);
+  readParam(nh, "gaze_timeout", t.gaze_timeout);
+  applyTunable(t, p);
 
-  std::string name = "priority_queues";
-  readParam(nh, "scheduler", name);
-  p.world.scheduler.kind = parsed("scheduler", [&] { return stc::parseScheduler(name); });
-  p.world.scheduler.queue_count = intParamIn(nh, "queue_count", p.world.scheduler.queue_count, 1, 64);
-  p.world.scheduler.queue_ratio = positiveParam(nh, "queue_ratio", p.world.scheduler.queue_ratio);
-  stc::validateSchedulerOptions(p.world.scheduler);  // its fields are named as the parameters
-  name = "accept";
-  readParam(nh, "unresolved_policy", name);
-  p.world.unresolved_policy = parsed("unresolved_policy", [&] { return stc::parseUnresolvedPolicy(name); });
-  name = "tight";
+  std::string name = "tight";
   readParam(nh, "sphere_fit", name);
   p.world.tree.fit = parsed("sphere_fit", [&] { return stc::parseSphereFit(name); });
   p.world.tree.max_levels = intParamIn(nh, "tree_levels", p.world.tree.max_levels, 1, 8);
@@ -127,17 +199,13 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   }
   p.gravity = vec3Param(nh, "gravity");
   if (p.gravity) stc::validateGravity(*p.gravity, limits);
-  readParam(nh, "response", p.world.response.enabled);
-  p.world.response.iterations = intParamIn(nh, "solver_iterations", p.world.response.iterations, 1, 1000);
-  parsed("solver_iterations", [&] { stc::validateResponseOptions(p.world.response); return 0; });
-
-  p.gaze_timeout = positiveParam(nh, "gaze_timeout", p.gaze_timeout);
   readParam(nh, "error_report", p.error_report);  // opened (and so checked) by ErrorReport
   int resolution = static_cast<int>(p.default_resolution);
   p.default_resolution = static_cast<std::uint32_t>(intParamIn(nh, "default_resolution", resolution, 1, 4096));
 
   readParam(nh, "camera_frame", p.camera.frame);
   readParam(nh, "published_camera_frame", p.camera.published_frame);
+  readParam(nh, "camera_info_topic", p.camera.info_topic);
   if (auto v = vec3Param(nh, "camera_position")) {
     p.camera.position = *v;
     p.camera.pose_given = true;

@@ -5,24 +5,33 @@
 
 namespace stc_ros {
 
-double positiveParam(const ros::NodeHandle& nh, const std::string& name, double fallback) {
-  const double value = paramOr(nh, name, fallback);
+double requirePositive(const std::string& name, double value) {
   if (!(value > 0.0) || !std::isfinite(value)) throw stc::InputError(name, "must be finite and > 0");
   return value;
 }
 
-double nonNegativeParam(const ros::NodeHandle& nh, const std::string& name, double fallback) {
-  const double value = paramOr(nh, name, fallback);
+double requireNonNegative(const std::string& name, double value) {
   if (!(value >= 0.0) || !std::isfinite(value)) throw stc::InputError(name, "must be finite and >= 0");
   return value;
 }
 
-int intParamIn(const ros::NodeHandle& nh, const std::string& name, int fallback, int lo, int hi) {
-  const int value = paramOr(nh, name, fallback);
+int requireIn(const std::string& name, int value, int lo, int hi) {
   if (value < lo || value > hi) {
     throw stc::InputError(name, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   }
   return value;
+}
+
+double positiveParam(const ros::NodeHandle& nh, const std::string& name, double fallback) {
+  return requirePositive(name, paramOr(nh, name, fallback));
+}
+
+double nonNegativeParam(const ros::NodeHandle& nh, const std::string& name, double fallback) {
+  return requireNonNegative(name, paramOr(nh, name, fallback));
+}
+
+int intParamIn(const ros::NodeHandle& nh, const std::string& name, int fallback, int lo, int hi) {
+  return requireIn(name, paramOr(nh, name, fallback), lo, hi);
 }
 
 std::optional<stc::Vec3> vec3Param(const ros::NodeHandle& nh, const std::string& name) {

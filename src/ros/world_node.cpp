@@ -2,12 +2,12 @@
 
 #include "sphere_tree_collision/ros/conversions.hpp"
 #include "sphere_tree_collision/ros/scene_file.hpp"
+#include "sphere_tree_collision/perception_ray.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <exception>
-#include <limits>
 
 namespace stc_ros {
 namespace {
@@ -30,25 +30,6 @@ stc::Camera cameraAt(const CameraParams& params, const stc::Pose& pose) {
   camera.height = params.height;
   camera.fov_y_deg = params.fov_y_deg;
   return camera;
-}
-
-// First hit of the ray with an entity's bounding ball, else with the ground
-// plane z = 0, else a point 5 m out: where the gaze marker is drawn.
-stc::Vec3 gazeTarget(const stc::World& world, const stc::Vec3& origin, const stc::Vec3& dir) {
-  double best = std::numeric_limits<double>::infinity();
-  const auto& bodies = world.bodies();
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    const double r = world.shape(world.bodyShapes()[i]).bounding_radius;
-    const stc::Vec3 oc = bodies[i].pose.position - origin;
-    const double t_mid = oc.dot(dir);
-    const double d2 = oc.squaredNorm() - t_mid * t_mid;
-    if (d2 > r * r) continue;
-    const double t = t_mid - std::sqrt(r * r - d2);
-    if (t > 0.0 && t < best) best = t;
-  }
-  if (std::isfinite(best)) return origin + best * dir;
-  if (dir.z() < -1e-6 && origin.z() > 0.0) return origin + (-origin.z() / dir.z()) * dir;
-  return origin + 5.0 * dir;
 }
 
 // What an exception caught by catch (...) says.
@@ -95,6 +76,9 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     camera_broadcaster_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
     camera_broadcaster_->sendTransform(t);
   }
+  camera_info_ = std::make_unique<PerceptionCameraInfo>(
+      nh_, pnh_, world_, params_.camera.frame.empty() ? params_.camera.published_frame : params_.camera.frame,
+      params_.camera.info_topic);
   budget_ = params_.budget();
   dt_ = 1.0 / params_.rate;
   if (!params_.error_report.empty()) error_report_ = std::make_unique<ErrorReport>(params_.error_report);
@@ -124,6 +108,17 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
            params_.detection_budget_ms < 0 ? "none" : std::to_string(params_.detection_budget_ms).c_str(),
            params_.sphere_test_budget < 0 ? "no limit" : std::to_string(params_.sphere_test_budget).c_str(),
            params_.tick_budget_ms > 0 ? std::to_string(params_.tick_budget_ms).c_str() : "none");
+  diagnostics_ = std::make_unique<NodeDiagnostics>(nh_, pnh_, params_);
+  tuning_ = std::make_unique<LiveTuning>(pnh_, params_, [this](const NodeParams& next) { retune(next); });
+}
+
+void WorldNode::retune(const NodeParams& next) {
+  world_.setScheduler(next.world.scheduler);  // the only step that can throw: first
+  world_.setResponse(next.world.response);  // checked by applyTunable already
+  world_.setUnresolvedPolicy(next.world.unresolved_policy);
+  budget_ = next.budget();
+  markers_->retune(next);
+  params_ = next;
 }
 
 void WorldNode::remember(stc::EntityId id, const std::string& name, const std::optional<Rgba>& color) {
@@ -279,10 +274,9 @@ void WorldNode::forget(stc::EntityId id, stc::ShapeId shape, bool is_static) {
 void WorldNode::updateCameraFromTf() {
   try {
     const auto t = tf_buffer_->lookupTransform(params_.world_frame, params_.camera.frame, ros::Time(0));
-    stc::Pose pose;
-    pose.position = toEigen(t.transform.translation);
-    pose.orientation = toEigen(t.transform.rotation).normalized();
-    world_.perception().setCamera(cameraAt(params_.camera, pose));
+    stc::Camera camera = world_.perception().camera();  // its size may come from ~camera_info_topic
+    camera.camera_to_world = toPose(t.transform);
+    world_.perception().setCamera(camera);
     if (!camera_from_tf_) ROS_INFO("camera pose now from tf frame '%s'", params_.camera.frame.c_str());
     camera_from_tf_ = true;
   } catch (const tf2::TransformException& e) {
@@ -298,8 +292,7 @@ void WorldNode::expireGaze(const ros::Time& now) {
 }
 
 void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
-  if (stats_pub_.getNumSubscribers() == 0) return;
-  sphere_tree_collision::TickStats s;
+  sphere_tree_collision::TickStats& s = stats_msg_;  // built every tick: diagnostics read it too
   s.header.stamp = stamp;
   s.header.frame_id = params_.world_frame;
   s.tick = tick_;
@@ -347,7 +340,8 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.physics_time = clock_.physicsSeconds();
   s.real_time_factor = clock_.realTimeFactor();
   s.paused = paused_;
-  stats_pub_.publish(s);
+  diagnostics_->onTick(s);
+  if (stats_pub_.getNumSubscribers() > 0) stats_pub_.publish(s);
 }
 
 void WorldNode::publishContacts(const ros::Time& stamp) {
@@ -396,16 +390,7 @@ void WorldNode::publishTf(const ros::Time& stamp) {
   if (n != 0) tf_pub_.publish(tf_msg_);
 }
 
-std::optional<stc::Vec3> WorldNode::gazePoint() const {
-  const stc::Perception& p = world_.perception();
-  if (!p.hasFixation()) return std::nullopt;
-  const stc::Camera& camera = p.camera();
-  const stc::Vec2& f = *p.fixation();
-  const stc::Vec3 dir_camera((f.x() - 0.5 * camera.width) / p.focalPx(), (f.y() - 0.5 * camera.height) / p.focalPx(), 1.0);
-  const stc::Vec3 dir = (camera.camera_to_world.orientation * dir_camera).normalized();
-  const stc::Vec3 origin = camera.camera_to_world.position;
-  return gazeTarget(world_, origin, dir);
-}
+std::optional<stc::Vec3> WorldNode::gazePoint() const { return stc::gazeTarget(world_); }
 
 // ---------------------------------------------------------------------------------
 // Inputs
@@ -539,10 +524,7 @@ void WorldNode::onClickedPoint(const geometry_msgs::PointStamped& msg) {
       }
       try {
         const auto t = tf_buffer_->lookupTransform(params_.world_frame, msg.header.frame_id, ros::Time(0));
-        stc::Pose pose;
-        pose.position = toEigen(t.transform.translation);
-        pose.orientation = toEigen(t.transform.rotation).normalized();
-        point = pose.apply(point);
+        point = toPose(t.transform).apply(point);
       } catch (const tf2::TransformException& e) {
         throw stc::InputError("header.frame_id", e.what());
       }

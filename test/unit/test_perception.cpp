@@ -1,8 +1,10 @@
 // Perception: pinhole projection, input checks, f(e, g), and the rule for
 // pairs behind the camera or off screen.
 #include "sphere_tree_collision/perception.hpp"
+#include "sphere_tree_collision/perception_ray.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
+#include "sphere_tree_collision/world.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,6 +23,13 @@ Perception defaultPerception() {
   Perception p;
   p.setCamera(Camera{});
   return p;
+}
+
+VoxelShape presetShape(const char* name, int resolution, double voxel_size) {
+  PresetParams params;
+  params.resolution = resolution;
+  params.voxel_size = voxel_size;
+  return makePreset(name, params);
 }
 
 std::string fieldOf(const std::function<void()>& f) {
@@ -150,10 +159,7 @@ TEST(Perception, PerceivedInaccuracyIsThePapersFunction) {
 class MeasurePair : public ::testing::Test {
  protected:
   void SetUp() override {
-    PresetParams params;
-    params.resolution = 8;
-    params.voxel_size = 0.05;  // 0.4 m across
-    const VoxelShape shape = makePreset("sphere", params);
+    const VoxelShape shape = presetShape("sphere", 8, 0.05);  // 0.4 m across
     const Vec3 origin = computeMassProperties(shape, 1.0).centre_of_mass;
     tree_ = SphereTree::build(shape, origin);
     ASSERT_EQ(tree_.levelCount(), 1);
@@ -256,6 +262,114 @@ TEST_F(MeasurePair, WithoutFixationPriorityIsZero) {
   const PairPerception m = p.measure(test_);
   EXPECT_EQ(m.priority, 0.0);
   EXPECT_FALSE(m.visible);
+}
+
+// A camera off the axes, tilted and rolled, so that no axis helps the round trip.
+Perception tiltedPerception() {
+  Perception p;
+  Camera camera;
+  camera.camera_to_world = opticalLookAt(Vec3(1.5, -2.0, 3.0), Vec3(-0.5, 4.0, 0.2), Vec3(0.3, 0.1, 1.0).normalized());
+  camera.width = 800;
+  camera.height = 600;
+  camera.fov_y_deg = 45.0;
+  p.setCamera(camera);
+  return p;
+}
+
+TEST(PerceptionRay, ProjectThenUnprojectIsTheIdentity) {
+  const Perception p = tiltedPerception();
+  for (const Vec3& world : {Vec3(-0.5, 4.0, 0.2), Vec3(0.3, 2.0, 1.0), Vec3(-2.0, 6.0, -1.0), Vec3(2.5, 1.0, 2.5)}) {
+    const auto pixel = p.project(world);
+    ASSERT_TRUE(pixel);
+    const Vec3 back = p.unproject(*pixel, *p.depthOf(world));
+    EXPECT_LT((back - world).norm(), 1e-9) << world.transpose();
+    // The ray through its pixel passes through the point.
+    const Ray ray = p.rayThrough(*pixel);
+    EXPECT_NEAR(ray.direction.norm(), 1.0, 1e-12);
+    const double t = (world - ray.origin).dot(ray.direction);
+    EXPECT_GT(t, 0.0);
+    EXPECT_LT((ray.origin + t * ray.direction - world).norm(), 1e-9) << world.transpose();
+  }
+}
+
+TEST(PerceptionRay, UnprojectThenProjectIsTheIdentityOnAndOffTheImage) {
+  const Perception p = tiltedPerception();
+  for (const Vec2& pixel : {Vec2(0, 0), Vec2(400, 300), Vec2(800, 600), Vec2(-250, 900), Vec2(123.5, 77.25)}) {
+    for (double depth : {0.01, 1.0, 37.0}) {
+      const auto back = p.project(p.unproject(pixel, depth));
+      ASSERT_TRUE(back);
+      EXPECT_LT((*back - pixel).norm(), 1e-7) << pixel.transpose() << " at " << depth;
+      EXPECT_NEAR(*p.depthOf(p.unproject(pixel, depth)), depth, 1e-9);
+    }
+  }
+  // The image centre looks along the optical axis.
+  const Ray centre = p.rayThrough(Vec2(400, 300));
+  EXPECT_LT((centre.direction - p.camera().camera_to_world.orientation * Vec3::UnitZ()).norm(), 1e-12);
+}
+
+// 1 m cubes (bounding radius r): three along +x, one beside them, one behind the origin.
+class CastRay : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const ShapeId cube = world_.addShape("cube", presetShape("cube", 4, 0.25));
+    radius_ = world_.shape(cube).bounding_radius;
+    for (const Vec3& at : {Vec3(8, 0, 0), Vec3(4, 0, 0), Vec3(12, 0, 0), Vec3(4, 3, 0), Vec3(-3, 0, 0)}) {
+      EntitySpec spec;
+      spec.shape = cube;
+      spec.pose.position = at;
+      world_.addEntity(spec);
+    }
+  }
+  World world_;
+  double radius_ = 0.0;
+};
+
+TEST_F(CastRay, HitsTheNearestBodyInFrontOfTheOrigin) {
+  ASSERT_GT(radius_, 0.5);
+  Ray ray;
+  ray.direction = Vec3::UnitX();
+  const auto hit = castRay(world_, ray);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->body, 1u);  // the body at x = 4, not the one at x = -3 behind the origin
+  EXPECT_NEAR(hit->distance, 4.0 - radius_, 1e-12);
+
+  ray.direction = -Vec3::UnitX();
+  ASSERT_TRUE(castRay(world_, ray));
+  EXPECT_EQ(castRay(world_, ray)->body, 4u);
+
+  ray.direction = Vec3(0, 0, 1);  // nothing above
+  EXPECT_FALSE(castRay(world_, ray));
+
+  ray.origin = Vec3(4, 0, 0);  // from inside a ball: where the ray leaves it
+  ray.direction = Vec3::UnitY();
+  ASSERT_TRUE(castRay(world_, ray));
+  EXPECT_EQ(castRay(world_, ray)->body, 1u);
+  EXPECT_NEAR(castRay(world_, ray)->distance, radius_, 1e-12);
+}
+
+TEST_F(CastRay, GazeTargetIsWhereTheFixationRayFirstMeetsTheScene) {
+  Camera camera;
+  camera.camera_to_world = opticalLookAt(Vec3(0, 0, 0), Vec3(1, 0, 0));
+  world_.perception().setCamera(camera);
+  EXPECT_FALSE(gazeTarget(world_));  // no fixation
+  world_.perception().setFixation(Vec2(640, 360));  // the image centre: along +x
+  const auto target = gazeTarget(world_);
+  ASSERT_TRUE(target);
+  EXPECT_LT((*target - Vec3(4.0 - radius_, 0, 0)).norm(), 1e-9);
+
+  // Looking down from above at empty ground: the ground plane z = 0.
+  camera.camera_to_world = opticalLookAt(Vec3(20, 20, 2), Vec3(22, 20, 0));
+  world_.perception().setCamera(camera);
+  const auto ground = gazeTarget(world_);
+  ASSERT_TRUE(ground);
+  EXPECT_LT((*ground - Vec3(22, 20, 0)).norm(), 1e-9);
+
+  // Looking up at the empty sky: a point kGazeFallbackDistance out.
+  camera.camera_to_world = opticalLookAt(Vec3(20, 20, 2), Vec3(20, 20, 9));
+  world_.perception().setCamera(camera);
+  const auto sky = gazeTarget(world_);
+  ASSERT_TRUE(sky);
+  EXPECT_LT((*sky - Vec3(20, 20, 2 + kGazeFallbackDistance)).norm(), 1e-9);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <geometry_msgs/Point.h>
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Quaternion.h>
+#include <geometry_msgs/Transform.h>
 #include <geometry_msgs/Vector3.h>
 #include <std_msgs/ColorRGBA.h>
 
@@ -16,10 +17,13 @@
 
 namespace stc_ros {
 
-inline stc::Vec3 toEigen(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
-inline stc::Vec3 toEigen(const geometry_msgs::Vector3& v) { return {v.x, v.y, v.z}; }
+// Through tf2_eigen (tf2::fromMsg / tf2::toMsg), under names that say the direction.
+stc::Vec3 toEigen(const geometry_msgs::Point& p);
+stc::Vec3 toEigen(const geometry_msgs::Vector3& v);
 // Not normalised: callers validate the norm first.
-inline stc::Quat toEigen(const geometry_msgs::Quaternion& q) { return stc::Quat(q.w, q.x, q.y, q.z); }
+stc::Quat toEigen(const geometry_msgs::Quaternion& q);
+// A tf transform as a pose; the rotation normalised (tf's is unit up to rounding).
+stc::Pose toPose(const geometry_msgs::Transform& t);
 
 geometry_msgs::Point toPointMsg(const stc::Vec3& v);
 geometry_msgs::Vector3 toVector3Msg(const stc::Vec3& v);

@@ -5,14 +5,16 @@
 //   saccades  the core GazeModel: a new seeded pixel every ~saccade_period s
 //   follow    the projection of tf frame ~target (an entity's frame), clamped
 //             onto the image; the last pixel while the frame is missing
-// Image size and field of view are read from the world node's parameters
-// (~world_node), the camera pose for follow from tf (the world node publishes
-// it as "perception_camera", or its ~camera_frame).
+// The camera (image size, projection, tf frame) is the world node's
+// perception camera as it publishes it on <~world_node>/camera_info; the
+// camera pose for follow comes from tf (the world node publishes it as
+// "perception_camera", or its ~camera_frame).
 #pragma once
 
 #include "sphere_tree_collision/perception.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 
+#include <image_geometry/pinhole_camera_model.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
@@ -35,8 +37,9 @@ class GazeSimulator {
 
   ros::NodeHandle nh_;
   Mode mode_ = Mode::Saccades;
-  stc::Camera camera_;
-  std::string world_frame_, camera_frame_, target_;
+  image_geometry::PinholeCameraModel camera_;
+  int width_ = 0, height_ = 0;  // the camera's image, pixels
+  std::string camera_frame_, target_;
   stc::Vec2 pixel_;
   double circle_radius_ = 0.0, circle_period_ = 4.0;
   std::unique_ptr<stc::GazeModel> model_;  // fixed and saccades

@@ -51,6 +51,9 @@ class MarkerPublisher {
   void entityRemoved(stc::EntityId id, stc::ShapeId shape, bool is_static);
   // The world was cleared: the next array starts with DELETEALL.
   void worldCleared();
+  // Live tuning: marker rate, levels and voxels shown. New levels or voxels
+  // redraw every entity (the next array starts with DELETEALL).
+  void retune(const NodeParams& next);
 
  private:
   void publish(const ros::Time& stamp);

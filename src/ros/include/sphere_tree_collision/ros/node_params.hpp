@@ -18,6 +18,7 @@ struct CameraParams {
   stc::Vec3 position = stc::Vec3(0.0, -2.6, 1.55);   // world frame, used without a frame or while tf has none
   stc::Vec3 look_at = stc::Vec3(0.0, 0.0, 0.5);
   std::string published_frame = "perception_camera";  // camera pose on /tf_static when not from tf; "" = off
+  std::string info_topic;  // sensor_msgs/CameraInfo giving size and field of view; "" = the parameters below
   bool pose_given = false;  // camera_position or camera_look_at set: a built-in scene's camera is not used
   int width = 1280;
   int height = 720;
@@ -57,6 +58,33 @@ struct NodeParams {
 
   stc::Budget budget() const;
 };
+
+// What may change while the node runs (dynamic_reconfigure, cfg/World.cfg),
+// as the parameters spell it. Start-up and live tuning both go through
+// applyTunable: one check for both.
+struct TunableParams {
+  double detection_budget;  // ms
+  int sphere_test_budget;
+  double tick_budget;  // ms
+  std::string scheduler;
+  int queue_count;
+  double queue_ratio;
+  std::string unresolved_policy;
+  bool response;
+  int solver_iterations;
+  std::vector<int> marker_levels;
+  bool show_voxels;
+  double marker_rate;  // Hz
+  double gaze_timeout;  // s
+};
+TunableParams tunableOf(const NodeParams& params);
+// Checks `t` and writes it into `params`; throws stc::InputError named after
+// the parameter and leaves `params` unchanged.
+void applyTunable(const TunableParams& t, NodeParams& params);
+// ~marker_levels as text ("1,2" or "1 2"), as dynamic_reconfigure carries it;
+// throws InputError("marker_levels").
+std::vector<int> parseMarkerLevels(const std::string& text);
+std::string formatMarkerLevels(const std::vector<int>& levels);
 
 // Throws stc::InputError whose field is the parameter name (e.g. "rate").
 NodeParams readNodeParams(const ros::NodeHandle& private_nh);

@@ -25,6 +25,12 @@ T paramOr(const ros::NodeHandle& nh, const std::string& name, T fallback) {
   return fallback;
 }
 
+// A value checked as the parameter `name` (start-up or live tuning): the value,
+// or InputError(name). Finite and > 0; finite and >= 0; in [lo, hi].
+double requirePositive(const std::string& name, double value);
+double requireNonNegative(const std::string& name, double value);
+int requireIn(const std::string& name, int value, int lo, int hi);
+
 // Finite and > 0.
 double positiveParam(const ros::NodeHandle& nh, const std::string& name, double fallback);
 // Finite and >= 0.

@@ -9,8 +9,11 @@
 
 #include "sphere_tree_collision/ros/entity_state_publisher.hpp"
 #include "sphere_tree_collision/ros/error_report.hpp"
+#include "sphere_tree_collision/ros/live_tuning.hpp"
 #include "sphere_tree_collision/ros/marker_publisher.hpp"
+#include "sphere_tree_collision/ros/node_diagnostics.hpp"
 #include "sphere_tree_collision/ros/node_params.hpp"
+#include "sphere_tree_collision/ros/perception_camera_info.hpp"
 #include "sphere_tree_collision/ros/tick_clock.hpp"
 #include "sphere_tree_collision/ros/world_services.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -90,6 +93,8 @@ class WorldNode {
   // Fills world_ from ~scene (YAML file, built-in scene name, or the default);
   // returns the camera pose to use when no tf frame gives one.
   stc::Pose loadScene();
+  // Live tuning: checked parameters in effect from the next tick on.
+  void retune(const NodeParams& next);
 
   void publishStats(const stc::TickReport& report, const ros::Time& stamp);
   void publishContacts(const ros::Time& stamp);
@@ -119,6 +124,7 @@ class WorldNode {
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   bool camera_from_tf_ = false;
   std::unique_ptr<tf2_ros::StaticTransformBroadcaster> camera_broadcaster_;  // without ~camera_frame
+  std::unique_ptr<PerceptionCameraInfo> camera_info_;  // ~camera_info, and ~camera_info_topic
 
   // Rejected inputs, total and per topic.
   std::uint64_t rejected_[4] = {0, 0, 0, 0};
@@ -132,9 +138,12 @@ class WorldNode {
   // Reused message buffers: no allocation per tick once warm.
   sphere_tree_collision::ContactArray contacts_msg_;
   tf2_msgs::TFMessage tf_msg_;
+  sphere_tree_collision::TickStats stats_msg_;
 
   ros::Publisher contacts_pub_, stats_pub_, tf_pub_, quarantined_pub_;
   ros::Subscriber spawn_sub_, despawn_sub_, clear_sub_, gaze_sub_, clicked_sub_;
+  std::unique_ptr<LiveTuning> tuning_;
+  std::unique_ptr<NodeDiagnostics> diagnostics_;
 };
 
 }  // namespace stc_ros
