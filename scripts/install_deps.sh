@@ -7,6 +7,7 @@ packages=(
   libroscpp-dev libtf2-ros-dev libtf2-dev libvisualization-msgs-dev libgeometry-msgs-dev libstd-msgs-dev
   librostest-dev python3-rostest python3-roslaunch libtf2-msgs-dev
   libeigen3-dev libyaml-cpp-dev libfcl-dev libgtest-dev googletest
+  libassimp-dev  # mesh loading (stc_mesh): STL, OBJ, DAE
   python3-matplotlib
   libbullet-dev  # benchmarks only: bench_bullet_compare (skipped when absent)
   clang libfuzzer-14-dev
