@@ -118,4 +118,17 @@ double enclosedVolume(const TriangleMesh& mesh) {
   return volume;
 }
 
+double windingNumber(const TriangleMesh& mesh, const Vec3& p) {
+  double total = 0.0;
+  for (const auto& t : mesh.triangles) {
+    // Signed solid angle of the triangle seen from p (Van Oosterom and Strackee).
+    const Vec3 a = mesh.vertices[t[0]] - p, b = mesh.vertices[t[1]] - p, c = mesh.vertices[t[2]] - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double numerator = a.dot(b.cross(c));
+    const double denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    total += 2.0 * std::atan2(numerator, denominator);
+  }
+  return total / (4.0 * M_PI);
+}
+
 }  // namespace stc::truth

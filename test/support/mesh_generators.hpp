@@ -32,5 +32,9 @@ TriangleMesh bumpyScanMesh(std::uint32_t seed = 7);
 
 // Volume enclosed by a closed, outward mesh (divergence theorem).
 double enclosedVolume(const TriangleMesh& mesh);
+// Generalised winding number of p (sum of the triangles' signed solid angles
+// / 4 pi): 1 inside a closed outward mesh, 0 outside, about right near a
+// small hole; > 0.5 means inside.
+double windingNumber(const TriangleMesh& mesh, const Vec3& p);
 
 }  // namespace stc::truth
