@@ -476,7 +476,7 @@ void WorldNode::rejectUnexpected(Input input) {
 }
 
 void WorldNode::onSpawn(const sphere_tree_collision::SpawnEntity& msg) {
-  const bool is_preset = !msg.preset.empty();
+  const bool is_preset = !msg.preset.empty() || !msg.mesh_resource.empty();  // sized by resolution, not dims
   try {
     EntityRequest request = toEntityRequest(msg, params_.default_resolution);
     const std::string name = request.spec.name;

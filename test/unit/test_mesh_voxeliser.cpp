@@ -4,6 +4,7 @@
 // STL / OBJ / DAE files written here load through assimp to the same shape.
 #include "mesh_files.hpp"
 #include "mesh_generators.hpp"
+#include "temp_dir.hpp"
 
 #include "sphere_tree_collision/mesh_loader.hpp"
 #include "sphere_tree_collision/mesh_voxeliser.hpp"
@@ -190,21 +191,8 @@ TEST(MeshVoxeliser, TheTreeGapBoundIncludesTheSurfaceMargin) {
 
 class MeshFiles : public ::testing::Test {
  protected:
-  void SetUp() override {
-    char pattern[] = "/tmp/stc_mesh_XXXXXX";
-    ASSERT_NE(mkdtemp(pattern), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    for (const std::string& f : written_) std::remove(f.c_str());
-    std::remove(dir_.c_str());
-  }
-  std::string file(const std::string& name) {
-    written_.push_back(dir_ + "/" + name);
-    return written_.back();
-  }
-  std::string dir_;
-  std::vector<std::string> written_;
+  std::string file(const std::string& name) { return dir_.file(name); }
+  truth::TempDir dir_;
 };
 
 TEST_F(MeshFiles, EveryFormatLoadsToTheSameSolid) {
@@ -237,7 +225,7 @@ TEST_F(MeshFiles, FileUriAndScaleAreApplied) {
 }
 
 TEST_F(MeshFiles, BadResourcesAreRejectedNamingTheField) {
-  const std::string missing = dir_ + "/missing.stl";
+  const std::string missing = dir_.path() + "/missing.stl";
   const InputError e = errorOf([&] { loadTriangleMesh(missing); });
   EXPECT_EQ(e.field(), "mesh_resource");
   EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
