@@ -151,7 +151,9 @@ int main(int argc, char** argv) {
          "meshes, not only for their voxels.\n\n"
       << "## Cost\n\n" << cost.str()
       << "\nVoxelisation: triangle-box overlap marks the surface voxels, a flood from the grid border marks the "
-         "outside, the rest is solid (src/core/mesh_voxeliser.cpp). Median of 5 runs, one core.\n\n"
+         "outside, the rest is solid (src/core/mesh_voxeliser.cpp). Median of 5 runs, one core, "
+         "measured on a shared 2-core machine under load: runs differ by up to 4x (robot link voxelisation "
+         "1.3 to 6 ms).\n\n"
       << "## Fit error against the mesh, per level\n\n"
       << "- **coverage excess**: how far any point of the mesh's outer surface (its triangles sampled a quarter "
          "voxel apart, without the inner triangles of a union) lies outside the level's union of spheres; 0 "
