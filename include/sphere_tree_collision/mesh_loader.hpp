@@ -19,8 +19,8 @@ std::string meshResourcePath(const std::string& resource);
 // (and a DAE's unit) applied, then scaled per axis. A DAE's up axis is
 // ignored: vertices stay as written, as for STL and OBJ.
 // Throws InputError("scale") unless every component is finite and > 0, and
-// InputError("mesh_resource") naming the file and assimp's reason when it
-// cannot be read or holds no triangle.
+// InputError("mesh_resource") naming the file and the reason when it is not
+// a regular file, assimp cannot read it, or it holds no triangle.
 TriangleMesh loadTriangleMesh(const std::string& resource, const Vec3& scale = Vec3::Ones());
 
 // "mesh:<resource>@<sx>,<sy>,<sz>/<voxel size or rN>": the World's shape key.

@@ -6,7 +6,9 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <filesystem>
 #include <sstream>
+#include <system_error>
 
 namespace stc {
 namespace {
@@ -38,6 +40,12 @@ TriangleMesh loadTriangleMesh(const std::string& resource, const Vec3& scale) {
                                   number(scale.y()) + ", " + number(scale.z()) + ")");
   }
   const std::string path = meshResourcePath(resource);
+  // Devices, pipes and directories are refused before assimp opens them (a
+  // read of /dev/stdin would block).
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    throw InputError("mesh_resource", resource + ": not a regular file");
+  }
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   // No welding or normal fixing: the voxeliser copes with duplicated vertices

@@ -231,6 +231,8 @@ TEST_F(MeshFiles, BadResourcesAreRejectedNamingTheField) {
   EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
   EXPECT_EQ(errorOf([&] { loadTriangleMesh("package://stc/meshes/x.stl"); }).field(), "mesh_resource");
   EXPECT_EQ(errorOf([&] { loadTriangleMesh(""); }).field(), "mesh_resource");
+  EXPECT_EQ(errorOf([&] { loadTriangleMesh(dir_.path()); }).field(), "mesh_resource");     // a directory
+  EXPECT_EQ(errorOf([&] { loadTriangleMesh("/dev/null"); }).field(), "mesh_resource");     // a device
   EXPECT_EQ(errorOf([&] { loadTriangleMesh(missing, Vec3(1, 0, 1)); }).field(), "scale");
 }
 
