@@ -14,7 +14,9 @@
 // largest disagreement is printed.
 //
 // Usage: bench_tightness [--markdown FILE]   (writes docs/tightness.md when asked)
+#include "doc_output.hpp"
 #include "fcl_mesh.hpp"
+#include "sphere_union.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 
 #include <fcl/geometry/shape/sphere.h>
@@ -24,7 +26,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -85,60 +86,36 @@ LevelStats measureLevel(const VoxelShape& shape, const Vec3& origin, const Spher
                         const std::vector<std::uint8_t>& surface, const stc::truth::FclMesh& mesh,
                         FclCheck& fcl_check) {
   const double a = shape.voxelSize();
-  struct Ball {
-    Vec3 c;  // grid frame, voxel units
-    double r, h;
-  };
-  std::vector<Ball> balls;
+  std::vector<stc::truth::Ball> balls;  // grid frame, voxel units
+  std::vector<double> gap_bounds;
   for (std::int32_t i = tree.levelBegin(level); i < tree.levelBegin(level + 1); ++i) {
     const stc::SphereNode& n = tree.node(i);
-    balls.push_back({(n.centre + origin) / a, n.radius / a, n.h / a});
+    balls.push_back({(n.centre + origin) / a, n.radius / a});
+    gap_bounds.push_back(n.h / a);
   }
-  // Spheres that can hide part of sphere i: those that intersect it.
-  std::vector<std::vector<int>> neighbours(balls.size());
-  for (std::size_t i = 0; i < balls.size(); ++i)
-    for (std::size_t j = 0; j < balls.size(); ++j)
-      if (i != j && (balls[i].c - balls[j].c).norm() < balls[i].r + balls[j].r) neighbours[i].push_back(int(j));
 
   const auto fclSphere = std::make_shared<fcl::Sphered>(1e-9);
   double worst = 0.0, sum = 0.0, shape_volume = static_cast<double>(shape.occupiedCount());
   std::int64_t count = 0;
   double sphere_volume = 0.0;
-  const double golden = M_PI * (3.0 - std::sqrt(5.0));
-  for (std::size_t i = 0; i < balls.size(); ++i) {
-    const Ball& b = balls[i];
-    sphere_volume += 4.0 / 3.0 * M_PI * b.r * b.r * b.r;
-    // Fibonacci points: area-uniform, about kSampleSpacing apart.
-    const int n = std::max(16, static_cast<int>(4.0 * M_PI * b.r * b.r / (kSampleSpacing * kSampleSpacing)));
-    for (int s = 0; s < n; ++s) {
-      const double z = 1.0 - 2.0 * (s + 0.5) / n, rho = std::sqrt(1.0 - z * z);
-      const Vec3 p = b.c + b.r * Vec3(rho * std::cos(golden * s), rho * std::sin(golden * s), z);
-      bool hidden = false;
-      for (int j : neighbours[i]) {
-        const Ball& o = balls[static_cast<std::size_t>(j)];
-        if ((p - o.c).squaredNorm() < o.r * o.r) {
-          hidden = true;
-          break;
-        }
-      }
-      if (hidden) continue;
-      const Vec3 f = p.array().floor();
-      if (shape.occupied(int(f.x()), int(f.y()), int(f.z()))) continue;  // inside the shape
-      // h bounds the distance from this sphere to the part it covers, so also to the shape.
-      const double d = distanceToShape(shape, surface, p, b.h + 1e-9);
-      worst = std::max(worst, d);
-      sum += d;
-      if (++count % kFclEvery == 0) {
-        fcl::DistanceRequestd request;
-        fcl::DistanceResultd result;
-        fcl::Transform3d at = fcl::Transform3d::Identity();
-        at.translation() = p * a - origin;
-        fcl::distance(&mesh, fcl::Transform3d::Identity(), fclSphere.get(), at, request, result);
-        fcl_check.max_disagreement = std::max(fcl_check.max_disagreement, std::abs(result.min_distance - d * a));
-        ++fcl_check.points;
-      }
+  for (const stc::truth::Ball& b : balls) sphere_volume += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;
+  stc::truth::forEachUnionBoundaryPoint(balls, kSampleSpacing, [&](std::size_t i, const Vec3& p) {
+    const Vec3 f = p.array().floor();
+    if (shape.occupied(int(f.x()), int(f.y()), int(f.z()))) return;  // inside the shape
+    // h bounds the distance from this sphere to the part it covers, so also to the shape.
+    const double d = distanceToShape(shape, surface, p, gap_bounds[i] + 1e-9);
+    worst = std::max(worst, d);
+    sum += d;
+    if (++count % kFclEvery == 0) {
+      fcl::DistanceRequestd request;
+      fcl::DistanceResultd result;
+      fcl::Transform3d at = fcl::Transform3d::Identity();
+      at.translation() = p * a - origin;
+      fcl::distance(&mesh, fcl::Transform3d::Identity(), fclSphere.get(), at, request, result);
+      fcl_check.max_disagreement = std::max(fcl_check.max_disagreement, std::abs(result.min_distance - d * a));
+      ++fcl_check.points;
     }
-  }
+  });
   const double extent = std::max({shape.nx(), shape.ny(), shape.nz()});
   LevelStats st;
   st.nodes = static_cast<int>(balls.size());
@@ -154,11 +131,7 @@ std::string pct(double fraction) {
   return buf;
 }
 
-std::string num(double v, const char* fmt = "%.2f") {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
+using stc::bench::num;
 
 }  // namespace
 
@@ -225,14 +198,5 @@ int main(int argc, char** argv) {
          "distance: "
       << num(fcl_check.max_disagreement * 1e3, "%.2g") << " mm (voxel size " << 0.05 * 1e3 << " mm).\n";
 
-  std::fputs(doc.str().c_str(), stdout);
-  if (!markdown_path.empty()) {
-    std::ofstream out(markdown_path);
-    if (!out) {
-      std::fprintf(stderr, "cannot write %s\n", markdown_path.c_str());
-      return 1;
-    }
-    out << doc.str();
-  }
-  return 0;
+  return stc::bench::printAndWrite(doc.str(), markdown_path);
 }

@@ -6,9 +6,13 @@
 add_library(stc_fuzz_ros STATIC
   ${PROJECT_SOURCE_DIR}/src/ros/entity_request.cpp
   ${PROJECT_SOURCE_DIR}/src/ros/scene_file.cpp
-  ${PROJECT_SOURCE_DIR}/src/ros/conversions.cpp)
+  ${PROJECT_SOURCE_DIR}/src/ros/conversions.cpp
+  ${PROJECT_SOURCE_DIR}/src/ros/mesh_resource.cpp)
 target_include_directories(stc_fuzz_ros PUBLIC ${PROJECT_SOURCE_DIR}/include ${PROJECT_SOURCE_DIR}/src/ros/include)
 target_link_libraries(stc_fuzz_ros stc_core yaml-cpp ${catkin_LIBRARIES})
+# Mesh entities: assimp loading and package:// resolution.
+target_link_libraries(stc_fuzz_ros stc_mesh ${roslib_LIBRARIES})
+target_include_directories(stc_fuzz_ros SYSTEM PRIVATE ${roslib_INCLUDE_DIRS})
 add_dependencies(stc_fuzz_ros ${PROJECT_NAME}_generate_messages_cpp)
 
 file(GLOB STC_FUZZ_TARGETS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/fuzz/fuzz_*.cpp)

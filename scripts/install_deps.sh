@@ -9,6 +9,7 @@ packages=(
   libstd-srvs-dev libros-rosgraph-msgs-dev
   python3-rospy python3-geometry-msgs python3-std-srvs  # scripts/example_client.py
   libeigen3-dev libyaml-cpp-dev libfcl-dev libgtest-dev googletest
+  libassimp-dev  # mesh loading (stc_mesh): STL, OBJ, DAE
   python3-matplotlib
   libbullet-dev  # benchmarks only: bench_bullet_compare (skipped when absent)
   clang libfuzzer-14-dev

@@ -32,7 +32,8 @@ struct SphereNode {
   // to the shape part it covers (the occupied voxels of its octree cell); a
   // rigorous upper bound, within 0.1 voxel + 3% of the radius of the true
   // value. If spheres a and b touch, overlap or nest, the true gap between the
-  // shapes is <= h_a + h_b.
+  // shapes is <= h_a + h_b. Plus the shape's surfaceMargin(), so that for a
+  // voxelised mesh the bound holds for the mesh, not only for its voxels.
   double h = 0.0;
   std::int32_t first_child = -1;  // index of the first child; children contiguous
   std::int32_t child_count = 0;

@@ -51,12 +51,19 @@ class VoxelShape {
   bool isSphere() const { return is_sphere_; }
   void markSphere() { is_sphere_ = true; }
 
+  // How far a point of the voxels may lie from the surface they approximate
+  // (0 for shapes defined by their voxels; a voxelised mesh sets its voxel
+  // diagonal). SphereTree::build adds it to every node's gap bound h.
+  double surfaceMargin() const { return surface_margin_; }
+  void setSurfaceMargin(double metres) { surface_margin_ = metres; }
+
  private:
   int nx_ = 0, ny_ = 0, nz_ = 0;
   double voxel_size_ = 0.0;
   std::vector<std::uint8_t> occupancy_;
   std::int64_t occupied_count_ = 0;
   bool is_sphere_ = false;
+  double surface_margin_ = 0.0;
 };
 
 // Mass properties of the shape treated as the union of its solid voxels.

@@ -184,7 +184,7 @@ SphereTree SphereTree::build(const VoxelShape& shape, const Vec3& body_origin,
     SphereNode node;
     node.centre = f.centre_from_corner * a - body_origin;
     node.radius = f.radius * a;
-    node.h = f.h * a;
+    node.h = f.h * a + shape.surfaceMargin();  // the gap bound covers the original surface
     node.parent = parent;
     node.level = level;
     tree.nodes_.push_back(node);

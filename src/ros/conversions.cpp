@@ -65,7 +65,18 @@ EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg,
   EntityRequest r;
   r.spec.name = msg.name;
   const bool has_grid = msg.dims[0] != 0 || msg.dims[1] != 0 || msg.dims[2] != 0 || !msg.occupancy.empty();
-  if (!msg.preset.empty()) {
+  if (!msg.mesh_resource.empty()) {
+    if (!msg.preset.empty() || has_grid) {
+      throw stc::InputError("mesh_resource", "give one of a mesh, a preset or dims + occupancy");
+    }
+    r.mesh_resource = msg.mesh_resource;
+    const stc::Vec3 scale = toEigen(msg.scale);
+    r.mesh_scale = scale.isZero(0.0) ? stc::Vec3::Ones() : scale;
+    r.mesh_voxel_size = msg.voxel_size;
+    const std::uint32_t resolution = msg.resolution == 0 ? default_resolution : msg.resolution;
+    if (resolution > 1024) throw stc::InputError("resolution", "must be <= 1024 for a mesh");
+    r.preset_params.resolution = static_cast<int>(resolution);
+  } else if (!msg.preset.empty()) {
     if (has_grid) throw stc::InputError("preset", "give either a preset or dims + occupancy, not both");
     r.preset = msg.preset;
     const std::uint32_t resolution = msg.resolution == 0 ? default_resolution : msg.resolution;
@@ -105,7 +116,8 @@ std::string spawnFieldOf(const std::string& core_field, bool is_preset) {
   static const std::map<std::string, std::string> kFields{
       {"linear_velocity", "twist.linear"}, {"angular_velocity", "twist.angular"},
       {"material.restitution", "restitution"}, {"material.friction", "friction"},
-      {"max_voxels", "dims"}};
+      {"max_voxels", "dims"}, {"mesh", "mesh_resource"}, {"vertices", "mesh_resource"},
+      {"triangles", "mesh_resource"}};
   if (is_preset && (core_field == "dims" || core_field == "max_voxels")) return "resolution";
   const auto it = kFields.find(core_field);
   return it == kFields.end() ? core_field : it->second;

@@ -1,5 +1,8 @@
 #include "sphere_tree_collision/ros/entity_request.hpp"
 
+#include "sphere_tree_collision/mesh_loader.hpp"
+#include "sphere_tree_collision/ros/mesh_resource.hpp"
+
 #include <cmath>
 #include <cstdio>
 
@@ -76,7 +79,17 @@ stc::EntityId addRequest(stc::World& world, EntityRequest request) {
                                               std::to_string(world.entityCount()) + " entities");
   }
 
-  if (!request.preset.empty()) {
+  if (!request.mesh_resource.empty()) {
+    if (!request.preset.empty() || request.grid) {
+      throw stc::InputError("mesh_resource", "give one of a mesh, a preset or an explicit grid");
+    }
+    stc::VoxeliseOptions options;
+    options.voxel_size = request.mesh_voxel_size;
+    options.resolution = request.preset_params.resolution;
+    options.limits = world.config().voxel_limits;
+    request.spec.shape =
+        stc::addMeshShape(world, resolveMeshResource(request.mesh_resource), request.mesh_scale, options);
+  } else if (!request.preset.empty()) {
     if (request.grid) throw stc::InputError("preset", "give either a preset or an explicit grid, not both");
     const std::string key = presetShapeKey(request.preset, request.preset_params);
     const auto found = world.findShape(key);

@@ -117,10 +117,18 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   checkKeys(node, p,
             {"name", "preset", "resolution", "voxel_size", "seed", "position", "orientation", "velocity",
              "angular_velocity", "density", "restitution", "friction", "color", "static", "box_mode",
-             "repeat"});
+             "repeat", "mesh_resource", "scale"});
   EntityRequest r;
-  if (!node["preset"]) throw InputError(p + "preset", "missing");
-  r.preset = readString(node["preset"], p + "preset");
+  if (node["mesh_resource"]) {
+    r.mesh_resource = readString(node["mesh_resource"], p + "mesh_resource");
+    if (node["preset"]) throw InputError(p + "mesh_resource", "give a mesh or a preset, not both");
+    if (node["scale"]) r.mesh_scale = readVec3(node["scale"], p + "scale");
+    if (node["voxel_size"]) r.mesh_voxel_size = readDouble(node["voxel_size"], p + "voxel_size");
+  } else {
+    if (!node["preset"]) throw InputError(p + "preset", "missing (or give a mesh_resource)");
+    if (node["scale"]) throw InputError(p + "scale", "only for a mesh_resource");
+    r.preset = readString(node["preset"], p + "preset");
+  }
   if (node["name"]) r.spec.name = readString(node["name"], p + "name");
   if (node["resolution"]) r.preset_params.resolution = static_cast<int>(readInt(node["resolution"], p + "resolution", 1, 4096));
   if (node["voxel_size"]) r.preset_params.voxel_size = readDouble(node["voxel_size"], p + "voxel_size");

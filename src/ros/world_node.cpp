@@ -407,6 +407,7 @@ void WorldNode::rejectUnexpected(Input input) {
 }
 
 stc::EntityId WorldNode::spawnEntity(const sphere_tree_collision::SpawnEntity& msg) {
+  const bool is_preset = !msg.preset.empty() || !msg.mesh_resource.empty();  // sized by resolution, not dims
   try {
     EntityRequest request = toEntityRequest(msg, params_.default_resolution);
     const std::string name = request.spec.name;
@@ -416,7 +417,7 @@ stc::EntityId WorldNode::spawnEntity(const sphere_tree_collision::SpawnEntity& m
     ROS_DEBUG("spawned entity %u (%s)", id, frames_[id].c_str());
     return id;
   } catch (const stc::InputError& e) {
-    throw stc::InputError(spawnFieldOf(e.field(), !msg.preset.empty()), reasonOf(e));
+    throw stc::InputError(spawnFieldOf(e.field(), is_preset), reasonOf(e));
   }
 }
 

@@ -21,11 +21,16 @@ struct ExplicitGrid {
 };
 
 struct EntityRequest {
-  std::string preset;                  // empty: `grid` gives the shape
+  std::string preset;                  // empty: `grid` or `mesh_resource` gives the shape
   stc::PresetParams preset_params;
   std::optional<ExplicitGrid> grid;
   stc::EntitySpec spec;                // spec.shape is filled in by addRequest
   std::optional<Rgba> color;           // unset: a palette colour by id
+  // A mesh (package://, file:// or a path), scaled per axis, voxelised at
+  // mesh_voxel_size, or when 0 at preset_params.resolution voxels along its longest side.
+  std::string mesh_resource;
+  stc::Vec3 mesh_scale = stc::Vec3::Ones();
+  double mesh_voxel_size = 0.0;
 };
 
 // Shape cache key of a preset: equal keys share one shape and one tree.

@@ -1,6 +1,6 @@
 // Scene files (YAML): gravity and a list of entities, each a preset shape with
 // its pose, velocities and material. The node's default scene is one of these,
-// embedded. Schema (every key optional except preset; unknown keys rejected):
+// embedded. Schema (every key optional except preset or mesh_resource; unknown keys rejected):
 //
 //   gravity: [0, 0, -9.81]
 //   entities:
@@ -20,6 +20,9 @@
 //       static: false
 //       box_mode: auto           # auto | fixed | dynamic
 //       repeat: {count: [3, 1, 1], spacing: [0.5, 0, 0]}   # copies on a grid, names get _i
+//     - mesh_resource: package://pkg/meshes/link.stl   # instead of preset: STL, OBJ, DAE
+//       scale: [1, 1, 1]         # mesh only, per axis
+//       resolution: 32           # voxels along the mesh's longest side, unless voxel_size is given
 #pragma once
 
 #include "sphere_tree_collision/ros/entity_request.hpp"

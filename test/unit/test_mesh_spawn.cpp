@@ -1,0 +1,120 @@
+// Meshes spawned through the ROS glue (issue 14 item 1): a scene file entry
+// and a SpawnEntity message naming a mesh_resource and a scale add an entity
+// whose shape is the voxelised mesh, cached by resource, scale and resolution;
+// bad resources are rejected naming the field.
+#include "mesh_files.hpp"
+#include "mesh_generators.hpp"
+#include "temp_dir.hpp"
+
+#include "sphere_tree_collision/ros/conversions.hpp"
+#include "sphere_tree_collision/ros/entity_request.hpp"
+#include "sphere_tree_collision/ros/mesh_resource.hpp"
+#include "sphere_tree_collision/ros/scene_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace stc_ros {
+namespace {
+
+class MeshSpawn : public ::testing::Test {
+ protected:
+  void SetUp() override { stc::truth::writeStlBinary(stc::truth::cubeMesh(0.4), path_); }
+  stc::truth::TempDir dir_;
+  std::string path_ = dir_.file("cube.stl");
+};
+
+TEST_F(MeshSpawn, SceneFileEntriesShareTheMeshShape) {
+  const Scene scene = parseSceneYaml("entities:\n"
+                                     "  - {name: a, mesh_resource: 'file://" + path_ +
+                                     "', scale: [1, 1, 0.5], resolution: 8, position: [0, 0, 1]}\n"
+                                     "  - {name: b, mesh_resource: 'file://" + path_ +
+                                     "', scale: [1, 1, 0.5], resolution: 8, position: [2, 0, 1]}\n");
+  stc::World world;
+  const std::vector<stc::EntityId> ids = addScene(world, scene);
+  ASSERT_EQ(ids.size(), 2u);
+  const stc::ShapeId shape = world.bodyShapes()[0];
+  EXPECT_EQ(world.bodyShapes()[1], shape);  // one shape, one tree
+  const stc::VoxelShape& v = world.shape(shape).voxels;
+  EXPECT_EQ(v.nx(), 8);
+  EXPECT_EQ(v.nz(), 4);  // scaled to 0.2 m: 4 voxels of 0.05 m
+  EXPECT_EQ(v.occupiedCount(), 8 * 8 * 4);
+  EXPECT_EQ(world.shape(shape).key.rfind("mesh:", 0), 0u) << world.shape(shape).key;
+}
+
+TEST_F(MeshSpawn, SceneFileRejectsAMeshWithAPresetOrAScaleWithoutAMesh) {
+  try {
+    parseSceneYaml("entities:\n  - {preset: cube, mesh_resource: '" + path_ + "'}\n");
+    FAIL() << "accepted";
+  } catch (const stc::InputError& e) {
+    EXPECT_EQ(e.field(), "entities[0].mesh_resource");
+  }
+  try {
+    parseSceneYaml("entities:\n  - {preset: cube, scale: [1, 1, 1]}\n");
+    FAIL() << "accepted";
+  } catch (const stc::InputError& e) {
+    EXPECT_EQ(e.field(), "entities[0].scale");
+  }
+}
+
+TEST_F(MeshSpawn, SpawnMessageWithAMeshAddsItScaled) {
+  sphere_tree_collision::SpawnEntity msg;
+  msg.mesh_resource = path_;
+  msg.scale.x = 0.5;
+  msg.scale.y = 0.5;
+  msg.scale.z = 0.5;
+  msg.voxel_size = 0.05;
+  msg.density = 1000.0;
+  msg.pose.orientation.w = 1.0;
+  stc::World world;
+  const stc::EntityId id = addRequest(world, toEntityRequest(msg, 8));
+  ASSERT_NE(id, stc::kInvalidEntity);
+  const stc::VoxelShape& v = world.shape(world.bodyShapes()[0]).voxels;
+  EXPECT_EQ(v.occupiedCount(), 4 * 4 * 4);  // 0.2 m cube at 0.05 m
+
+  msg.preset = "cube";
+  try {
+    toEntityRequest(msg, 8);
+    FAIL() << "accepted a mesh and a preset";
+  } catch (const stc::InputError& e) {
+    EXPECT_EQ(e.field(), "mesh_resource");
+  }
+}
+
+TEST_F(MeshSpawn, PackageResourcesOfUnknownPackagesAreRejected) {
+  EXPECT_EQ(resolveMeshResource(path_), path_);
+  EXPECT_EQ(resolveMeshResource("file://" + path_), "file://" + path_);
+  for (const std::string bad : {"package://no_such_package_xyz/meshes/a.stl", "package://only_a_name"}) {
+    try {
+      resolveMeshResource(bad);
+      FAIL() << bad;
+    } catch (const stc::InputError& e) {
+      EXPECT_EQ(e.field(), "mesh_resource");
+      EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST_F(MeshSpawn, AnOpenMeshIsRejectedAndNothingIsAdded) {
+  stc::TriangleMesh sheet;
+  sheet.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0.1}};
+  sheet.triangles = {{0, 1, 2}};
+  const std::string sheet_path = dir_.file("sheet.obj");
+  stc::truth::writeObj(sheet, sheet_path);
+  EntityRequest r;
+  r.mesh_resource = sheet_path;
+  r.spec.density = 1000.0;
+  stc::World world;
+  try {
+    addRequest(world, r);
+    FAIL() << "accepted an open sheet";
+  } catch (const stc::InputError& e) {
+    EXPECT_EQ(e.field(), "mesh");
+    EXPECT_NE(std::string(e.what()).find(sheet_path), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(world.entityCount(), 0u);
+}
+
+}  // namespace
+}  // namespace stc_ros

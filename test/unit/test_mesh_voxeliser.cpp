@@ -1,0 +1,265 @@
+// Meshes in (issue 14 item 1): closed meshes voxelise to the expected solid,
+// holes narrower than a voxel and duplicated vertices are tolerated, meshes
+// that enclose nothing and absurd inputs are rejected naming the field, and
+// STL / OBJ / DAE files written here load through assimp to the same shape.
+#include "mesh_files.hpp"
+#include "mesh_generators.hpp"
+#include "temp_dir.hpp"
+
+#include "sphere_tree_collision/mesh_loader.hpp"
+#include "sphere_tree_collision/mesh_voxeliser.hpp"
+#include "sphere_tree_collision/sphere_tree.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <limits>
+#include <string>
+
+namespace stc {
+namespace {
+
+using truth::cubeMesh;
+using truth::icosphere;
+
+VoxeliseOptions atResolution(int resolution) {
+  VoxeliseOptions o;
+  o.resolution = resolution;
+  return o;
+}
+
+// The InputError thrown by `f`, or fails the test.
+InputError errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no InputError thrown";
+  return InputError("none", "not thrown");
+}
+
+// Voxel (i,j,k) of the shape, its centre in mesh coordinates.
+Vec3 voxelCentre(const VoxelisedMesh& v, int i, int j, int k) {
+  return v.grid_origin + v.shape.voxelSize() * (Vec3(i, j, k) + Vec3::Constant(0.5));
+}
+
+TEST(MeshVoxeliser, AlignedCubeGivesExactlyItsVoxels) {
+  // Faces on grid planes: the voxels beside a face are not part of the cube.
+  const VoxelisedMesh v = voxeliseMesh(cubeMesh(1.0), atResolution(8));
+  EXPECT_EQ(v.shape.nx(), 8);
+  EXPECT_EQ(v.shape.ny(), 8);
+  EXPECT_EQ(v.shape.nz(), 8);
+  EXPECT_EQ(v.shape.occupiedCount(), 512);
+  EXPECT_DOUBLE_EQ(v.shape.voxelSize(), 0.125);
+  EXPECT_NEAR((v.grid_origin - Vec3::Zero()).norm(), 0.0, 1e-12);
+  EXPECT_EQ(v.interior_voxels, 512);  // no triangle crosses a voxel's interior
+  EXPECT_DOUBLE_EQ(v.shape.surfaceMargin(), std::sqrt(3.0) * 0.125);
+  EXPECT_EQ(v.stats.triangle_count, 12u);
+  EXPECT_EQ(v.stats.boundary_edges, 0u);
+}
+
+TEST(MeshVoxeliser, UnalignedCubeCoversItsFacesConservatively) {
+  // 0.95 m at 0.1 m voxels: 10 voxels per axis, each face inside the outer layer.
+  VoxeliseOptions o;
+  o.voxel_size = 0.1;
+  const VoxelisedMesh v = voxeliseMesh(cubeMesh(0.95), o);
+  EXPECT_EQ(v.shape.occupiedCount(), 1000);
+  EXPECT_EQ(v.interior_voxels, 8 * 8 * 8);
+  EXPECT_EQ(v.surface_voxels, 1000 - 512);
+  EXPECT_NEAR(v.grid_origin.x(), -0.025, 1e-12);  // centred slack
+}
+
+TEST(MeshVoxeliser, SphereVolumeIsCloseToTheBall) {
+  const double r = 1.0;
+  const TriangleMesh sphere = icosphere(r, 4);  // 5120 triangles
+  const VoxelisedMesh v = voxeliseMesh(sphere, atResolution(96));
+  const double a = v.shape.voxelSize();
+  const double voxel_volume = static_cast<double>(v.shape.occupiedCount()) * a * a * a;
+  const double ball = 4.0 / 3.0 * M_PI * r * r * r;
+  // Conservative: never below the polyhedron's volume, and above the ball by
+  // no more than the shell of voxels the surface crosses.
+  EXPECT_GE(voxel_volume, truth::enclosedVolume(sphere));
+  EXPECT_NEAR(voxel_volume / ball, 1.0, 0.05);
+  // Each voxel centre is inside the ball grown by half a voxel diagonal, and
+  // each interior voxel entirely inside the polyhedron's inscribed ball.
+  const double inscribed = r * 0.995;  // subdivided icosahedron: faces within 0.5% of r
+  for (int k = 0; k < v.shape.nz(); ++k)
+    for (int j = 0; j < v.shape.ny(); ++j)
+      for (int i = 0; i < v.shape.nx(); ++i) {
+        if (!v.shape.occupied(i, j, k)) continue;
+        const double d = voxelCentre(v, i, j, k).norm();
+        ASSERT_LE(d, r + std::sqrt(3.0) / 2 * a);
+        if (!v.shape.isSurfaceVoxel(i, j, k)) continue;
+        ASSERT_GE(d, inscribed - 2.0 * a);  // exposed voxels are near the surface
+      }
+}
+
+TEST(MeshVoxeliser, ThinClosedPlateIsKeptAsItsSurfaceVoxels) {
+  const TriangleMesh plate = truth::boxMesh(Vec3(0, 0, 0), Vec3(1.0, 1.0, 0.01));
+  const VoxelisedMesh v = voxeliseMesh(plate, atResolution(10));
+  EXPECT_EQ(v.interior_voxels, 0);
+  EXPECT_EQ(v.shape.occupiedCount(), 10 * 10);
+}
+
+TEST(MeshVoxeliser, SmallHoleAndDuplicatedVerticesStillGiveTheSolid) {
+  const TriangleMesh closed = icosphere(1.0, 3);  // triangles ~0.13 across
+  TriangleMesh holed = truth::unwelded(closed);
+  holed.triangles.erase(holed.triangles.begin() + 100);
+  const VoxelisedMesh v = voxeliseMesh(holed, atResolution(10));  // 0.2 m voxels: wider than the hole
+  EXPECT_EQ(v.stats.duplicated_vertices, holed.vertices.size() - closed.vertices.size());
+  EXPECT_EQ(v.stats.boundary_edges, 3u);
+  EXPECT_GT(v.interior_voxels, 0);
+  EXPECT_EQ(v.shape.occupiedCount(), voxeliseMesh(closed, atResolution(10)).shape.occupiedCount());
+}
+
+TEST(MeshVoxeliser, HoleWiderThanAVoxelIsRejectedNamingTheSource) {
+  TriangleMesh open = icosphere(1.0, 3);
+  std::vector<std::array<std::int32_t, 3>> kept;
+  for (const auto& t : open.triangles) {
+    const double z = (open.vertices[t[0]] + open.vertices[t[1]] + open.vertices[t[2]]).z() / 3.0;
+    if (z < 0.8) kept.push_back(t);  // a cap of radius ~0.6 cut away
+  }
+  open.triangles = kept;
+  VoxeliseOptions o = atResolution(24);
+  o.source = "capless.stl";
+  const InputError e = errorOf([&] { voxeliseMesh(open, o); });
+  EXPECT_EQ(e.field(), "mesh");
+  EXPECT_NE(std::string(e.what()).find("capless.stl"), std::string::npos) << e.what();
+  EXPECT_NE(std::string(e.what()).find("cannot be closed"), std::string::npos) << e.what();
+}
+
+TEST(MeshVoxeliser, OpenSheetIsRejected) {
+  TriangleMesh sheet;
+  sheet.vertices = {{0, 0, 0}, {1, 0, 0.1}, {1, 1, 0.2}, {0, 1, 0.1}};
+  sheet.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const InputError e = errorOf([&] { voxeliseMesh(sheet, atResolution(8)); });
+  EXPECT_EQ(e.field(), "mesh");
+  EXPECT_NE(std::string(e.what()).find("open edges"), std::string::npos) << e.what();
+}
+
+TEST(MeshVoxeliser, AbsurdInputsAreRejectedNamingTheField) {
+  TriangleMesh nan = cubeMesh(1.0);
+  nan.vertices[3].y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(errorOf([&] { voxeliseMesh(nan); }).field(), "vertices");
+  EXPECT_EQ(errorOf([&] { voxeliseMesh(TriangleMesh{}); }).field(), "vertices");
+  TriangleMesh no_triangles = cubeMesh(1.0);
+  no_triangles.triangles.clear();
+  EXPECT_EQ(errorOf([&] { voxeliseMesh(no_triangles); }).field(), "triangles");
+  TriangleMesh bad_index = cubeMesh(1.0);
+  bad_index.triangles[0][1] = 8;
+  EXPECT_EQ(errorOf([&] { voxeliseMesh(bad_index); }).field(), "triangles");
+  EXPECT_EQ(errorOf([&] { voxeliseMesh(cubeMesh(1.0), atResolution(0)); }).field(), "resolution");
+  VoxeliseOptions tiny;
+  tiny.voxel_size = 1e-4;  // 10^12 voxels
+  EXPECT_EQ(errorOf([&] { voxeliseMesh(cubeMesh(1.0), tiny); }).field(), "max_voxels");
+  VoxeliseOptions negative;
+  negative.voxel_size = -0.1;
+  EXPECT_EQ(errorOf([&] { voxeliseMesh(cubeMesh(1.0), negative); }).field(), "voxel_size");
+  TriangleMesh point;
+  point.vertices = {{1, 1, 1}, {1, 1, 1}, {1, 1, 1}};
+  point.triangles = {{0, 1, 2}};
+  EXPECT_EQ(errorOf([&] { voxeliseMesh(point); }).field(), "voxel_size");  // zero extent
+}
+
+TEST(MeshVoxeliser, TriangleBoxOverlapSeparatesOnEveryAxisKind) {
+  const Vec3 c = Vec3::Zero(), h = Vec3::Constant(0.5);
+  // Box axis, triangle normal, edge cross product each the only separator.
+  EXPECT_FALSE(triangleOverlapsBox({0.6, 0, 0}, {2, 0, 0}, {0.6, 1, 0}, c, h));
+  EXPECT_FALSE(triangleOverlapsBox({2, 0, 0}, {0, 2, 0}, {0, 0, 2}, c, h));     // plane x+y+z=2 misses
+  EXPECT_TRUE(triangleOverlapsBox({1.4, 0, 0}, {0, 1.4, 0}, {0, 0, 1.4}, c, h));  // x+y+z=1.4 cuts the corner
+  // Neither the box axes nor the normal separate this one; an edge cross product does.
+  EXPECT_FALSE(triangleOverlapsBox({-0.8, -0.2, 0}, {-0.8, -0.8, -0.8}, {-0.1, -0.6, -1.4}, c, h));
+  EXPECT_TRUE(triangleOverlapsBox({-5, -5, 0}, {5, -5, 0}, {0, 5, 0}, c, h));  // larger than the box
+}
+
+TEST(MeshVoxeliser, TheTreeGapBoundIncludesTheSurfaceMargin) {
+  const VoxelisedMesh v = voxeliseMesh(icosphere(1.0, 3), atResolution(16));
+  VoxelShape bare = VoxelShape::create(v.shape.nx(), v.shape.ny(), v.shape.nz(), v.shape.voxelSize(),
+                                       v.shape.occupancy());
+  const SphereTree with = SphereTree::build(v.shape, Vec3::Zero());
+  const SphereTree without = SphereTree::build(bare, Vec3::Zero());
+  ASSERT_EQ(with.nodes().size(), without.nodes().size());
+  for (std::size_t i = 0; i < with.nodes().size(); ++i)
+    EXPECT_NEAR(with.nodes()[i].h - without.nodes()[i].h, v.shape.surfaceMargin(), 1e-12);
+}
+
+// --- files through assimp ------------------------------------------------------------
+
+class MeshFiles : public ::testing::Test {
+ protected:
+  std::string file(const std::string& name) { return dir_.file(name); }
+  truth::TempDir dir_;
+};
+
+TEST_F(MeshFiles, EveryFormatLoadsToTheSameSolid) {
+  const TriangleMesh scan = truth::bumpyScanMesh();
+  const std::int64_t expected = voxeliseMesh(scan, atResolution(20)).shape.occupiedCount();
+  const std::string stl_ascii = file("scan_ascii.stl"), stl_binary = file("scan_binary.stl"),
+                    obj = file("scan.obj"), dae = file("scan.dae");
+  truth::writeStlAscii(scan, stl_ascii);
+  truth::writeStlBinary(scan, stl_binary);
+  truth::writeObj(scan, obj);
+  truth::writeDae(scan, dae);
+  for (const std::string& path : {stl_ascii, stl_binary, obj, dae}) {
+    const TriangleMesh loaded = loadTriangleMesh(path);
+    EXPECT_EQ(loaded.triangles.size(), scan.triangles.size()) << path;
+    const VoxelisedMesh v = voxeliseMesh(loaded, atResolution(20));
+    // Binary STL stores floats: a voxel may flip where the surface grazes it.
+    EXPECT_NEAR(static_cast<double>(v.shape.occupiedCount()), static_cast<double>(expected), 0.002 * expected)
+        << path;
+    EXPECT_LT((v.stats.min - computeMeshStats(scan).min).norm(), 1e-6) << path;
+  }
+}
+
+TEST_F(MeshFiles, FileUriAndScaleAreApplied) {
+  const std::string path = file("cube.stl");
+  truth::writeStlAscii(cubeMesh(1.0), path);
+  const TriangleMesh m = loadTriangleMesh("file://" + path, Vec3(2.0, 1.0, 0.5));
+  const MeshStats s = computeMeshStats(m);
+  EXPECT_NEAR((s.max - s.min - Vec3(2.0, 1.0, 0.5)).norm(), 0.0, 1e-12);
+  EXPECT_EQ(s.duplicated_vertices, 36u - 8u);  // STL stores three vertices per triangle
+}
+
+TEST_F(MeshFiles, BadResourcesAreRejectedNamingTheField) {
+  const std::string missing = dir_.path() + "/missing.stl";
+  const InputError e = errorOf([&] { loadTriangleMesh(missing); });
+  EXPECT_EQ(e.field(), "mesh_resource");
+  EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
+  EXPECT_EQ(errorOf([&] { loadTriangleMesh("package://stc/meshes/x.stl"); }).field(), "mesh_resource");
+  EXPECT_EQ(errorOf([&] { loadTriangleMesh(""); }).field(), "mesh_resource");
+  EXPECT_EQ(errorOf([&] { loadTriangleMesh(dir_.path()); }).field(), "mesh_resource");     // a directory
+  EXPECT_EQ(errorOf([&] { loadTriangleMesh("/dev/null"); }).field(), "mesh_resource");     // a device
+  EXPECT_EQ(errorOf([&] { loadTriangleMesh(missing, Vec3(1, 0, 1)); }).field(), "scale");
+}
+
+TEST_F(MeshFiles, MeshShapesAreCachedByResourceScaleAndResolution) {
+  const std::string path = file("link.obj");
+  truth::writeObj(truth::robotLinkMesh(), path);
+  World world;
+  const ShapeId a = addMeshShape(world, path, Vec3::Ones(), atResolution(16));
+  std::remove(path.c_str());  // a cached shape is not read again
+  EXPECT_EQ(addMeshShape(world, path, Vec3::Ones(), atResolution(16)), a);
+  EXPECT_EQ(world.shape(a).key, meshShapeKey(path, Vec3::Ones(), atResolution(16)));
+  EXPECT_EQ(errorOf([&] { addMeshShape(world, path, Vec3::Ones(), atResolution(17)); }).field(), "mesh_resource");
+  EXPECT_GT(world.shape(a).tree.nodes().size(), 1u);
+  EXPECT_DOUBLE_EQ(world.shape(a).voxels.surfaceMargin(), std::sqrt(3.0) * world.shape(a).voxels.voxelSize());
+}
+
+TEST(MeshGenerators, TheTwoRealWorldMeshesVoxeliseSolid) {
+  const VoxelisedMesh link = voxeliseMesh(truth::robotLinkMesh(), atResolution(32));
+  EXPECT_GT(link.stats.duplicated_vertices, 0u);
+  EXPECT_GT(link.stats.boundary_edges, 0u);  // the missing cap triangle
+  EXPECT_GT(link.interior_voxels, link.surface_voxels / 4);
+  const VoxelisedMesh scan = voxeliseMesh(truth::bumpyScanMesh(), atResolution(32));
+  EXPECT_EQ(scan.stats.boundary_edges, 0u);
+  const double a = scan.shape.voxelSize();
+  const double volume = static_cast<double>(scan.shape.occupiedCount()) * a * a * a;
+  EXPECT_GE(volume, truth::enclosedVolume(truth::bumpyScanMesh()));
+}
+
+}  // namespace
+}  // namespace stc
