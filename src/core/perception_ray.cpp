@@ -15,7 +15,8 @@ std::optional<RayHit> castRay(const World& world, const Ray& ray) {
     if (!(miss2 <= r * r)) continue;
     const double half_chord = std::sqrt(r * r - miss2);
     const double t = t_mid - half_chord >= 0.0 ? t_mid - half_chord : t_mid + half_chord;
-    if (t < 0.0 || (nearest && t >= nearest->distance)) continue;
+    // A body whose state or ball is not finite is never what the viewer looks at.
+    if (!(t >= 0.0) || !std::isfinite(t) || (nearest && t >= nearest->distance)) continue;
     nearest = RayHit{t, i};
   }
   return nearest;
