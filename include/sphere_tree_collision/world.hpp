@@ -102,7 +102,7 @@ struct TickReport {
   // are then dropped, as with any removal) and the time spent splitting them
   // and building the pieces' trees, deferred splits included.
   std::size_t fractures = 0;
-  std::size_t fractures_deferred = 0;  // found after the deadline: broken at the next tick's start
+  std::size_t fractures_deferred = 0;  // waiting for time: broken from the next tick's start
   double fracture_s = 0.0;
 };
 
@@ -143,6 +143,7 @@ class World {
   ShapeId addShape(const std::string& key, VoxelShape shape);
   std::optional<ShapeId> findShape(const std::string& key) const;
   const ShapeInfo& shape(ShapeId id) const;
+  std::size_t shapeCount() const { return shapes_.size(); }
 
   // Throws InputError naming the field ("shape", "pose.position",
   // "pose.orientation", "linear_velocity", "angular_velocity", "density",
@@ -208,10 +209,12 @@ class World {
   void quarantine(TickReport& report);  // first and last: removes bodies beyond the limits
   // After the response: bodies hit harder than their strength break, until
   // the tick's deadline; the rest wait in pending_breaks_ for the next tick's
-  // start (world_fracture.cpp). Both take the clock at their start and
+  // start, where at least one breaks and more while the new tick's budget
+  // lasts (world_fracture.cpp). Both take the clock at their start and
   // return it at their end, reading it only when there is something to break.
   double fracture(double now, const Deadline& tick_end, TickReport& report);
-  double breakPending(double now, TickReport& report);
+  double breakPending(double now, const Deadline& tick_end, TickReport& report);
+  void breakQueued(const Deadline& tick_end, bool at_least_one, TickReport& report);
   // What the physics phases read and write this tick (physics.hpp); each
   // phase sets what is its own (dt, the solver's budget).
   StepContext physicsStep();

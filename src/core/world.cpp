@@ -245,7 +245,7 @@ TickReport World::step(double dt, const Budget& budget) {
   const bool timed_tick = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
   const Deadline tick_end = timed_tick ? Deadline(&clock_, t0 + std::max(budget.tick_seconds, 0.0)) : Deadline();
   if (timed_tick) report.tick_budget_s = std::max(budget.tick_seconds, 0.0);
-  const double t0i = breakPending(t0, report);  // splits the last tick had no time for
+  const double t0i = breakPending(t0, tick_end, report);  // splits the last tick had no time for
   integrate(dt, report);
   const double t1 = clock_();
   broadPhase(report);

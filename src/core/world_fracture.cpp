@@ -88,41 +88,46 @@ double World::fracture(double now, const Deadline& tick_end, TickReport& report)
     }
   }
   // Where each breaking body is hit, in its own frame (the dense indices and
-  // the contacts go stale with the first break). The queue is empty here:
-  // breakPending emptied it at the tick's start.
+  // the contacts go stale with the first break), queued after the breaks
+  // older ticks had no time for.
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     const BodyState& body = bodies_[i];
     if (body.is_static || !(body.material.strength > 0.0) || !(hits_[i].impulse > body.material.strength)) continue;
+    const EntityId id = ids_[i];
+    const bool queued = std::any_of(pending_breaks_.begin(), pending_breaks_.end(),
+                                    [id](const PendingBreak& p) { return p.id == id; });
+    if (queued) continue;
     const Contact& c = contacts_[hits_[i].hardest];
     const Quat to_body = body.pose.orientation.conjugate();
-    pending_breaks_.push_back({ids_[i], to_body * (c.point - body.pose.position), to_body * c.normal});
+    pending_breaks_.push_back({id, to_body * (c.point - body.pose.position), to_body * c.normal});
   }
-  // Break until the deadline; what is left waits for the next tick's start.
-  std::size_t done = 0;
-  while (done < pending_breaks_.size() && !tick_end.passed()) {
-    const PendingBreak& p = pending_breaks_[done++];
-    const Pose pose = bodies_[*indexOf(p.id)].pose;
-    if (!breakEntity(p.id, pose.apply(p.point), pose.orientation * p.normal).empty()) ++report.fractures;
-  }
-  pending_breaks_.erase(pending_breaks_.begin(), pending_breaks_.begin() + done);
-  report.fractures_deferred = pending_breaks_.size();
+  breakQueued(tick_end, false, report);
   const double end = clock_();
   report.fracture_s += end - now;
   return end;
 }
 
-double World::breakPending(double now, TickReport& report) {
+double World::breakPending(double now, const Deadline& tick_end, TickReport& report) {
   if (pending_breaks_.empty()) return now;
-  for (const PendingBreak& p : pending_breaks_) {
+  breakQueued(tick_end, true, report);
+  const double end = clock_();
+  report.fracture_s += end - now;
+  return end;
+}
+
+// Oldest first, until the deadline (at least one when asked: the queue
+// always moves); the rest wait for the next tick.
+void World::breakQueued(const Deadline& tick_end, bool at_least_one, TickReport& report) {
+  std::size_t done = 0;
+  while (done < pending_breaks_.size() && ((at_least_one && done == 0) || !tick_end.passed())) {
+    const PendingBreak& p = pending_breaks_[done++];
     const auto index = indexOf(p.id);
     if (!index) continue;  // removed meanwhile
     const Pose pose = bodies_[*index].pose;
     if (!breakEntity(p.id, pose.apply(p.point), pose.orientation * p.normal).empty()) ++report.fractures;
   }
-  pending_breaks_.clear();
-  const double end = clock_();
-  report.fracture_s += end - now;
-  return end;
+  pending_breaks_.erase(pending_breaks_.begin(), pending_breaks_.begin() + done);
+  report.fractures_deferred = pending_breaks_.size();
 }
 
 }  // namespace stc
