@@ -78,6 +78,7 @@ EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg,
   r.spec.density = msg.density;
   r.spec.material.restitution = msg.restitution;
   r.spec.material.friction = msg.friction;
+  r.spec.material.strength = msg.strength;
   r.spec.is_static = msg.is_static;
   const auto& c = msg.color;
   if (c.r != 0.0f || c.g != 0.0f || c.b != 0.0f || c.a != 0.0f) r.color = Rgba{c.r, c.g, c.b, c.a};
@@ -88,6 +89,7 @@ std::string spawnFieldOf(const std::string& core_field, bool is_preset) {
   static const std::map<std::string, std::string> kFields{
       {"linear_velocity", "twist.linear"}, {"angular_velocity", "twist.angular"},
       {"material.restitution", "restitution"}, {"material.friction", "friction"},
+      {"material.strength", "strength"},
       {"max_voxels", "dims"}};
   if (is_preset && (core_field == "dims" || core_field == "max_voxels")) return "resolution";
   const auto it = kFields.find(core_field);
