@@ -8,6 +8,9 @@ namespace stc {
 struct Material {
   double restitution = 0.3;  // [0, 1]
   double friction = 0.5;     // Coulomb coefficient, >= 0
+  // Contact impulse (N s, summed over a tick's contacts) the body takes
+  // before it breaks (fracture.hpp); 0: unbreakable. Finite, >= 0.
+  double strength = 0.0;
 };
 
 // Pose is of the body frame, whose origin is the centre of mass.

@@ -6,6 +6,7 @@
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/fracture.hpp"
 #include "sphere_tree_collision/limits.hpp"
 #include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
@@ -46,6 +47,7 @@ struct WorldConfig {
   std::size_t max_entities = 20000;
   ResponseOptions response;
   PhysicalLimits limits;  // inputs beyond them are rejected; bodies beyond them quarantined
+  FractureOptions fracture;  // for bodies with a material strength (fracture.hpp)
 };
 
 struct EntitySpec {
@@ -96,6 +98,12 @@ struct TickReport {
   // non-finite or beyond the limits, and, apart, bodies that left the world.
   std::size_t quarantined = 0;
   std::size_t left_world = 0;
+  // Bodies broken this tick (their pieces replace them; the tick's contacts
+  // are then dropped, as with any removal) and the time spent splitting them
+  // and building the pieces' trees, deferred splits included.
+  std::size_t fractures = 0;
+  std::size_t fractures_deferred = 0;  // waiting for time: broken from the next tick's start
+  double fracture_s = 0.0;
 };
 
 // One entity removed at the end of a tick, and why.
@@ -104,6 +112,14 @@ struct QuarantinedEntity {
   std::string name;
   ShapeId shape = 0;
   Quarantine reason = Quarantine::None;
+};
+
+// One body broken (by the last step, or breakEntity since): its pieces replace it.
+struct BrokenEntity {
+  EntityId id = kInvalidEntity;
+  std::string name;
+  ShapeId shape = 0;
+  std::vector<EntityId> pieces;
 };
 
 struct ShapeInfo {
@@ -127,6 +143,7 @@ class World {
   ShapeId addShape(const std::string& key, VoxelShape shape);
   std::optional<ShapeId> findShape(const std::string& key) const;
   const ShapeInfo& shape(ShapeId id) const;
+  std::size_t shapeCount() const { return shapes_.size(); }
 
   // Throws InputError naming the field ("shape", "pose.position",
   // "pose.orientation", "linear_velocity", "angular_velocity", "density",
@@ -137,6 +154,13 @@ class World {
   std::optional<EntityId> findByName(const std::string& name) const;
   void clear();  // removes every entity, keeps shapes
 
+  // Breaks a body as an impact at `point` along `normal` (world frame) would
+  // (fracture.hpp): its pieces replace it, each with the parent's velocity at
+  // its centre of mass and the parent's spin, so momentum is kept. Returns
+  // the pieces' ids, or nothing when the body stays whole (static, unknown,
+  // nothing to split, or a piece the limits would reject).
+  std::vector<EntityId> breakEntity(EntityId id, const Vec3& point, const Vec3& normal);
+
   // Throws InputError("dt") only. A body whose state leaves the limits during
   // the tick is removed at its end (see quarantined()); the rest goes on. A
   // state edited through bodies() is checked the same way before the tick.
@@ -146,6 +170,8 @@ class World {
   void setClock(SecondsClock clock) { clock_ = std::move(clock); }
   // The entities the last step removed, with the reason.
   const std::vector<QuarantinedEntity>& quarantined() const { return quarantined_; }
+  // The bodies the last step (and breakEntity since) broke, with their pieces.
+  const std::vector<BrokenEntity>& broken() const { return broken_; }
 
   Perception& perception() { return perception_; }
   const Perception& perception() const { return perception_; }
@@ -183,6 +209,14 @@ class World {
   double narrowPhase(const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
   void response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report);
   void quarantine(TickReport& report);  // first and last: removes bodies beyond the limits
+  // After the response: bodies hit harder than their strength break, until
+  // the tick's deadline; the rest wait in pending_breaks_ for the next tick's
+  // start, where at least one breaks and more while the new tick's budget
+  // lasts (world_fracture.cpp). Both take the clock at their start and
+  // return it at their end, reading it only when there is something to break.
+  double fracture(double now, const Deadline& tick_end, TickReport& report);
+  double breakPending(double now, const Deadline& tick_end, TickReport& report);
+  void breakQueued(const Deadline& tick_end, bool at_least_one, TickReport& report);
   // What the physics phases read and write this tick (physics.hpp); each
   // phase sets what is its own (dt, the solver's budget).
   StepContext physicsStep();
@@ -220,6 +254,22 @@ class World {
   SecondsClock clock_ = steadySeconds;
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step
+  // A break found after the tick's deadline: where, in the body's frame.
+  struct PendingBreak {
+    EntityId id = kInvalidEntity;
+    Vec3 point = Vec3::Zero();
+    Vec3 normal = Vec3::UnitZ();
+  };
+  std::vector<PendingBreak> pending_breaks_;
+  std::vector<BrokenEntity> broken_;  // since the last step began
+  // Contact impulses on each body this tick (by dense index; ticks with a
+  // breakable body in contact only), pooled.
+  struct BodyHits {
+    double impulse = 0.0;          // summed, N s
+    double hardest_impulse = 0.0;  // of the contact with the largest impulse
+    std::int32_t hardest = -1;     // that contact
+  };
+  std::vector<BodyHits> hits_;
 };
 
 }  // namespace stc

@@ -81,6 +81,10 @@ void validateBodyInput(const Pose& pose, const Vec3& linear_velocity, const Vec3
     throw InputError("material.friction", number(material.friction) + " is outside [0, max_friction = " +
                                               number(limits.max_friction) + "]");
   }
+  if (!(std::isfinite(material.strength) && material.strength >= 0.0)) {
+    throw InputError("material.strength", "must be finite and >= 0 N s (0: unbreakable), got " +
+                                              number(material.strength));
+  }
 }
 
 const char* toString(Quarantine reason) {

@@ -66,6 +66,7 @@ World::World(const WorldConfig& config)
     : config_(config), scheduler_(makeScheduler(config.scheduler)) {
   validateLimits(config_.limits);
   validateGravity(config_.gravity, config_.limits);
+  validateFractureOptions(config_.fracture);
 }
 World::~World() = default;
 World::World(World&&) noexcept = default;
@@ -243,11 +244,13 @@ TickReport World::step(double dt, const Budget& budget) {
   TickReport report;
   report.entities = ids_.size();
   quarantined_.clear();
+  broken_.clear();
   quarantine(report);  // states edited through bodies() since the last step
   const double t0 = clock_();
   const bool timed_tick = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
   const Deadline tick_end = timed_tick ? Deadline(&clock_, t0 + std::max(budget.tick_seconds, 0.0)) : Deadline();
   if (timed_tick) report.tick_budget_s = std::max(budget.tick_seconds, 0.0);
+  const double t0i = breakPending(t0, tick_end, report);  // splits the last tick had no time for
   integrate(dt, report);
   const double t1 = clock_();
   broadPhase(report);
@@ -259,13 +262,15 @@ TickReport World::step(double dt, const Budget& budget) {
   if (timed_tick) report.response_budget_s = std::max(tick_end.at() - t3, 0.0);
   response(dt, budget, tick_end, report);
   const double t4 = clock_();
-  report.integrate_s = t1 - t0;
+  const double t5 = fracture(t4, tick_end, report);
+  report.integrate_s = t1 - t0i;
   report.broad_s = t2 - t1;
   report.sweep_s = t2s - t2;
   report.narrow_s = t3 - t2s;
   report.response_s = t4 - t3;
-  report.total_s = t4 - t0;
+  report.total_s = t5 - t0;
   report.contacts = contacts_.size();
+  report.entities = ids_.size();
   reserve_s_ = std::max(t4 - scheduled - report.response_refinement_s, kReserveDecay * reserve_s_);
   quarantine(report);
   return report;

@@ -106,6 +106,7 @@ EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg,
   r.spec.density = msg.density;
   r.spec.material.restitution = msg.restitution;
   r.spec.material.friction = msg.friction;
+  r.spec.material.strength = msg.strength;
   r.spec.is_static = msg.is_static;
   const auto& c = msg.color;
   if (c.r != 0.0f || c.g != 0.0f || c.b != 0.0f || c.a != 0.0f) r.color = Rgba{c.r, c.g, c.b, c.a};
@@ -116,6 +117,7 @@ std::string spawnFieldOf(const std::string& core_field, bool is_preset) {
   static const std::map<std::string, std::string> kFields{
       {"linear_velocity", "twist.linear"}, {"angular_velocity", "twist.angular"},
       {"material.restitution", "restitution"}, {"material.friction", "friction"},
+      {"material.strength", "strength"},
       {"max_voxels", "dims"}, {"mesh", "mesh_resource"}, {"vertices", "mesh_resource"},
       {"triangles", "mesh_resource"}};
   if (is_preset && (core_field == "dims" || core_field == "max_voxels")) return "resolution";

@@ -24,6 +24,7 @@ const std::set<std::string>& knownParams() {
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
       "min_voxel_size", "max_voxel_size", "entity_states_rate", "publish_clock", "error_report",
+      "min_piece_voxels", "small_pieces",
       "diagnostic_period", "camera_info_topic"};  // diagnostic_period: read by diagnostic_updater
   return kNames;
 }
@@ -177,6 +178,12 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   readParam(nh, "sphere_fit", name);
   p.world.tree.fit = parsed("sphere_fit", [&] { return stc::parseSphereFit(name); });
   p.world.tree.max_levels = intParamIn(nh, "tree_levels", p.world.tree.max_levels, 1, 8);
+  // Fracture of bodies spawned with a strength (docs/fracture.md).
+  p.world.fracture.min_piece_voxels =
+      intParamIn(nh, "min_piece_voxels", p.world.fracture.min_piece_voxels, 1, INT_MAX);
+  name = "attach";
+  readParam(nh, "small_pieces", name);
+  p.world.fracture.small_pieces = parsed("small_pieces", [&] { return stc::parseSmallPieces(name); });
 
   p.world.max_entities = static_cast<std::size_t>(
       intParamIn(nh, "max_entities", static_cast<int>(p.world.max_entities), 1, 10000000));

@@ -37,7 +37,8 @@ RockfallSpawner::RockfallSpawner(ros::NodeHandle nh, ros::NodeHandle pnh) {
   max_rocks_ = intParamIn(pnh, "max_rocks", max_rocks_, 1, 1000000);
   density_ = positiveParam(pnh, "density", density_);
   restitution_ = paramOr(pnh, "restitution", restitution_);
-  friction_ = paramOr(pnh, "friction", friction_);  // the world validates both, by name
+  friction_ = paramOr(pnh, "friction", friction_);  // the world validates these, by name
+  strength_ = paramOr(pnh, "strength", strength_);  // N s; 0: rocks never break
   seed_ = static_cast<std::uint32_t>(paramOr(pnh, "seed", 1));
   random_.seed(seed_);
 
@@ -68,6 +69,7 @@ void RockfallSpawner::drop() {
   m.density = density_;
   m.restitution = restitution_;
   m.friction = friction_;
+  m.strength = strength_;
   const float shade = static_cast<float>(0.45 + 0.25 * unit(random_));
   m.color.r = shade + 0.1f;
   m.color.g = shade;

@@ -117,7 +117,7 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   checkKeys(node, p,
             {"name", "preset", "resolution", "voxel_size", "seed", "position", "orientation", "velocity",
              "angular_velocity", "density", "restitution", "friction", "color", "static", "box_mode",
-             "repeat", "mesh_resource", "scale"});
+             "repeat", "mesh_resource", "scale", "strength"});
   EntityRequest r;
   if (node["mesh_resource"]) {
     r.mesh_resource = readString(node["mesh_resource"], p + "mesh_resource");
@@ -140,6 +140,7 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   if (node["density"]) r.spec.density = readDouble(node["density"], p + "density");
   if (node["restitution"]) r.spec.material.restitution = readDouble(node["restitution"], p + "restitution");
   if (node["friction"]) r.spec.material.friction = readDouble(node["friction"], p + "friction");
+  if (node["strength"]) r.spec.material.strength = readDouble(node["strength"], p + "strength");
   if (node["color"]) r.color = readColor(node["color"], p + "color");
   if (node["static"]) r.spec.is_static = readBool(node["static"], p + "static");
   if (node["box_mode"]) {
@@ -191,7 +192,8 @@ std::string sceneKeyOf(const std::string& field) {
   static const std::map<std::string, std::string> kKeys{
       {"pose.position", "position"},        {"pose.orientation", "orientation"},
       {"linear_velocity", "velocity"},      {"material.restitution", "restitution"},
-      {"material.friction", "friction"},    {"dims", "resolution"}};
+      {"material.friction", "friction"},    {"dims", "resolution"},
+      {"material.strength", "strength"}};
   const auto it = kKeys.find(field);
   return it == kKeys.end() ? field : it->second;
 }

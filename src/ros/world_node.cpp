@@ -219,6 +219,7 @@ void WorldNode::runTick() {
   expireGaze(now);
   const stc::TickReport report = world_.step(dt_, budget_);
   ++tick_;
+  for (const stc::BrokenEntity& b : world_.broken()) onBroken(b);
   for (const stc::QuarantinedEntity& q : world_.quarantined()) onQuarantined(q, now);
   publishStats(report, now);
   if (error_report_) {
@@ -262,6 +263,19 @@ void WorldNode::onQuarantined(const stc::QuarantinedEntity& q, const ros::Time& 
     quarantined_pub_.publish(msg);
   }
   forget(q.id, q.shape, false);  // static bodies never move, so are never quarantined
+}
+
+// The pieces of a broken body get its colour and frames of their own names
+// (markers and tf follow them as any entity); the parent's markers go.
+void WorldNode::onBroken(const stc::BrokenEntity& broken) {
+  const auto color = colors_.find(broken.id);
+  const std::optional<Rgba> parent_color =
+      color != colors_.end() ? std::optional<Rgba>(color->second) : std::nullopt;
+  for (const stc::EntityId piece : broken.pieces) {
+    const auto index = world_.indexOf(piece);
+    if (index) remember(piece, world_.bodyNames()[*index], parent_color);  // a piece may be quarantined already
+  }
+  forget(broken.id, broken.shape, false);
 }
 
 void WorldNode::forget(stc::EntityId id, stc::ShapeId shape, bool is_static) {
@@ -435,6 +449,7 @@ void WorldNode::despawnEntity(stc::EntityId requested, const std::string& name) 
   std::optional<stc::EntityId> id;
   if (!name.empty()) {
     id = world_.findByName(name);
+    if (!id && despawnPieces(name)) return;
     if (!id) throw stc::InputError("name", "no entity named '" + name + "'");
   } else {
     id = requested;
@@ -445,6 +460,23 @@ void WorldNode::despawnEntity(stc::EntityId requested, const std::string& name) 
   const bool is_static = world_.bodies()[*index].is_static;
   world_.removeEntity(*id);
   forget(*id, shape, is_static);
+}
+
+// The name of a broken body despawns its pieces (named <name>/piece<k>, and
+// theirs in turn): the rockfall spawner despawns its oldest rock by name.
+bool WorldNode::despawnPieces(const std::string& name) {
+  const std::string prefix = name + "/piece";
+  std::vector<stc::EntityId> pieces;
+  for (std::size_t i = 0; i < world_.entityCount(); ++i) {
+    if (world_.bodyNames()[i].compare(0, prefix.size(), prefix) == 0) pieces.push_back(world_.entityIds()[i]);
+  }
+  for (const stc::EntityId piece : pieces) {
+    const std::size_t index = *world_.indexOf(piece);
+    const stc::ShapeId shape = world_.bodyShapes()[index];
+    world_.removeEntity(piece);
+    forget(piece, shape, false);  // pieces are never static
+  }
+  return !pieces.empty();
 }
 
 void WorldNode::onDespawn(const sphere_tree_collision::Despawn& msg) {

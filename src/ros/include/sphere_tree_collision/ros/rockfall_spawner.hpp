@@ -26,6 +26,7 @@ class RockfallSpawner {
 
   stc::Vec3 region_min_, region_max_, direction_;
   double speed_ = 1.0, size_ = 0.4, density_ = 2500.0, restitution_ = 0.3, friction_ = 0.6;
+  double strength_ = 0.0;  // ~strength, N s: 0 = unbreakable
   int resolution_ = 8, shape_count_ = 4, max_rocks_ = 60;
   std::uint32_t seed_ = 1;
   std::uint64_t dropped_ = 0;

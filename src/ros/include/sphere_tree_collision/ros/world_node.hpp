@@ -81,6 +81,8 @@ class WorldNode {
   void guarded(const char* what, F&& callback);
   void runTick();
   void onQuarantined(const stc::QuarantinedEntity& q, const ros::Time& stamp);
+  void onBroken(const stc::BrokenEntity& broken);
+  bool despawnPieces(const std::string& name);
   // Drops what the node keeps of an entity the world no longer has.
   void forget(stc::EntityId id, stc::ShapeId shape, bool is_static);
 
