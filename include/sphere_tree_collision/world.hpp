@@ -6,6 +6,7 @@
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/islands.hpp"
 #include "sphere_tree_collision/limits.hpp"
 #include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
@@ -46,6 +47,7 @@ struct WorldConfig {
   std::size_t max_entities = 20000;
   ResponseOptions response;
   PhysicalLimits limits;  // inputs beyond them are rejected; bodies beyond them quarantined
+  SleepOptions sleeping;  // islands at rest sleep (islands.hpp); validated as "sleeping.*"
 };
 
 struct EntitySpec {
@@ -96,6 +98,7 @@ struct TickReport {
   // non-finite or beyond the limits, and, apart, bodies that left the world.
   std::size_t quarantined = 0;
   std::size_t left_world = 0;
+  std::size_t sleeping = 0;  // bodies asleep after the tick (islands.hpp)
 };
 
 // One entity removed at the end of a tick, and why.
@@ -152,6 +155,11 @@ class World {
   const WorldConfig& config() const { return config_; }
   void setScheduler(const SchedulerOptions& options);
   void setUnresolvedPolicy(UnresolvedPolicy policy) { config_.unresolved_policy = policy; }
+  // Throws InputError("gravity") as the constructor does; wakes every island.
+  void setGravity(const Vec3& gravity);
+  // Sleeping islands (islands.hpp). wake: the entity's island; false for an unknown id.
+  bool wake(EntityId id);
+  bool isSleeping(EntityId id) const;
 
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.
@@ -184,6 +192,7 @@ class World {
   Aabb boxOf(std::size_t index) const;
   Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
+  bool setUpPairTests();  // of the broad phase's pairs; true when a sleeping island woke
 
   WorldConfig config_;
   std::deque<ShapeInfo> shapes_;  // deque: trees keep their address as shapes are added
@@ -211,6 +220,7 @@ class World {
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
   std::vector<Contact> contacts_;
   Physics physics_;  // integration and response (response.hpp), warm-start state
+  Islands islands_;  // which bodies sleep, indexed like bodies_
   SecondsClock clock_ = steadySeconds;
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step
