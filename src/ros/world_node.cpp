@@ -331,6 +331,7 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.left_world_total = left_world_total_;
   s.last_quarantine = last_quarantine_;
   s.callback_errors = callback_errors_;
+  s.sleeping = static_cast<std::uint32_t>(r.sleeping);
   stats_pub_.publish(s);
 }
 
