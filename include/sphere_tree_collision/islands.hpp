@@ -67,6 +67,9 @@ class Islands {
     if ((!bodies[other].is_static && moving_[other] != 0) || fresh_[other] != 0) requestWake(held_a ? a : b);
     return !to_wake_.empty();
   }
+  // True from beginTick while every movable body is held and none was
+  // added: no pair can be tested or wake anything, the pair setup is skipped.
+  bool quiet() const { return quiet_; }
   // Releases the held bodies of the islands noteOverlap woke (the pair tests
   // must then be set up again: their pairs are no longer static-static).
   void releaseWoken(std::vector<BodyState>& bodies);
@@ -93,6 +96,7 @@ class Islands {
   std::vector<std::uint32_t> to_wake_;      // groups to wake
   std::uint32_t next_group_ = 1;
   std::size_t sleeping_ = 0;
+  bool quiet_ = false;
 };
 
 }  // namespace stc

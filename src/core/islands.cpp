@@ -104,6 +104,7 @@ void Islands::wakeAll() {
 }
 
 void Islands::beginTick(std::vector<BodyState>& bodies, const SleepOptions& options) {
+  quiet_ = false;
   if (!options.enabled || sleeping_ == 0) return;
   for (std::size_t i = 0; i < group_.size(); ++i) {
     if (group_[i] == kAwake) continue;
@@ -115,8 +116,14 @@ void Islands::beginTick(std::vector<BodyState>& bodies, const SleepOptions& opti
     moving_[i] = 1;  // its overlaps wake what it touches
   }
   applyWakes(nullptr);
+  quiet_ = true;
   for (std::size_t i = 0; i < group_.size(); ++i) {
-    if (group_[i] == kAwake || bodies[i].is_static) continue;
+    quiet_ = quiet_ && fresh_[i] == 0;
+    if (bodies[i].is_static) continue;
+    if (group_[i] == kAwake) {
+      quiet_ = false;
+      continue;
+    }
     held_[i] = 1;
     bodies[i].is_static = true;
   }

@@ -358,6 +358,7 @@ void World::broadPhase(TickReport& report) {
 bool World::setUpPairTests() {
   pair_count_ = 0;
   pair_arena_->clear();
+  if (islands_.quiet()) return false;  // all asleep: every pair is held-held or held-static
   bool woke = false;
   for (const BroadPair& pair : broad_phase_.pairs()) {
     const std::size_t ia = index_of_.find(pair.first)->second;
