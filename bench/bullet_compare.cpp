@@ -25,7 +25,8 @@
 //   --scenes    comma separated, each NAME or NAME:BODIES (default: corner_drift:500,
 //               packed_box:500, rockfall:1000, rockfall:5000, cube_box:10000;
 //               a bare NAME picks that scene's cases from the default list)
-//   --variants  Bullet shapes to run: compound,hull (default both)
+//   --variants  Bullet shapes to run: compound,hull (default both; empty: none)
+//   --bullet-only  skip this package's run (to run the engines apart, in parallel)
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
@@ -381,6 +382,7 @@ std::string phaseRow(const Case& c, const Run& r) {
 struct Options {
   double seconds = 10.0;
   double settle = 0.0;
+  bool bullet_only = false;
   std::vector<Case> cases;
   std::vector<BulletShape> variants{BulletShape::Compound, BulletShape::Hull};
   std::string markdown;
@@ -419,6 +421,8 @@ Options parse(int argc, char** argv) {
         else if (v == "hull") o.variants.push_back(BulletShape::Hull);
         else throw InputError("--variants", "unknown value '" + v + "' (expected compound, hull)");
       }
+    } else if (a == "--bullet-only") {
+      o.bullet_only = true;
     } else if (a == "--markdown") {
       o.markdown = next();
     } else {
@@ -469,8 +473,8 @@ int main(int argc, char** argv) {
   for (const Case& c : opt.cases) {
     std::printf("## %s (load %.2f)\n", label(c).c_str(), loadAverage());
     std::fflush(stdout);
-    const Run ours = runPackage(c, ticks, settle_ticks);
-    std::string rows = runRow(c, ours);
+    const Run ours = opt.bullet_only ? Run{} : runPackage(c, ticks, settle_ticks);
+    std::string rows = opt.bullet_only ? std::string() : runRow(c, ours);
     std::printf("%s", rows.c_str());
     std::fflush(stdout);
     double best = NAN;
