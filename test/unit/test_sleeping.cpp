@@ -99,8 +99,8 @@ TEST(Sleeping, OffChangesNothingAndOnIsBitIdenticalUntilTheFirstSleep) {
   EXPECT_GT(off.world->step(kDt, Budget::unlimited()).sphere_tests, 0);
 }
 
-TEST(Sleeping, BallDroppedOnTheSleepingPileWakesItAndEverythingRestsSupported) {
-  Pile pile = settledPile();
+// A heavy ball 1 m above the pile's last mover, falling at `speed`.
+EntityId dropBall(Pile& pile, double speed) {
   World& world = *pile.world;
   PresetParams p;
   p.resolution = 4;
@@ -109,9 +109,15 @@ TEST(Sleeping, BallDroppedOnTheSleepingPileWakesItAndEverythingRestsSupported) {
   ball.shape = world.addShape("test_ball", makePreset("sphere", p));
   const Vec3 top = world.bodies()[indexOf(world, pile.spec.movers.back())].pose.position;
   ball.pose.position = Vec3(top.x(), top.y(), highestMover(pile) + 1.0);
-  ball.linear_velocity = Vec3(0.0, 0.0, -3.0);
+  ball.linear_velocity = Vec3(0.0, 0.0, -speed);
   ball.density = 4000.0;
-  const EntityId ball_id = world.addEntity(ball);
+  return world.addEntity(ball);
+}
+
+TEST(Sleeping, BallDroppedOnTheSleepingPileWakesItAndEverythingRestsSupported) {
+  Pile pile = settledPile();
+  World& world = *pile.world;
+  const EntityId ball_id = dropBall(pile, 3.0);
   std::size_t fewest_asleep = pile.spec.movers.size();
   for (int t = 0; t < 60; ++t) fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).sleeping);
   EXPECT_LT(fewest_asleep, pile.spec.movers.size());  // the hit woke the island it hit
@@ -131,6 +137,21 @@ TEST(Sleeping, BallDroppedOnTheSleepingPileWakesItAndEverythingRestsSupported) {
   EXPECT_LT(moved, 0.01);  // m, in half a second of free fall a floating body drops 1.2 m
   // and the momentum of the resting world is that of bodies at rest.
   EXPECT_LT(linearMomentum(world.bodies()).norm(), 0.05 * 9.81 * kDt * 4000.0);
+}
+
+TEST(Sleeping, FastBallDoesNotTunnelThroughTheSleepingPile) {
+  Pile pile = settledPile();
+  World& world = *pile.world;
+  const EntityId ball_id = dropBall(pile, 40.0);  // 0.67 m a tick: its swept box reaches the pile
+  double lowest = 1e9;
+  std::size_t fewest_asleep = pile.spec.movers.size();
+  for (int t = 0; t < 60; ++t) {
+    fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).sleeping);
+    lowest = std::min(lowest, world.bodies()[indexOf(world, ball_id)].pose.position.z());
+  }
+  EXPECT_LT(fewest_asleep, pile.spec.movers.size());
+  EXPECT_GT(lowest, pile.spec.bounds.min.z());  // never through the floor under the pile
+  for (EntityId id : pile.spec.movers) EXPECT_GE(world.bodies()[indexOf(world, id)].pose.position.z(), pile.spec.bounds.min.z());
 }
 
 // A body spawned just above the pile's last mover, its box overlapping.
