@@ -163,6 +163,7 @@ class World {
 
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.
+  // A sleeping body's pose or velocity edited here wakes its island at the next step.
   std::size_t entityCount() const { return ids_.size(); }
   const std::vector<EntityId>& entityIds() const { return ids_; }
   const std::vector<BodyState>& bodies() const { return bodies_; }
