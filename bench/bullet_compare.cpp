@@ -488,8 +488,10 @@ int main(int argc, char** argv) {
       if (!(best <= p50)) best = p50;
     }
     runs_md += rows;
-    phases_md += phaseRow(c, ours);
-    std::printf("phases p50 / mean ms: %s", phaseRow(c, ours).c_str());
+    if (!opt.bullet_only) {
+      phases_md += phaseRow(c, ours);
+      std::printf("phases p50 / mean ms: %s", phaseRow(c, ours).c_str());
+    }
     char buf[256];
     const double p50 = percentile(ours.cpu, 0.5);
     std::snprintf(buf, sizeof buf,
