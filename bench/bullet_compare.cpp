@@ -20,8 +20,8 @@
 // Usage: bench_bullet_compare [--seconds S] [--settle S] [--scenes LIST] [--variants LIST] [--markdown FILE]
 //   --seconds   simulated time per run (default 10)
 //   --settle    simulated time run first, untimed (default 0): with it the timed
-//               ticks are those of a settled scene, where both engines sleep
-//               (docs/sleeping.md)
+//               ticks are those of a settling scene, where both engines put
+//               islands at rest to sleep (docs/sleeping.md)
 //   --scenes    comma separated, each NAME or NAME:BODIES (default: corner_drift:500,
 //               packed_box:500, rockfall:1000, rockfall:5000, cube_box:10000;
 //               a bare NAME picks that scene's cases from the default list)
