@@ -17,12 +17,16 @@
 // Ends with one SUMMARY line per scene: this package's thread-CPU p50 and
 // p99, Bullet's best (lowest) thread-CPU p50 and the ratio of the two p50s.
 //
-// Usage: bench_bullet_compare [--seconds S] [--scenes LIST] [--variants LIST] [--markdown FILE]
+// Usage: bench_bullet_compare [--seconds S] [--settle S] [--scenes LIST] [--variants LIST] [--markdown FILE]
 //   --seconds   simulated time per run (default 10)
+//   --settle    simulated time run first, untimed (default 0): with it the timed
+//               ticks are those of a settling scene, where both engines put
+//               islands at rest to sleep (docs/sleeping.md)
 //   --scenes    comma separated, each NAME or NAME:BODIES (default: corner_drift:500,
 //               packed_box:500, rockfall:1000, rockfall:5000, cube_box:10000;
 //               a bare NAME picks that scene's cases from the default list)
-//   --variants  Bullet shapes to run: compound,hull (default both)
+//   --variants  Bullet shapes to run: compound,hull (default both; empty: none)
+//   --bullet-only  skip this package's run (to run the engines apart, in parallel)
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
@@ -69,7 +73,7 @@ struct Run {
   double moved_speed = 0.0;   // mean over ticks and movers of |dx| / dt
   double final_speed = 0.0;   // mean |v| after the last tick
   int out_end = 0, out_ever = 0, non_finite = 0;
-  int sleeping = -1;          // Bullet: movers asleep at the end
+  int sleeping = -1;          // movers asleep at the end
 };
 
 // Follows the movers' centres tick by tick for the sanity figures.
@@ -132,9 +136,10 @@ void timeTick(Run& run, double wall0, double cpu0) {
   run.cpu.push_back(stc_bench::threadCpuSeconds() - cpu0);
 }
 
-Run runPackage(const Case& c, int ticks) {
+Run runPackage(const Case& c, int ticks, int settle_ticks) {
   SceneSpec spec;
   World world = sceneWorld(c, spec);
+  for (int t = 0; t < settle_ticks; ++t) world.step(spec.dt, Budget::unlimited());
   std::vector<std::size_t> dense;
   for (EntityId id : spec.movers) dense.push_back(*world.indexOf(id));
   std::vector<Vec3> positions(dense.size()), velocities(dense.size());
@@ -158,6 +163,7 @@ Run runPackage(const Case& c, int ticks) {
     run.narrow.push_back(r.narrow_s);
     run.response.push_back(r.response_s);
     run.contacts.push_back(static_cast<double>(r.contacts));
+    run.sleeping = static_cast<int>(r.sleeping);
     read();
     check.tick(positions, velocities);
   }
@@ -312,13 +318,14 @@ class BulletScene {
   std::vector<btRigidBody*> movers_;
 };
 
-Run runBullet(const Case& c, int ticks, BulletShape kind) {
+Run runBullet(const Case& c, int ticks, int settle_ticks, BulletShape kind) {
   SceneSpec spec;
   std::unique_ptr<BulletScene> scene;
   {
     const World world = sceneWorld(c, spec);
     scene = std::make_unique<BulletScene>(world, spec, kind);
   }
+  for (int t = 0; t < settle_ticks; ++t) scene->step(spec.dt);
   Run run;
   run.engine = std::string("Bullet ") + toString(kind);
   MotionCheck check(spec.bounds, spec.dt);
@@ -374,6 +381,8 @@ std::string phaseRow(const Case& c, const Run& r) {
 
 struct Options {
   double seconds = 10.0;
+  double settle = 0.0;
+  bool bullet_only = false;
   std::vector<Case> cases;
   std::vector<BulletShape> variants{BulletShape::Compound, BulletShape::Hull};
   std::string markdown;
@@ -400,6 +409,9 @@ Options parse(int argc, char** argv) {
     if (a == "--seconds") {
       o.seconds = std::stod(next());
       if (!(o.seconds > 0.0)) throw InputError("--seconds", "must be > 0");
+    } else if (a == "--settle") {
+      o.settle = std::stod(next());
+      if (!(o.settle >= 0.0)) throw InputError("--settle", "must be >= 0");
     } else if (a == "--scenes") {
       scenes = next();
     } else if (a == "--variants") {
@@ -409,6 +421,8 @@ Options parse(int argc, char** argv) {
         else if (v == "hull") o.variants.push_back(BulletShape::Hull);
         else throw InputError("--variants", "unknown value '" + v + "' (expected compound, hull)");
       }
+    } else if (a == "--bullet-only") {
+      o.bullet_only = true;
     } else if (a == "--markdown") {
       o.markdown = next();
     } else {
@@ -445,6 +459,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int ticks = static_cast<int>(std::lround(opt.seconds * 60.0));
+  const int settle_ticks = static_cast<int>(std::lround(opt.settle * 60.0));
   std::string runs_md =
       "| scene | engine | CPU p50 | CPU p99 | CPU max | wall p50 | wall p99 | wall max | "
       "stored speed | \\|dx\\|/dt | final speed | out of bounds (end / ever) | asleep |\n"
@@ -453,18 +468,18 @@ int main(int argc, char** argv) {
       "| scene | integrate | broad | narrow | response | whole tick | contacts p50 |\n"
       "|---|---|---|---|---|---|---|\n";
   std::string summary;
-  std::printf("# bench_bullet_compare: %.1f s simulated per run (%d ticks at 60 Hz), load %.2f\n",
-              opt.seconds, ticks, loadAverage());
+  std::printf("# bench_bullet_compare: %.1f s simulated per run (%d ticks at 60 Hz) after %.1f s untimed, load %.2f\n",
+              opt.seconds, ticks, opt.settle, loadAverage());
   for (const Case& c : opt.cases) {
     std::printf("## %s (load %.2f)\n", label(c).c_str(), loadAverage());
     std::fflush(stdout);
-    const Run ours = runPackage(c, ticks);
-    std::string rows = runRow(c, ours);
+    const Run ours = opt.bullet_only ? Run{} : runPackage(c, ticks, settle_ticks);
+    std::string rows = opt.bullet_only ? std::string() : runRow(c, ours);
     std::printf("%s", rows.c_str());
     std::fflush(stdout);
     double best = NAN;
     for (BulletShape v : opt.variants) {
-      const Run theirs = runBullet(c, ticks, v);
+      const Run theirs = runBullet(c, ticks, settle_ticks, v);
       const std::string row = runRow(c, theirs);
       std::printf("%s", row.c_str());
       std::fflush(stdout);
@@ -473,8 +488,10 @@ int main(int argc, char** argv) {
       if (!(best <= p50)) best = p50;
     }
     runs_md += rows;
-    phases_md += phaseRow(c, ours);
-    std::printf("phases p50 / mean ms: %s", phaseRow(c, ours).c_str());
+    if (!opt.bullet_only) {
+      phases_md += phaseRow(c, ours);
+      std::printf("phases p50 / mean ms: %s", phaseRow(c, ours).c_str());
+    }
     char buf[256];
     const double p50 = percentile(ours.cpu, 0.5);
     std::snprintf(buf, sizeof buf,
@@ -487,9 +504,9 @@ int main(int argc, char** argv) {
   std::string md;
   char head[256];
   std::snprintf(head, sizeof head,
-                "%.1f s simulated per run (%d ticks, dt = 1/60 s). Times in ms per tick; speeds in "
-                "m/s, means over movers and ticks.\n\n",
-                opt.seconds, ticks);
+                "%.1f s simulated per run (%d ticks, dt = 1/60 s) after %.1f s untimed. Times in ms per "
+                "tick; speeds in m/s, means over movers and ticks.\n\n",
+                opt.seconds, ticks, opt.settle);
   md = std::string(head) + runs_md +
        "\nThis package's phases, ms per tick (p50 / mean, wall time):\n\n" + phases_md;
   std::printf("\n%s\nload at the end %.2f\n%s", md.c_str(), loadAverage(), summary.c_str());

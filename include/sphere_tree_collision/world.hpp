@@ -7,6 +7,7 @@
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
 #include "sphere_tree_collision/fracture.hpp"
+#include "sphere_tree_collision/islands.hpp"
 #include "sphere_tree_collision/limits.hpp"
 #include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
@@ -48,6 +49,7 @@ struct WorldConfig {
   ResponseOptions response;
   PhysicalLimits limits;  // inputs beyond them are rejected; bodies beyond them quarantined
   FractureOptions fracture;  // for bodies with a material strength (fracture.hpp)
+  SleepOptions sleeping;  // islands at rest sleep (islands.hpp); validated as "sleeping.*"
 };
 
 struct EntitySpec {
@@ -104,6 +106,7 @@ struct TickReport {
   std::size_t fractures = 0;
   std::size_t fractures_deferred = 0;  // waiting for time: broken from the next tick's start
   double fracture_s = 0.0;
+  std::size_t sleeping = 0;  // bodies asleep after the tick (islands.hpp)
 };
 
 // One entity removed at the end of a tick, and why.
@@ -180,9 +183,15 @@ class World {
   void setUnresolvedPolicy(UnresolvedPolicy policy) { config_.unresolved_policy = policy; }
   // From the next step on; throws InputError (validateResponseOptions) and changes nothing.
   void setResponse(const ResponseOptions& options);
+  // Throws InputError("gravity") as the constructor does; wakes every island.
+  void setGravity(const Vec3& gravity);
+  // Sleeping islands (islands.hpp). wake: the entity's island; false for an unknown id.
+  bool wake(EntityId id);
+  bool isSleeping(EntityId id) const;
 
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.
+  // A sleeping body's pose or velocity edited here wakes its island at the next step.
   std::size_t entityCount() const { return ids_.size(); }
   const std::vector<EntityId>& entityIds() const { return ids_; }
   const std::vector<BodyState>& bodies() const { return bodies_; }
@@ -223,6 +232,7 @@ class World {
   Aabb boxOf(std::size_t index) const;
   Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
+  bool setUpPairTests();  // of the broad phase's pairs; true when a sleeping island woke
 
   WorldConfig config_;
   std::deque<ShapeInfo> shapes_;  // deque: trees keep their address as shapes are added
@@ -251,6 +261,7 @@ class World {
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
   std::vector<Contact> contacts_;
   Physics physics_;  // integration and response (response.hpp), warm-start state
+  Islands islands_;  // which bodies sleep, indexed like bodies_
   SecondsClock clock_ = steadySeconds;
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step

@@ -67,6 +67,7 @@ World::World(const WorldConfig& config)
   validateLimits(config_.limits);
   validateGravity(config_.gravity, config_.limits);
   validateFractureOptions(config_.fracture);
+  validateSleepOptions(config_.sleeping);
 }
 World::~World() = default;
 World::World(World&&) noexcept = default;
@@ -164,6 +165,7 @@ EntityId World::addEntity(const EntitySpec& spec) {
   index_of_.emplace(id, index);
   if (!spec.name.empty()) id_by_name_.emplace(spec.name, id);
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
+  islands_.add();
   ++next_id_;
   invalidateLastTick();
   return id;
@@ -174,6 +176,12 @@ bool World::removeEntity(EntityId id) {
   if (it == index_of_.end()) return false;
   const std::size_t index = it->second;
   const std::size_t last = ids_.size() - 1;
+  for (const BroadPair& pair : broad_phase_.pairs()) {  // what it touched loses it: wakes
+    if (pair.first != id && pair.second != id) continue;
+    const auto other = index_of_.find(pair.first == id ? pair.second : pair.first);
+    if (other != index_of_.end()) islands_.wake(other->second);  // end: removed since the last update
+  }
+  islands_.remove(index, last);
   broad_phase_.remove(id);
   if (!names_[index].empty()) id_by_name_.erase(names_[index]);
   index_of_.erase(it);
@@ -215,6 +223,7 @@ void World::clear() {
   index_of_.clear();
   id_by_name_.clear();
   broad_phase_ = SweepAndPrune();
+  islands_.clear();
   invalidateLastTick();
 }
 
@@ -227,6 +236,23 @@ void World::setScheduler(const SchedulerOptions& options) {
 void World::setResponse(const ResponseOptions& options) {
   validateResponseOptions(options);
   config_.response = options;
+}
+
+void World::setGravity(const Vec3& gravity) {
+  validateGravity(gravity, config_.limits);
+  config_.gravity = gravity;
+  islands_.wakeAll();
+}
+
+bool World::wake(EntityId id) {
+  const auto index = indexOf(id);
+  if (index) islands_.wake(*index);
+  return index.has_value();
+}
+
+bool World::isSleeping(EntityId id) const {
+  const auto index = indexOf(id);
+  return index && islands_.isSleeping(*index);
 }
 
 // The last tick's pair tests point at bodies and its contacts name dense
@@ -246,6 +272,7 @@ TickReport World::step(double dt, const Budget& budget) {
   quarantined_.clear();
   broken_.clear();
   quarantine(report);  // states edited through bodies() since the last step
+  islands_.beginTick(bodies_, config_.sleeping);  // sleepers held as static until endTick
   const double t0 = clock_();
   const bool timed_tick = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
   const Deadline tick_end = timed_tick ? Deadline(&clock_, t0 + std::max(budget.tick_seconds, 0.0)) : Deadline();
@@ -272,7 +299,9 @@ TickReport World::step(double dt, const Budget& budget) {
   report.contacts = contacts_.size();
   report.entities = ids_.size();
   reserve_s_ = std::max(t4 - scheduled - report.response_refinement_s, kReserveDecay * reserve_s_);
+  islands_.endTick(bodies_, contacts_, dt, config_.sleeping);
   quarantine(report);
+  report.sleeping = islands_.sleepingCount();
   return report;
 }
 
@@ -354,12 +383,20 @@ void World::broadPhase(TickReport& report) {
     pair_bodies_.resize(pairs.size());
     pair_priority_.resize(pairs.size());
   }
+  // A moving body reached a sleeping island: it woke, its pairs are tested too.
+  if (setUpPairTests()) setUpPairTests();
+}
+
+bool World::setUpPairTests() {
   pair_count_ = 0;
   pair_arena_->clear();
-  for (const BroadPair& pair : pairs) {
+  if (islands_.quiet()) return false;  // all asleep: every pair is held-held or held-static
+  bool woke = false;
+  for (const BroadPair& pair : broad_phase_.pairs()) {
     const std::size_t ia = index_of_.find(pair.first)->second;
     const std::size_t ib = index_of_.find(pair.second)->second;
-    if (bodies_[ia].is_static && bodies_[ib].is_static) continue;  // nothing can change
+    woke |= islands_.noteOverlap(static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib), bodies_);
+    if (bodies_[ia].is_static && bodies_[ib].is_static) continue;  // nothing can change (or asleep)
     pair_tests_[pair_count_].reset(
         PairBody{pair.first, &shapes_[body_shapes_[ia]].tree, &bodies_[ia].pose},
         PairBody{pair.second, &shapes_[body_shapes_[ib]].tree, &bodies_[ib].pose},
@@ -367,6 +404,8 @@ void World::broadPhase(TickReport& report) {
     pair_bodies_[pair_count_] = {static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib)};
     ++pair_count_;
   }
+  if (woke) islands_.releaseWoken(bodies_);
+  return woke;
 }
 
 // Fast bodies put back at their first contact with a broad-phase partner

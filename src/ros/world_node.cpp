@@ -354,6 +354,7 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.physics_time = clock_.physicsSeconds();
   s.real_time_factor = clock_.realTimeFactor();
   s.paused = paused_;
+  s.sleeping = static_cast<std::uint32_t>(r.sleeping);
   diagnostics_->onTick(s);
   if (stats_pub_.getNumSubscribers() > 0) stats_pub_.publish(s);
 }

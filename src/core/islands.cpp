@@ -1,0 +1,196 @@
+// Islands and sleep (islands.hpp): union-find over the tick's contacts, rest
+// timers per body, whole islands put to sleep and woken.
+#include "sphere_tree_collision/islands.hpp"
+
+#include "sphere_tree_collision/types.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace stc {
+namespace {
+
+void requireNonNegative(double value, const char* field) {
+  if (!(std::isfinite(value) && value >= 0.0)) throw InputError(field, "must be finite and >= 0");
+}
+
+bool samePose(const Pose& a, const Pose& b) {
+  return a.position == b.position && a.orientation.coeffs() == b.orientation.coeffs();
+}
+
+}  // namespace
+
+void validateSleepOptions(const SleepOptions& options) {
+  requireNonNegative(options.linear_speed, "sleeping.linear_speed");
+  requireNonNegative(options.angular_speed, "sleeping.angular_speed");
+  requireNonNegative(options.time_to_sleep, "sleeping.time_to_sleep");
+}
+
+void Islands::add() {
+  group_.push_back(kAwake);
+  held_.push_back(0);
+  fresh_.push_back(1);
+  moving_.push_back(1);
+  rest_pose_.emplace_back();
+  rest_time_.push_back(0.0);
+}
+
+void Islands::remove(std::size_t index, std::size_t last) {
+  if (group_[index] != kAwake) {
+    // The removed body's island loses a support: the rest of it wakes.
+    requestWake(index);
+    applyWakes(nullptr);
+  }
+  group_[index] = group_[last];
+  held_[index] = held_[last];
+  fresh_[index] = fresh_[last];
+  moving_[index] = moving_[last];
+  rest_pose_[index] = rest_pose_[last];
+  rest_time_[index] = rest_time_[last];
+  group_.pop_back();
+  held_.pop_back();
+  fresh_.pop_back();
+  moving_.pop_back();
+  rest_pose_.pop_back();
+  rest_time_.pop_back();
+}
+
+void Islands::clear() {
+  group_.clear();
+  held_.clear();
+  fresh_.clear();
+  moving_.clear();
+  rest_pose_.clear();
+  rest_time_.clear();
+  to_wake_.clear();
+  sleeping_ = 0;
+}
+
+void Islands::requestWake(std::size_t body) {
+  const std::uint32_t group = group_[body];
+  if (group == kAwake) return;
+  if (std::find(to_wake_.begin(), to_wake_.end(), group) == to_wake_.end()) to_wake_.push_back(group);
+}
+
+// One pass over the bodies wakes every requested group.
+void Islands::applyWakes(std::vector<BodyState>* bodies) {
+  if (to_wake_.empty()) return;
+  for (std::size_t i = 0; i < group_.size(); ++i) {
+    if (group_[i] == kAwake) continue;
+    if (std::find(to_wake_.begin(), to_wake_.end(), group_[i]) == to_wake_.end()) continue;
+    group_[i] = kAwake;
+    rest_time_[i] = 0.0;
+    --sleeping_;
+    if (held_[i] != 0 && bodies != nullptr) {
+      held_[i] = 0;
+      (*bodies)[i].is_static = false;
+    }
+  }
+  to_wake_.clear();
+}
+
+void Islands::wake(std::size_t body) {
+  requestWake(body);
+  applyWakes(nullptr);
+}
+
+void Islands::wakeAll() {
+  std::fill(group_.begin(), group_.end(), kAwake);
+  std::fill(rest_time_.begin(), rest_time_.end(), 0.0);
+  to_wake_.clear();
+  sleeping_ = 0;
+}
+
+void Islands::beginTick(std::vector<BodyState>& bodies, const SleepOptions& options) {
+  quiet_ = false;
+  if (!options.enabled || sleeping_ == 0) return;
+  for (std::size_t i = 0; i < group_.size(); ++i) {
+    if (group_[i] == kAwake) continue;
+    const BodyState& body = bodies[i];
+    const bool edited = !samePose(body.pose, rest_pose_[i]) || !body.linear_velocity.isZero(0.0) ||
+                        !body.angular_velocity.isZero(0.0);
+    if (!edited) continue;
+    requestWake(i);
+    moving_[i] = 1;  // its overlaps wake what it touches
+  }
+  applyWakes(nullptr);
+  quiet_ = true;
+  for (std::size_t i = 0; i < group_.size(); ++i) {
+    quiet_ = quiet_ && fresh_[i] == 0;
+    if (bodies[i].is_static) continue;
+    if (group_[i] == kAwake) {
+      quiet_ = false;
+      continue;
+    }
+    held_[i] = 1;
+    bodies[i].is_static = true;
+  }
+}
+
+void Islands::releaseWoken(std::vector<BodyState>& bodies) { applyWakes(&bodies); }
+
+std::uint32_t Islands::find(std::uint32_t i) {
+  while (parent_[i] != i) {
+    parent_[i] = parent_[parent_[i]];  // path halving
+    i = parent_[i];
+  }
+  return i;
+}
+
+void Islands::endTick(std::vector<BodyState>& bodies, const std::vector<Contact>& contacts, double dt,
+                      const SleepOptions& options) {
+  const std::size_t n = bodies.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (held_[i] == 0) continue;
+    held_[i] = 0;
+    bodies[i].is_static = false;
+  }
+  std::fill(fresh_.begin(), fresh_.end(), 0);
+  if (!options.enabled) return;
+
+  // Islands of the awake movable bodies: a contact joins two of them.
+  const auto movable = [&](std::size_t i) { return !bodies[i].is_static && group_[i] == kAwake; };
+  parent_.resize(n);
+  std::iota(parent_.begin(), parent_.end(), 0u);
+  for (const Contact& c : contacts) {
+    if (!movable(c.index_a) || !movable(c.index_b)) continue;
+    const std::uint32_t ra = find(c.index_a), rb = find(c.index_b);
+    if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
+  }
+
+  // Rest timers, and each island's least.
+  island_rest_.assign(n, std::numeric_limits<double>::infinity());
+  const double lin_sq = options.linear_speed * options.linear_speed;
+  const double ang_sq = options.angular_speed * options.angular_speed;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!movable(i)) continue;
+    const BodyState& body = bodies[i];
+    const bool resting = body.linear_velocity.squaredNorm() <= lin_sq && body.angular_velocity.squaredNorm() <= ang_sq;
+    rest_time_[i] = resting ? rest_time_[i] + dt : 0.0;
+    moving_[i] = resting ? 0 : 1;
+    double& least = island_rest_[find(static_cast<std::uint32_t>(i))];
+    least = std::min(least, rest_time_[i]);
+  }
+
+  // Islands that rested long enough sleep, each as one group.
+  island_group_.assign(n, kAwake);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!movable(i)) continue;
+    const std::uint32_t root = find(static_cast<std::uint32_t>(i));
+    if (!(island_rest_[root] >= options.time_to_sleep)) continue;
+    if (island_group_[root] == kAwake) {
+      island_group_[root] = next_group_;
+      next_group_ = next_group_ == std::numeric_limits<std::uint32_t>::max() ? 1 : next_group_ + 1;
+    }
+    group_[i] = island_group_[root];
+    moving_[i] = 0;
+    rest_pose_[i] = bodies[i].pose;
+    bodies[i].linear_velocity.setZero();
+    bodies[i].angular_velocity.setZero();
+    ++sleeping_;
+  }
+}
+
+}  // namespace stc

@@ -1,0 +1,245 @@
+// Sleeping islands (islands.hpp): a pile that comes to rest sleeps, keeps its
+// poses exactly and costs no sphere test; a moving body, a spawn, a despawn,
+// a change of gravity, an edit and World::wake wake it; with sleeping off
+// nothing changes; bad thresholds are rejected naming the field.
+#include "sphere_tree_collision/dynamics.hpp"
+#include "sphere_tree_collision/scenes.hpp"
+#include "sphere_tree_collision/world.hpp"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+
+namespace stc {
+namespace {
+
+constexpr double kDt = 1.0 / 60.0;
+constexpr int kSettleTicks = 900;  // 15 s: the pile is asleep long before
+
+struct Pile {
+  std::unique_ptr<World> world;
+  SceneSpec spec;
+};
+
+// Cubes falling into a pile in a closed box (scenes.hpp CubeBox).
+Pile cubePile(bool sleeping = true, int count = 27) {
+  WorldConfig config;
+  config.gravity = sceneGravity(SceneKind::CubeBox);
+  config.sleeping.enabled = sleeping;
+  Pile pile;
+  pile.world = std::make_unique<World>(config);
+  SceneParams params;
+  params.entities = count;
+  params.resolution = 4;
+  pile.spec = populateScene(*pile.world, SceneKind::CubeBox, params);
+  return pile;
+}
+
+// Steps until every mover sleeps; returns the ticks it took (-1: never).
+int settle(World& world, std::size_t movers, int max_ticks = kSettleTicks) {
+  for (int t = 1; t <= max_ticks; ++t) {
+    if (world.step(kDt, Budget::unlimited()).sleeping == movers) return t;
+  }
+  return -1;
+}
+
+Pile settledPile() {
+  Pile pile = cubePile();
+  EXPECT_GT(settle(*pile.world, pile.spec.movers.size()), 0);
+  return pile;
+}
+
+std::size_t indexOf(const World& world, EntityId id) { return *world.indexOf(id); }
+
+// Top of the pile: the highest mover's centre.
+double highestMover(const Pile& pile) {
+  double z = -1e9;
+  for (EntityId id : pile.spec.movers) z = std::max(z, pile.world->bodies()[indexOf(*pile.world, id)].pose.position.z());
+  return z;
+}
+
+TEST(Sleeping, PileComesToRestSleepsAndCostsNoSphereTest) {
+  Pile pile = settledPile();
+  World& world = *pile.world;
+  std::vector<Pose> poses;
+  for (const BodyState& b : world.bodies()) poses.push_back(b.pose);
+  for (int t = 0; t < 120; ++t) {
+    const TickReport r = world.step(kDt, Budget::unlimited());
+    EXPECT_EQ(r.sleeping, pile.spec.movers.size());
+    EXPECT_EQ(r.sphere_tests, 0);  // sleeping-sleeping and sleeping-static pairs are not tested
+    EXPECT_EQ(r.contacts, 0u);     // nor solved
+  }
+  for (std::size_t i = 0; i < world.bodies().size(); ++i) {
+    const BodyState& b = world.bodies()[i];
+    EXPECT_EQ(b.pose.position, poses[i].position);  // exactly
+    EXPECT_EQ(b.pose.orientation.coeffs(), poses[i].orientation.coeffs());
+    EXPECT_TRUE(b.linear_velocity.isZero(0.0));
+    EXPECT_TRUE(b.angular_velocity.isZero(0.0));
+  }
+  for (EntityId id : pile.spec.walls) EXPECT_FALSE(world.isSleeping(id));  // static bodies never do
+  for (EntityId id : pile.spec.movers) EXPECT_TRUE(world.isSleeping(id));
+}
+
+TEST(Sleeping, OffChangesNothingAndOnIsBitIdenticalUntilTheFirstSleep) {
+  Pile on = cubePile(true), off = cubePile(false);
+  int compared = 0;
+  for (int t = 0; t < kSettleTicks; ++t) {
+    const TickReport r_on = on.world->step(kDt, Budget::unlimited());
+    const TickReport r_off = off.world->step(kDt, Budget::unlimited());
+    EXPECT_EQ(r_off.sleeping, 0u);
+    if (r_on.sleeping != 0) break;
+    ++compared;
+    for (std::size_t i = 0; i < on.world->bodies().size(); ++i) {
+      ASSERT_EQ(on.world->bodies()[i].pose.position, off.world->bodies()[i].pose.position) << "tick " << t;
+      ASSERT_EQ(on.world->bodies()[i].linear_velocity, off.world->bodies()[i].linear_velocity) << "tick " << t;
+    }
+  }
+  EXPECT_GT(compared, 30);  // the pile fell and moved before anything slept
+  // Off: the settled pile still tests its pairs every tick.
+  EXPECT_GT(off.world->step(kDt, Budget::unlimited()).sphere_tests, 0);
+}
+
+// A heavy ball 1 m above the pile's last mover, falling at `speed`.
+EntityId dropBall(Pile& pile, double speed) {
+  World& world = *pile.world;
+  PresetParams p;
+  p.resolution = 4;
+  p.voxel_size = 0.1;
+  EntitySpec ball;
+  ball.shape = world.addShape("test_ball", makePreset("sphere", p));
+  const Vec3 top = world.bodies()[indexOf(world, pile.spec.movers.back())].pose.position;
+  ball.pose.position = Vec3(top.x(), top.y(), highestMover(pile) + 1.0);
+  ball.linear_velocity = Vec3(0.0, 0.0, -speed);
+  ball.density = 4000.0;
+  return world.addEntity(ball);
+}
+
+TEST(Sleeping, BallDroppedOnTheSleepingPileWakesItAndEverythingRestsSupported) {
+  Pile pile = settledPile();
+  World& world = *pile.world;
+  const EntityId ball_id = dropBall(pile, 3.0);
+  std::size_t fewest_asleep = pile.spec.movers.size();
+  for (int t = 0; t < 60; ++t) fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).sleeping);
+  EXPECT_LT(fewest_asleep, pile.spec.movers.size());  // the hit woke the island it hit
+  // Everything comes to rest again, the ball on the pile, nothing through the floor.
+  EXPECT_GT(settle(world, pile.spec.movers.size() + 1), 0);
+  const double ball_z = world.bodies()[indexOf(world, ball_id)].pose.position.z();
+  EXPECT_GT(ball_z, pile.spec.bounds.min.z());
+  for (EntityId id : pile.spec.movers) EXPECT_GE(world.bodies()[indexOf(world, id)].pose.position.z(), pile.spec.bounds.min.z());
+  // Nothing sleeps in mid-air: woken with gravity on, the settled bodies stay where they are.
+  std::vector<Vec3> rest;
+  for (const BodyState& b : world.bodies()) rest.push_back(b.pose.position);
+  world.setGravity(world.config().gravity);
+  EXPECT_EQ(world.step(kDt, Budget::unlimited()).sleeping, 0u);
+  for (int t = 0; t < 30; ++t) world.step(kDt, Budget::unlimited());
+  double moved = 0.0;
+  for (std::size_t i = 0; i < rest.size(); ++i) moved = std::max(moved, (world.bodies()[i].pose.position - rest[i]).norm());
+  EXPECT_LT(moved, 0.01);  // m, in half a second of free fall a floating body drops 1.2 m
+  // and the momentum of the resting world is that of bodies at rest.
+  EXPECT_LT(linearMomentum(world.bodies()).norm(), 0.05 * 9.81 * kDt * 4000.0);
+}
+
+TEST(Sleeping, FastBallDoesNotTunnelThroughTheSleepingPile) {
+  Pile pile = settledPile();
+  World& world = *pile.world;
+  const EntityId ball_id = dropBall(pile, 40.0);  // 0.67 m a tick: its swept box reaches the pile
+  double lowest = 1e9;
+  std::size_t fewest_asleep = pile.spec.movers.size();
+  for (int t = 0; t < 60; ++t) {
+    fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).sleeping);
+    lowest = std::min(lowest, world.bodies()[indexOf(world, ball_id)].pose.position.z());
+  }
+  EXPECT_LT(fewest_asleep, pile.spec.movers.size());
+  EXPECT_GT(lowest, pile.spec.bounds.min.z());  // never through the floor under the pile
+  for (EntityId id : pile.spec.movers) EXPECT_GE(world.bodies()[indexOf(world, id)].pose.position.z(), pile.spec.bounds.min.z());
+}
+
+// A body spawned just above the pile's last mover, its box overlapping.
+void expectSpawnWakes(bool is_static) {
+  Pile pile = settledPile();
+  World& world = *pile.world;
+  const std::size_t top = indexOf(world, pile.spec.movers.back());
+  EntitySpec spawn;
+  spawn.shape = world.bodyShapes()[top];
+  spawn.pose.position = world.bodies()[top].pose.position + Vec3(0.0, 0.0, 0.45);
+  spawn.is_static = is_static;
+  world.addEntity(spawn);
+  world.step(kDt, Budget::unlimited());
+  EXPECT_FALSE(world.isSleeping(pile.spec.movers.back()));
+}
+
+TEST(Sleeping, SpawnOverlappingTheSleepingPileWakesIt) { expectSpawnWakes(false); }
+
+TEST(Sleeping, StaticSpawnOverlappingTheSleepingPileWakesIt) { expectSpawnWakes(true); }
+
+TEST(Sleeping, DespawnWakesItsIslandAndWhatItTouched) {
+  Pile pile = settledPile();
+  World& world = *pile.world;
+  // The lowest mover holds others up.
+  EntityId lowest = pile.spec.movers.front();
+  for (EntityId id : pile.spec.movers) {
+    if (world.bodies()[indexOf(world, id)].pose.position.z() < world.bodies()[indexOf(world, lowest)].pose.position.z()) lowest = id;
+  }
+  const std::size_t before = world.step(kDt, Budget::unlimited()).sleeping;
+  ASSERT_TRUE(world.removeEntity(lowest));
+  std::size_t awake = 0;
+  for (EntityId id : pile.spec.movers) awake += id != lowest && !world.isSleeping(id) ? 1 : 0;
+  EXPECT_GT(awake, 0u);
+  EXPECT_LT(world.step(kDt, Budget::unlimited()).sleeping, before - 1);
+}
+
+TEST(Sleeping, ChangeOfGravityWakesAllAndBadGravityChangesNothing) {
+  Pile pile = settledPile();
+  World& world = *pile.world;
+  EXPECT_THROW(world.setGravity(Vec3(0.0, 0.0, 1e9)), InputError);
+  for (EntityId id : pile.spec.movers) EXPECT_TRUE(world.isSleeping(id));
+  world.setGravity(Vec3(2.0, 0.0, -9.81));
+  for (EntityId id : pile.spec.movers) EXPECT_FALSE(world.isSleeping(id));
+  EXPECT_EQ(world.config().gravity, Vec3(2.0, 0.0, -9.81));
+  world.step(kDt, Budget::unlimited());
+  double vx = 0.0;
+  for (EntityId id : pile.spec.movers) vx += world.bodies()[indexOf(world, id)].linear_velocity.x();
+  EXPECT_GT(vx, 0.0);  // the new gravity acts
+}
+
+TEST(Sleeping, EditThroughBodiesAndWakeWakeTheIsland) {
+  Pile pile = settledPile();
+  World& world = *pile.world;
+  const EntityId id = pile.spec.movers.back();
+  world.bodies()[indexOf(world, id)].linear_velocity = Vec3(0.0, 0.0, 2.0);
+  world.step(kDt, Budget::unlimited());
+  EXPECT_FALSE(world.isSleeping(id));
+  EXPECT_GT(world.bodies()[indexOf(world, id)].pose.position.z(), 0.0);
+
+  Pile other = settledPile();
+  const EntityId woken = other.spec.movers.front();
+  EXPECT_TRUE(other.world->wake(woken));
+  EXPECT_FALSE(other.world->isSleeping(woken));
+  EXPECT_FALSE(other.world->wake(kInvalidEntity));
+}
+
+TEST(Sleeping, BadThresholdsAreRejectedNamingTheField) {
+  const auto field = [](SleepOptions sleeping) {
+    WorldConfig config;
+    config.sleeping = sleeping;
+    try {
+      World world(config);
+    } catch (const InputError& e) {
+      return e.field();
+    }
+    return std::string();
+  };
+  SleepOptions s;
+  s.linear_speed = -1.0;
+  EXPECT_EQ(field(s), "sleeping.linear_speed");
+  s = SleepOptions{};
+  s.angular_speed = std::nan("");
+  EXPECT_EQ(field(s), "sleeping.angular_speed");
+  s = SleepOptions{};
+  s.time_to_sleep = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(field(s), "sleeping.time_to_sleep");
+  EXPECT_EQ(field(SleepOptions{}), "");
+}
+
+}  // namespace
+}  // namespace stc
