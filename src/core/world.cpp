@@ -236,6 +236,7 @@ void World::setScheduler(const SchedulerOptions& options) {
 void World::setResponse(const ResponseOptions& options) {
   validateResponseOptions(options);
   config_.response = options;
+  if (!options.enabled) islands_.wakeAll();  // detection alone: every pair is tested again
 }
 
 void World::setGravity(const Vec3& gravity) {
@@ -272,7 +273,11 @@ TickReport World::step(double dt, const Budget& budget) {
   quarantined_.clear();
   broken_.clear();
   quarantine(report);  // states edited through bodies() since the last step
-  islands_.beginTick(bodies_, config_.sleeping);  // sleepers held as static until endTick
+  // Sleeping saves physics: without a response nothing sleeps, and every pair
+  // is tested (and reports its contacts) every tick.
+  SleepOptions sleeping = config_.sleeping;
+  sleeping.enabled = sleeping.enabled && config_.response.enabled;
+  islands_.beginTick(bodies_, sleeping);  // sleepers held as static until endTick
   const double t0 = clock_();
   const bool timed_tick = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
   const Deadline tick_end = timed_tick ? Deadline(&clock_, t0 + std::max(budget.tick_seconds, 0.0)) : Deadline();
@@ -299,7 +304,7 @@ TickReport World::step(double dt, const Budget& budget) {
   report.contacts = contacts_.size();
   report.entities = ids_.size();
   reserve_s_ = std::max(t4 - scheduled - report.response_refinement_s, kReserveDecay * reserve_s_);
-  islands_.endTick(bodies_, contacts_, dt, config_.sleeping);
+  islands_.endTick(bodies_, contacts_, dt, sleeping);
   quarantine(report);
   report.sleeping = islands_.sleepingCount();
   return report;

@@ -17,6 +17,18 @@ using stc::InputError;
 }  // namespace
 
 GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
+  // What needs no image is checked first: a bad parameter ends the node at
+  // once, not after the world node's camera arrives (or never does).
+  const std::string mode = paramOr<std::string>(pnh, "mode", "saccades");
+  if (mode != "fixed" && mode != "saccades" && mode != "circle" && mode != "follow") {
+    throw InputError("mode", "unknown value '" + mode + "' (expected one of: fixed, circle, saccades, follow)");
+  }
+  const double rate = positiveParam(pnh, "rate", 30.0);
+  if (mode == "follow") {
+    target_ = paramOr<std::string>(pnh, "target", "");
+    if (target_.empty()) throw InputError("target", "follow needs the tf frame of an entity");
+  }
+
   // The world node's perception camera, as it publishes it (latched): the
   // image for every mode, its tf frame and projection for follow.
   const std::string world_node = paramOr<std::string>(pnh, "world_node", "collision_world");
@@ -32,8 +44,6 @@ GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) 
   camera_frame_ = info->header.frame_id;
   const stc::Vec2 centre(0.5 * width_, 0.5 * height_);
 
-  const std::string mode = paramOr<std::string>(pnh, "mode", "saccades");
-  const double rate = positiveParam(pnh, "rate", 30.0);
   std::vector<double> pixel{centre.x(), centre.y()};
   if (pnh.hasParam("pixel") && (!pnh.getParam("pixel", pixel) || pixel.size() != 2)) {
     throw InputError("pixel", "expected [x, y] in pixels");
@@ -58,15 +68,11 @@ GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) 
     if (circle_radius_ > 0.5 * std::min(width_, height_)) {
       throw InputError("circle_radius", "the circle must fit the image");
     }
-  } else if (mode == "follow") {
+  } else {  // follow (its target is checked above)
     mode_ = Mode::Follow;
-    target_ = paramOr<std::string>(pnh, "target", "");
-    if (target_.empty()) throw InputError("target", "follow needs the tf frame of an entity");
     if (camera_frame_.empty()) throw InputError("mode", "follow needs the camera in tf (world node ~published_camera_frame)");
     tf_ = std::make_unique<tf2_ros::Buffer>();
     listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_, nh_);
-  } else {
-    throw InputError("mode", "unknown value '" + mode + "' (expected one of: fixed, circle, saccades, follow)");
   }
 
   pub_ = nh_.advertise<sphere_tree_collision::GazePoint>("gaze", 10);

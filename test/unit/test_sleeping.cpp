@@ -58,6 +58,41 @@ double highestMover(const Pile& pile) {
   return z;
 }
 
+TEST(Sleeping, WithoutAResponseNothingSleepsAndEveryPairReportsItsContacts) {
+  // Detection alone (the node's ~response false): bodies at rest keep being
+  // tested, so overlapping ones report contacts tick after tick.
+  Pile pile = cubePile();
+  WorldConfig config = pile.world->config();
+  ResponseOptions off = config.response;
+  off.enabled = false;
+  World& world = *pile.world;
+  for (int t = 0; t < 240; ++t) world.step(kDt, Budget::unlimited());  // under gravity, no response: they fall
+  world.setResponse(off);
+  for (BodyState& b : world.bodies()) {  // hold them where they are, overlapping the floor or not
+    b.linear_velocity.setZero();
+    b.angular_velocity.setZero();
+  }
+  world.setGravity(Vec3::Zero());
+  std::size_t contacts = 0;
+  for (int t = 0; t < 120; ++t) {
+    const TickReport r = world.step(kDt, Budget::unlimited());
+    EXPECT_EQ(r.sleeping, 0u);
+    if (t == 0) contacts = r.contacts;
+    EXPECT_EQ(r.contacts, contacts);  // nothing moves: the same contacts every tick
+  }
+  EXPECT_GT(contacts, 0u);
+}
+
+TEST(Sleeping, TurningTheResponseOffWakesEveryIsland) {
+  Pile pile = settledPile();
+  World& world = *pile.world;
+  ResponseOptions off = world.config().response;
+  off.enabled = false;
+  world.setResponse(off);
+  for (EntityId id : pile.spec.movers) EXPECT_FALSE(world.isSleeping(id));
+  EXPECT_EQ(world.step(kDt, Budget::unlimited()).sleeping, 0u);
+}
+
 TEST(Sleeping, PileComesToRestSleepsAndCostsNoSphereTest) {
   Pile pile = settledPile();
   World& world = *pile.world;
