@@ -12,6 +12,9 @@
 #include "sphere_tree_collision/ros/scene_file.hpp"
 
 #include <gtest/gtest.h>
+#include <ros/package.h>
+
+#include <cstdlib>
 
 #include <string>
 
@@ -41,6 +44,32 @@ TEST_F(MeshSpawn, SceneFileEntriesShareTheMeshShape) {
   EXPECT_EQ(v.nz(), 4);  // scaled to 0.2 m: 4 voxels of 0.05 m
   EXPECT_EQ(v.occupiedCount(), 8 * 8 * 4);
   EXPECT_EQ(world.shape(shape).key.rfind("mesh:", 0), 0u) << world.shape(shape).key;
+}
+
+TEST(ShippedMeshScene, LoadsByPackageResourceAndTheLinkComesToRestOnTheScan) {
+  // config/meshes.yaml (README's picture): meshes named package://, resolved
+  // from the source tree the tests run in when no ROS environment says where.
+  if (ros::package::getPath("sphere_tree_collision").empty()) ::setenv("ROS_PACKAGE_PATH", ".", 1);
+  const Scene scene = loadSceneYaml("config/meshes.yaml");
+  stc::WorldConfig config;
+  config.gravity = scene.gravity;
+  stc::World world(config);
+  const std::vector<stc::EntityId> ids = addScene(world, scene);
+  ASSERT_EQ(ids.size(), 3u);
+  const auto link = world.findByName("link"), scan = world.findByName("scan");
+  ASSERT_TRUE(link && scan);
+  for (const auto id : {*link, *scan}) {
+    const stc::ShapeInfo& shape = world.shape(world.bodyShapes()[*world.indexOf(id)]);
+    EXPECT_EQ(shape.key.rfind("mesh:", 0), 0u) << shape.key;
+    EXPECT_GT(shape.voxels.occupiedCount(), 0);
+  }
+  for (int t = 0; t < 240; ++t) world.step(1.0 / 60.0, stc::Budget::unlimited());  // 4 s
+  const stc::BodyState& l = world.bodies()[*world.indexOf(*link)];
+  const stc::BodyState& c = world.bodies()[*world.indexOf(*scan)];
+  EXPECT_GT(l.pose.position.z(), 0.0);            // on the floor or the scan, not through
+  EXPECT_GT(c.pose.position.z(), 0.0);
+  EXPECT_LT(l.linear_velocity.norm(), 0.05);      // at rest
+  EXPECT_LT(c.linear_velocity.norm(), 0.05);
 }
 
 TEST_F(MeshSpawn, SceneFileRejectsAMeshWithAPresetOrAScaleWithoutAMesh) {
