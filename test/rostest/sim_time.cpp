@@ -8,6 +8,7 @@
 #include <sphere_tree_collision/TickStats.h>
 
 #include <set>
+#include <vector>
 
 namespace {
 
@@ -35,6 +36,9 @@ TEST(SimTime, TicksFollowTheClock) {
   // Then 6 s of sim time in quarter ticks, each published once the node has
   // ticked up to one period before it: a loaded machine slows the test, never
   // makes the node skip a period.
+  // Before the node's first tick the clock runs ahead unpaced, and a timer
+  // that falls behind skips what it missed: the period is judged from here on.
+  const ros::Time paced_from = clock.clock;
   const ros::Time end = clock.clock + ros::Duration(6.0);
   while (clock.clock < end) {
     clock.clock += step;
@@ -44,12 +48,17 @@ TEST(SimTime, TicksFollowTheClock) {
         << "last tick stamped " << stats.last.header.stamp << ", clock at " << clock.clock;
   }
 
-  const auto& ticks = stats.all;
-  ASSERT_GE(ticks.size(), 60u);
-  for (std::size_t i = 0; i < ticks.size(); ++i) {
-    EXPECT_EQ(published.count(ticks[i].header.stamp.toNSec()), 1u) << "tick " << ticks[i].tick << " at " << ticks[i].header.stamp;
-    EXPECT_NEAR(ticks[i].physics_time, ticks[i].tick * kDt, 1e-9 * ticks[i].tick);
-    if (i == 0) continue;
+  const auto& all = stats.all;
+  for (const auto& t : all) {
+    EXPECT_EQ(published.count(t.header.stamp.toNSec()), 1u) << "tick " << t.tick << " at " << t.header.stamp;
+    EXPECT_NEAR(t.physics_time, t.tick * kDt, 1e-9 * t.tick);
+  }
+  std::vector<sphere_tree_collision::TickStats> ticks;  // of the paced clock
+  for (const auto& t : all) {
+    if (t.header.stamp > paced_from) ticks.push_back(t);
+  }
+  ASSERT_GE(ticks.size(), 55u);
+  for (std::size_t i = 1; i < ticks.size(); ++i) {
     // One tick per period of the clock: none skipped, none extra.
     EXPECT_EQ(ticks[i].tick, ticks[i - 1].tick + 1);
     EXPECT_NEAR((ticks[i].header.stamp - ticks[i - 1].header.stamp).toSec(), kDt, 1e-9) << "tick " << ticks[i].tick;
