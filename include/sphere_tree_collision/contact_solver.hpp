@@ -107,6 +107,10 @@ class ContactSolver {
                  SolveStats& stats);
   void commitJacobi(std::vector<Vec3>& v, std::vector<Vec3>& w);
   static void applyNormal(const Row& row, double impulse, std::vector<Vec3>& v, std::vector<Vec3>& w);
+  // Friction of one row from the velocities now, clamped to the cone of its
+  // normal impulse so far (incl. the bounce); adds to its lambdas and returns
+  // the change along t1, t2.
+  Eigen::Vector2d frictionStep(Row& row, double mass_t1, double mass_t2) const;
   void solveVelocities(const ResponseOptions& options, int passes);
   int affordableIterations(const ResponseOptions& options, int cap, double pass_seconds,
                            double seconds_left) const;

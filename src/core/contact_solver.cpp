@@ -188,19 +188,10 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
             w_[row.b] += delta * row.ang_b[k];
           }
         };
-        Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
-        const double limit = row.friction * (row.lambda[0] + row.bounce_impulse);
-        const double t1 = row.lambda[1] - mass[1] * vrel.dot(row.t1);
-        const double t2 = row.lambda[2] - mass[2] * vrel.dot(row.t2);
-        const double tn = std::sqrt(t1 * t1 + t2 * t2);
-        const double scale = tn > limit ? (tn > 0.0 ? limit / tn : 0.0) : 1.0;
-        const double d1 = t1 * scale - row.lambda[1];
-        const double d2 = t2 * scale - row.lambda[2];
-        row.lambda[1] += d1;
-        row.lambda[2] += d2;
-        apply(1, d1);
-        apply(2, d2);
-        vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
+        const Eigen::Vector2d d = frictionStep(row, mass[1], mass[2]);
+        apply(1, d.x());
+        apply(2, d.y());
+        const Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
         const double normal = std::max(0.0, row.lambda[0] + mass[0] * (-row.speculative - vrel.dot(row.n)));
         apply(0, normal - row.lambda[0]);
         row.lambda[0] = normal;
@@ -269,6 +260,19 @@ void ContactSolver::applyNormal(const Row& row, double impulse, std::vector<Vec3
   w[row.b] += impulse * row.ang_b[0];
 }
 
+Eigen::Vector2d ContactSolver::frictionStep(Row& row, double mass_t1, double mass_t2) const {
+  const Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
+  const double limit = row.friction * (row.lambda[0] + row.bounce_impulse);
+  const double t1 = row.lambda[1] - mass_t1 * vrel.dot(row.t1);
+  const double t2 = row.lambda[2] - mass_t2 * vrel.dot(row.t2);
+  const double tn = std::sqrt(t1 * t1 + t2 * t2);
+  const double scale = tn > limit ? (tn > 0.0 ? limit / tn : 0.0) : 1.0;
+  const Eigen::Vector2d delta(t1 * scale - row.lambda[1], t2 * scale - row.lambda[2]);
+  row.lambda[1] += delta.x();
+  row.lambda[2] += delta.y();
+  return delta;
+}
+
 void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) {
   const bool jacobi = options.solver == SolverKind::Jacobi;
   std::vector<Vec3>& out_v = jacobi ? dv_ : v_;
@@ -276,24 +280,17 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
   for (int it = 0; it < passes; ++it) {
     for (Row& row : rows_) {
       // Friction first, bounded by the normal impulse so far (Box2D order).
-      Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
-      const double limit = row.friction * (row.lambda[0] + row.bounce_impulse);
-      const double t1 = row.lambda[1] - row.mass[1] * vrel.dot(row.t1);
-      const double t2 = row.lambda[2] - row.mass[2] * vrel.dot(row.t2);
-      const double tn = std::sqrt(t1 * t1 + t2 * t2);
-      const double scale = tn > limit ? (tn > 0.0 ? limit / tn : 0.0) : 1.0;
-      const double d1 = t1 * scale - row.lambda[1];
-      const double d2 = t2 * scale - row.lambda[2];
-      row.lambda[1] += d1;
-      row.lambda[2] += d2;
+      const Eigen::Vector2d d = frictionStep(row, row.mass[1], row.mass[2]);
+      const double d1 = d.x(), d2 = d.y();
       const Vec3 pt = d1 * row.t1 + d2 * row.t2;
       out_v[row.a] -= row.inv_ma * pt;
       out_v[row.b] += row.inv_mb * pt;
       out_w[row.a] -= d1 * row.ang_a[1] + d2 * row.ang_a[2];
       out_w[row.b] += d1 * row.ang_b[1] + d2 * row.ang_b[2];
 
-      // Non-penetration (Jacobi: from the same state as the friction above).
-      if (!jacobi) vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
+      // Non-penetration (Jacobi: v_ is untouched until the commit, so this is
+      // the same state the friction above saw).
+      const Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
       const double normal =
           std::max(0.0, row.lambda[0] + row.mass[0] * (-row.speculative - vrel.dot(row.n)));
       const double dn = normal - row.lambda[0];

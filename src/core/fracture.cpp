@@ -116,36 +116,33 @@ std::vector<VoxelPiece> splitVoxelShape(const VoxelShape& shape, const SplitPlan
   // Tight bounds of each piece's voxels.
   std::vector<Eigen::Vector3i> lo(pieces, Eigen::Vector3i(shape.nx(), shape.ny(), shape.nz()));
   std::vector<Eigen::Vector3i> hi(pieces, Eigen::Vector3i(-1, -1, -1));
-  for (int k = 0; k < shape.nz(); ++k) {
-    for (int j = 0; j < shape.ny(); ++j) {
-      for (int i = 0; i < shape.nx(); ++i) {
-        const std::int32_t l = label[shape.index(i, j, k)];
-        if (l < 0 || piece_of[l] < 0) continue;
-        const int p = piece_of[l];
-        lo[p] = lo[p].cwiseMin(Eigen::Vector3i(i, j, k));
-        hi[p] = hi[p].cwiseMax(Eigen::Vector3i(i, j, k));
+  // Calls visit(piece, cell) for every voxel that went to a piece.
+  const auto forEachPieceVoxel = [&](const auto& visit) {
+    for (int k = 0; k < shape.nz(); ++k) {
+      for (int j = 0; j < shape.ny(); ++j) {
+        for (int i = 0; i < shape.nx(); ++i) {
+          const std::int32_t l = label[shape.index(i, j, k)];
+          if (l >= 0 && piece_of[l] >= 0) visit(piece_of[l], Eigen::Vector3i(i, j, k));
+        }
       }
     }
-  }
+  };
+  forEachPieceVoxel([&](int p, const Eigen::Vector3i& cell) {
+    lo[p] = lo[p].cwiseMin(cell);
+    hi[p] = hi[p].cwiseMax(cell);
+  });
   std::vector<std::vector<std::uint8_t>> grids(pieces);
   for (int p = 0; p < pieces; ++p) {
     const Eigen::Vector3i dims = hi[p] - lo[p] + Eigen::Vector3i::Ones();
     grids[p].assign(static_cast<std::size_t>(dims.x()) * dims.y() * dims.z(), 0);
   }
-  for (int k = 0; k < shape.nz(); ++k) {
-    for (int j = 0; j < shape.ny(); ++j) {
-      for (int i = 0; i < shape.nx(); ++i) {
-        const std::int32_t l = label[shape.index(i, j, k)];
-        if (l < 0 || piece_of[l] < 0) continue;
-        const int p = piece_of[l];
-        const Eigen::Vector3i dims = hi[p] - lo[p] + Eigen::Vector3i::Ones();
-        const Eigen::Vector3i v = Eigen::Vector3i(i, j, k) - lo[p];
-        grids[p][static_cast<std::size_t>(v.x()) +
-                 static_cast<std::size_t>(dims.x()) * (static_cast<std::size_t>(v.y()) +
-                                                       static_cast<std::size_t>(dims.y()) * v.z())] = 1;
-      }
-    }
-  }
+  forEachPieceVoxel([&](int p, const Eigen::Vector3i& cell) {
+    const Eigen::Vector3i dims = hi[p] - lo[p] + Eigen::Vector3i::Ones();
+    const Eigen::Vector3i v = cell - lo[p];
+    grids[p][static_cast<std::size_t>(v.x()) +
+             static_cast<std::size_t>(dims.x()) * (static_cast<std::size_t>(v.y()) +
+                                                   static_cast<std::size_t>(dims.y()) * v.z())] = 1;
+  });
   // A piece is never larger than its parent: the parent's grid and voxel size are its limits.
   VoxelLimits limits;
   limits.max_voxels = static_cast<std::int64_t>(shape.occupancy().size());
