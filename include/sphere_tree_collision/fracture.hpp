@@ -23,10 +23,34 @@ SmallPieces parseSmallPieces(const std::string& name);
 struct FractureOptions {
   int min_piece_voxels = 8;  // >= 1; the largest piece is kept whatever its size
   SmallPieces small_pieces = SmallPieces::Attach;
+  // A piece's strength is the parent's times (piece volume / parent volume)
+  // to this power (pieceStrength). 5/6: the energy balance of a crack
+  // (docs/fracture.md); 0: pieces keep the parent's strength; >= 0.
+  double strength_exponent = 5.0 / 6.0;
 };
-// Throws InputError("fracture.min_piece_voxels") (< 1) or
-// InputError("fracture.small_pieces") (not a known value).
+// Throws InputError("fracture.min_piece_voxels") (< 1),
+// InputError("fracture.small_pieces") (not a known value) or
+// InputError("fracture.strength_exponent") (not finite and >= 0).
 void validateFractureOptions(const FractureOptions& options);
+
+// The strength of a piece of `piece_voxels` cut from a body of
+// `parent_voxels` whose strength is `parent_strength`: the impulse that
+// breaks a body grows as its volume to the power `exponent`.
+double pieceStrength(double parent_strength, std::int64_t piece_voxels, std::int64_t parent_voxels,
+                     double exponent);
+
+// What a new piece's sphere-tree costs, learned from the trees built:
+// seconds per voxel, the largest of recent builds (each build forgets 10 % of
+// the older maximum, so a slow moment is not assumed for ever). Unknown (infinite)
+// until one build is measured, so the first tree is never guessed to fit.
+class TreeCostEstimate {
+ public:
+  double seconds(std::int64_t voxels) const;  // infinity while unknown
+  void record(std::int64_t voxels, double seconds);
+
+ private:
+  double seconds_per_voxel_ = -1.0;  // < 0: unknown
+};
 
 // A plane in a shape's grid frame; the normal is unit.
 struct SplitPlane {

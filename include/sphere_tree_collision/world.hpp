@@ -106,6 +106,8 @@ struct TickReport {
   std::size_t fractures = 0;
   std::size_t fractures_deferred = 0;  // waiting for time: broken from the next tick's start
   double fracture_s = 0.0;
+  std::size_t piece_trees = 0;  // new pieces' sphere-trees built this tick
+  double piece_tree_s = 0.0;    // of fracture_s: building them
   std::size_t sleeping = 0;  // bodies asleep after the tick (islands.hpp)
 };
 
@@ -218,14 +220,25 @@ class World {
   double narrowPhase(const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
   void response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report);
   void quarantine(TickReport& report);  // first and last: removes bodies beyond the limits
-  // After the response: bodies hit harder than their strength break, until
-  // the tick's deadline; the rest wait in pending_breaks_ for the next tick's
-  // start, where at least one breaks and more while the new tick's budget
-  // lasts (world_fracture.cpp). Both take the clock at their start and
-  // return it at their end, reading it only when there is something to break.
+  // After the response: bodies hit harder than their strength are queued in
+  // pending_breaks_. A break is made once its pieces' trees exist; a tree is
+  // built only when its estimated cost (tree_cost_) fits before the tick's
+  // deadline, but for one tree at each tick's start, so the queue always
+  // moves (world_fracture.cpp). Both take the clock at their start and return
+  // it at their end, reading it only when there is something to break.
   double fracture(double now, const Deadline& tick_end, TickReport& report);
   double breakPending(double now, const Deadline& tick_end, TickReport& report);
-  void breakQueued(const Deadline& tick_end, bool at_least_one, TickReport& report);
+  void breakQueued(const Deadline& trees_until, bool one_tree_anyway, TickReport& report);
+  // The fracture plane of an impact at `point` along `normal` (world frame)
+  // on body `index`, in its grid frame (fracturePlane).
+  SplitPlane gridPlaneOf(std::size_t index, const Vec3& point, const Vec3& normal) const;
+  // The split of body `index` by `plane` (its grid frame): its pieces, or
+  // nothing when it stays whole.
+  std::vector<VoxelPiece> piecesOf(std::size_t index, const SplitPlane& plane) const;
+  // A piece's shape: the one with its voxels, or std::nullopt (*key: the key to add it by).
+  std::optional<ShapeId> findPieceShape(const VoxelShape& voxels, std::string* key) const;
+  // Replaces body `index` by `pieces`; their trees are built here if missing.
+  std::vector<EntityId> placePieces(std::size_t index, std::vector<VoxelPiece>& pieces);
   // What the physics phases read and write this tick (physics.hpp); each
   // phase sets what is its own (dt, the solver's budget).
   StepContext physicsStep();
@@ -265,13 +278,14 @@ class World {
   SecondsClock clock_ = steadySeconds;
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step
-  // A break found after the tick's deadline: where, in the body's frame.
+  // A break waiting for its pieces' trees: the plane in the body's grid
+  // frame, so the split is the same whenever it is made.
   struct PendingBreak {
     EntityId id = kInvalidEntity;
-    Vec3 point = Vec3::Zero();
-    Vec3 normal = Vec3::UnitZ();
+    SplitPlane plane;
   };
   std::vector<PendingBreak> pending_breaks_;
+  TreeCostEstimate tree_cost_;  // of the pieces' trees built so far
   std::vector<BrokenEntity> broken_;  // since the last step began
   // Contact impulses on each body this tick (by dense index; ticks with a
   // breakable body in contact only), pooled.

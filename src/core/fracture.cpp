@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <numeric>
 
 namespace stc {
@@ -31,6 +32,27 @@ void validateFractureOptions(const FractureOptions& options) {
   if (options.small_pieces != SmallPieces::Attach && options.small_pieces != SmallPieces::Vanish) {
     throw InputError("fracture.small_pieces", "must be attach or vanish");
   }
+  if (!(std::isfinite(options.strength_exponent) && options.strength_exponent >= 0.0)) {
+    throw InputError("fracture.strength_exponent", "must be finite and >= 0");
+  }
+}
+
+double pieceStrength(double parent_strength, std::int64_t piece_voxels, std::int64_t parent_voxels,
+                     double exponent) {
+  if (exponent == 0.0 || parent_voxels <= 0) return parent_strength;
+  return parent_strength * std::pow(static_cast<double>(piece_voxels) / static_cast<double>(parent_voxels), exponent);
+}
+
+double TreeCostEstimate::seconds(std::int64_t voxels) const {
+  if (seconds_per_voxel_ < 0.0) return std::numeric_limits<double>::infinity();
+  return seconds_per_voxel_ * static_cast<double>(voxels);
+}
+
+void TreeCostEstimate::record(std::int64_t voxels, double seconds) {
+  constexpr double kForget = 0.9;
+  const double rate = seconds / static_cast<double>(std::max<std::int64_t>(voxels, 1));
+  if (!(rate >= 0.0)) return;  // a clock that went back tells nothing
+  seconds_per_voxel_ = seconds_per_voxel_ < 0.0 ? rate : std::max(rate, kForget * seconds_per_voxel_);
 }
 
 SplitPlane fracturePlane(const Vec3& point, const Vec3& normal, const Vec3& centre) {

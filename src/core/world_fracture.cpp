@@ -1,5 +1,6 @@
-// World's part of fracture: which bodies break this tick, and their pieces
-// placed, weighed and set moving as the parent was (fracture.hpp).
+// World's part of fracture: which bodies break this tick, their pieces'
+// trees built inside the tick budget, and the pieces placed, weighed and set
+// moving as the parent was (fracture.hpp).
 #include "sphere_tree_collision/world.hpp"
 
 #include <algorithm>
@@ -10,30 +11,51 @@ namespace stc {
 std::vector<EntityId> World::breakEntity(EntityId id, const Vec3& point, const Vec3& normal) {
   const auto found = indexOf(id);
   if (!found || bodies_[*found].is_static || !point.allFinite() || !(normal.norm() > 0.0)) return {};
-  const BodyState parent = bodies_[*found];  // copied: the arrays change below
-  const ShapeInfo& info = shapes_[body_shapes_[*found]];  // deque: stays put as pieces are added
-  const Mat3 r = parent.pose.orientation.toRotationMatrix();
-  // The body frame is the grid frame moved to the centre of mass.
-  const Vec3 point_grid = r.transpose() * (point - parent.pose.position) + info.body_origin;
-  const SplitPlane plane = fracturePlane(point_grid, r.transpose() * normal, info.body_origin);
-  std::vector<VoxelPiece> pieces = splitVoxelShape(info.voxels, plane, config_.fracture);
-  if (pieces.size() == 1 && pieces[0].voxels == info.voxels.occupiedCount()) return {};
-  if (ids_.size() - 1 + pieces.size() > config_.max_entities) return {};
+  std::vector<VoxelPiece> pieces = piecesOf(*found, gridPlaneOf(*found, point, normal));
+  return placePieces(*found, pieces);
+}
 
+SplitPlane World::gridPlaneOf(std::size_t index, const Vec3& point, const Vec3& normal) const {
+  const Pose& pose = bodies_[index].pose;
+  const ShapeInfo& info = shapes_[body_shapes_[index]];
+  // The body frame is the grid frame moved to the centre of mass.
+  const Quat to_body = pose.orientation.conjugate();
+  return fracturePlane(to_body * (point - pose.position) + info.body_origin, to_body * normal, info.body_origin);
+}
+
+std::vector<VoxelPiece> World::piecesOf(std::size_t index, const SplitPlane& plane) const {
+  const VoxelShape& voxels = shapes_[body_shapes_[index]].voxels;
+  std::vector<VoxelPiece> pieces = splitVoxelShape(voxels, plane, config_.fracture);
+  if (pieces.size() == 1 && pieces[0].voxels == voxels.occupiedCount()) return {};
+  if (ids_.size() - 1 + pieces.size() > config_.max_entities) return {};
+  return pieces;
+}
+
+std::optional<ShapeId> World::findPieceShape(const VoxelShape& voxels, std::string* key) const {
+  // Content key; a clash with different voxels (never seen) gets a suffix.
+  *key = pieceShapeKey(voxels);
+  while (const auto same_key = findShape(*key)) {
+    if (sameVoxels(shapes_[*same_key].voxels, voxels)) return same_key;
+    *key += "'";
+  }
+  return std::nullopt;
+}
+
+std::vector<EntityId> World::placePieces(std::size_t index, std::vector<VoxelPiece>& pieces) {
+  if (pieces.empty()) return {};
+  const BodyState parent = bodies_[index];  // copied: the arrays change below
+  const ShapeInfo& info = shapes_[body_shapes_[index]];  // deque: stays put as pieces are added
+  const Mat3 r = parent.pose.orientation.toRotationMatrix();
   // The parent's density: the pieces' exact mass properties follow from it.
   const double density = 1.0 / (parent.inv_mass * info.unit_mass.mass);
   const double s = info.voxels.voxelSize();
-  const std::string parent_name = names_[*found];
+  const std::string parent_name = names_[index];
   std::vector<EntitySpec> specs(pieces.size());
   int next_name = 0;
   for (std::size_t k = 0; k < pieces.size(); ++k) {
-    // Content key; a clash with different voxels (never seen) gets a suffix.
-    std::string key = pieceShapeKey(pieces[k].shape);
-    while (const auto same_key = findShape(key)) {
-      if (sameVoxels(shapes_[*same_key].voxels, pieces[k].shape)) break;
-      key += "'";
-    }
-    const ShapeId shape = addShape(key, std::move(pieces[k].shape));
+    std::string key;
+    const auto found = findPieceShape(pieces[k].shape, &key);
+    const ShapeId shape = found ? *found : addShape(key, std::move(pieces[k].shape));
     // The piece's centre of mass, from the parent's: its voxels stay where they were.
     const Vec3 offset = r * (pieces[k].offset.cast<double>() * s + shapes_[shape].body_origin - info.body_origin);
     EntitySpec& spec = specs[k];
@@ -44,6 +66,8 @@ std::vector<EntityId> World::breakEntity(EntityId id, const Vec3& point, const V
     spec.angular_velocity = parent.angular_velocity;
     spec.density = density;
     spec.material = parent.material;
+    spec.material.strength = pieceStrength(parent.material.strength, pieces[k].voxels,
+                                           info.voxels.occupiedCount(), config_.fracture.strength_exponent);
     if (!parent_name.empty()) {
       do {
         spec.name = parent_name + "/piece" + std::to_string(next_name++);
@@ -58,7 +82,8 @@ std::vector<EntityId> World::breakEntity(EntityId id, const Vec3& point, const V
       return {};
     }
   }
-  BrokenEntity broken{id, parent_name, body_shapes_[*found], {}};
+  const EntityId id = ids_[index];
+  BrokenEntity broken{id, parent_name, body_shapes_[index], {}};
   removeEntity(id);
   for (const EntitySpec& spec : specs) broken.pieces.push_back(addEntity(spec));
   broken_.push_back(broken);
@@ -87,9 +112,9 @@ double World::fracture(double now, const Deadline& tick_end, TickReport& report)
       }
     }
   }
-  // Where each breaking body is hit, in its own frame (the dense indices and
-  // the contacts go stale with the first break), queued after the breaks
-  // older ticks had no time for.
+  // Each breaking body's plane, in its own frame (the dense indices and the
+  // contacts go stale with the first break), queued after the breaks older
+  // ticks had no time for.
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     const BodyState& body = bodies_[i];
     if (body.is_static || !(body.material.strength > 0.0) || !(hits_[i].impulse > body.material.strength)) continue;
@@ -98,8 +123,7 @@ double World::fracture(double now, const Deadline& tick_end, TickReport& report)
                                     [id](const PendingBreak& p) { return p.id == id; });
     if (queued) continue;
     const Contact& c = contacts_[hits_[i].hardest];
-    const Quat to_body = body.pose.orientation.conjugate();
-    pending_breaks_.push_back({id, to_body * (c.point - body.pose.position), to_body * c.normal});
+    pending_breaks_.push_back({id, gridPlaneOf(i, c.point, c.normal)});
   }
   breakQueued(tick_end, false, report);
   const double end = clock_();
@@ -109,22 +133,44 @@ double World::fracture(double now, const Deadline& tick_end, TickReport& report)
 
 double World::breakPending(double now, const Deadline& tick_end, TickReport& report) {
   if (pending_breaks_.empty()) return now;
-  breakQueued(tick_end, true, report);
+  // At the tick's start one tree only (and the breaks whose trees exist):
+  // integrate and the broad phase that follow cannot be cut short, so more
+  // trees wait for the tick's end, where the time left is known.
+  breakQueued(tick_end.isSet() ? Deadline(&clock_, now) : tick_end, true, report);
   const double end = clock_();
   report.fracture_s += end - now;
   return end;
 }
 
-// Oldest first, until the deadline (at least one when asked: the queue
-// always moves); the rest wait for the next tick.
-void World::breakQueued(const Deadline& tick_end, bool at_least_one, TickReport& report) {
+// Oldest first. A break is made once all its pieces' trees exist (equal
+// pieces share one); a missing tree is built when its estimated cost fits
+// before the deadline, or, once, when asked (the queue always moves). The
+// first break whose trees do not fit stops the walk: it and the rest wait.
+void World::breakQueued(const Deadline& trees_until, bool one_tree_anyway, TickReport& report) {
   std::size_t done = 0;
-  while (done < pending_breaks_.size() && ((at_least_one && done == 0) || !tick_end.passed())) {
-    const PendingBreak& p = pending_breaks_[done++];
+  for (; done < pending_breaks_.size(); ++done) {
+    const PendingBreak& p = pending_breaks_[done];
     const auto index = indexOf(p.id);
     if (!index) continue;  // removed meanwhile
-    const Pose pose = bodies_[*index].pose;
-    if (!breakEntity(p.id, pose.apply(p.point), pose.orientation * p.normal).empty()) ++report.fractures;
+    std::vector<VoxelPiece> pieces = piecesOf(*index, p.plane);
+    bool ready = true;
+    for (const VoxelPiece& piece : pieces) {
+      std::string key;
+      if (findPieceShape(piece.shape, &key)) continue;
+      if (!one_tree_anyway && !(tree_cost_.seconds(piece.voxels) <= trees_until.remaining())) {
+        ready = false;
+        break;
+      }
+      one_tree_anyway = false;
+      const double start = clock_();
+      addShape(key, piece.shape);
+      const double seconds = clock_() - start;
+      tree_cost_.record(piece.voxels, seconds);
+      ++report.piece_trees;
+      report.piece_tree_s += seconds;
+    }
+    if (!ready) break;
+    if (!placePieces(*index, pieces).empty()) ++report.fractures;
   }
   pending_breaks_.erase(pending_breaks_.begin(), pending_breaks_.begin() + done);
   report.fractures_deferred = pending_breaks_.size();

@@ -347,16 +347,138 @@ TEST(FractureWorld, BreaksAfterTheDeadlineWaitForTheNextTick) {
     }
   }
   ASSERT_GE(deferred_tick, 0) << "nothing broke";
-  const TickReport next = w.step(kDt, Budget::ofTickSeconds(1e-4));
+  // Each next tick builds one of the pieces' trees at its start (the queue
+  // always moves, whatever the budget); the tick that has them all breaks it.
+  TickReport next;
+  int ticks = 0;
+  do {
+    next = w.step(kDt, Budget::ofTickSeconds(1e-4));
+    ++ticks;
+    EXPECT_EQ(next.piece_trees, 1u) << "tick " << ticks;
+    EXPECT_GT(next.fracture_s, 0.0);
+  } while (next.fractures == 0 && ticks < 10);
   EXPECT_EQ(next.fractures, 1u);
-  EXPECT_GT(next.fracture_s, 0.0);
+  EXPECT_EQ(next.fractures_deferred, 0u);
   EXPECT_FALSE(w.findByName("rock").has_value());
-  EXPECT_TRUE(w.findByName("rock/piece0").has_value());
+  ASSERT_TRUE(w.findByName("rock/piece0").has_value());
+  ASSERT_EQ(w.broken().size(), 1u);
+  std::vector<ShapeId> shapes;
+  for (const EntityId piece : w.broken()[0].pieces) shapes.push_back(w.bodyShapes()[*w.indexOf(piece)]);
+  std::sort(shapes.begin(), shapes.end());
+  EXPECT_EQ(ticks, std::unique(shapes.begin(), shapes.end()) - shapes.begin()) << "one tick per new tree";
 }
 
-TEST(FractureWorld, OverBudgetBreaksGoOnePerTick) {
-  // Three rocks hit the slab in the same tick; every tick is over budget, so
-  // each tick breaks one (the queue always moves) and defers the rest.
+// A clock on which time passes only while shapes are added: every voxel of a
+// shape added after it was made costs `per_voxel` seconds. The pieces' trees
+// are then the whole cost of a tick, and deterministic.
+class TreeWorkClock {
+ public:
+  TreeWorkClock(const World& w, double per_voxel) : w_(&w), first_(w.shapeCount()), per_voxel_(per_voxel) {}
+  double operator()() const {
+    double t = 0.0;
+    for (ShapeId s = first_; s < w_->shapeCount(); ++s) t += per_voxel_ * w_->shape(s).voxels.occupiedCount();
+    return t;
+  }
+
+ private:
+  const World* w_;
+  ShapeId first_;
+  double per_voxel_;
+};
+
+// How far a body of `shape` turned by `q` reaches from its centre of mass along `dir`.
+double reach(const World& w, ShapeId shape, const Quat& q, const Vec3& dir) {
+  const ShapeInfo& info = w.shape(shape);
+  const double s = info.voxels.voxelSize();
+  double most = -std::numeric_limits<double>::infinity();
+  for (const auto& v : voxelsOf(info.voxels)) {
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 p = Vec3(v[0] + (corner & 1), v[1] + ((corner >> 1) & 1), v[2] + ((corner >> 2) & 1)) * s;
+      most = std::max(most, (q * (p - info.body_origin)).dot(dir));
+    }
+  }
+  return most;
+}
+
+TEST(FractureWorld, PieceTreesKeepTheTickDeadlineAndEveryBreakIsMadeWithMomentumKept) {
+  // No gravity, nothing static: four breakable rocks, each turned its own
+  // way (their pieces differ), hit a free 1 m block in the same tick; every
+  // impulse is internal, so the world's linear momentum is constant, breaks
+  // included.
+  World w;
+  EntitySpec block;
+  block.shape = w.addShape("block", solidBox(10, 10, 10, 0.1));
+  block.density = 1000.0;
+  w.addEntity(block);
+  const ShapeId rock = rockShape(w);
+  const std::int64_t rock_voxels = w.shape(rock).voxels.occupiedCount();
+  const std::array<Vec3, 4> towards = {Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY()};
+  for (int k = 0; k < 4; ++k) {
+    EntitySpec s = spec(rock, Vec3::Zero(), "rock" + std::to_string(k), 1.0);
+    s.pose.orientation = Quat(Eigen::AngleAxisd(0.4 + 0.7 * k, Vec3(1.0, 2.0 - k, 0.5 + k).normalized()));
+    // 0.1 m from the block's face: all four touch it in the same tick.
+    s.pose.position = -towards[k] * (0.5 + 0.1 + reach(w, rock, s.pose.orientation, towards[k]));
+    s.linear_velocity = 12.0 * towards[k];
+    s.angular_velocity = Vec3(0.5, 2.0, -1.0) * (k + 1);
+    w.addEntity(s);
+  }
+  // A whole rock's trees cost 40 % of the tick: four rocks' do not fit in one.
+  const double budget = 0.01;
+  w.setClock(TreeWorkClock(w, 0.4 * budget / static_cast<double>(rock_voxels)));
+  const Vec3 p0 = linearMomentum(w.bodies());
+  double scale = 0.0;
+  for (const BodyState& b : w.bodies()) scale += b.linear_velocity.norm() / b.inv_mass;
+
+  std::size_t breaks = 0, trees = 0, most_deferred = 0, trees_of_one_tick = 0;
+  TickReport r;
+  for (int i = 0; i < 120; ++i) {
+    r = w.step(kDt, Budget::ofTickSeconds(budget));
+    // Stamps of the World's clock: the tick ends by its deadline.
+    EXPECT_LE(r.total_s, budget * (1.0 + 1e-12)) << "tick " << i << ": " << r.piece_trees << " trees";
+    EXPECT_LE((linearMomentum(w.bodies()) - p0).norm(), 1e-9 * scale) << "tick " << i;
+    breaks += r.fractures;
+    trees += r.piece_trees;
+    most_deferred = std::max(most_deferred, r.fractures_deferred);
+    trees_of_one_tick = std::max(trees_of_one_tick, r.piece_trees);
+  }
+  EXPECT_GE(breaks, 3u);
+  EXPECT_GE(most_deferred, 1u) << "every break fitted: the test does not load the budget";
+  EXPECT_LT(trees_of_one_tick, trees) << "the trees were not spread over ticks";
+  EXPECT_EQ(r.fractures_deferred, 0u) << "a deferred break was never made";
+  for (const char* name : {"rock0", "rock1", "rock2", "rock3"}) EXPECT_FALSE(w.findByName(name).has_value()) << name;
+}
+
+TEST(FractureWorld, PiecesAreWeakerAsTheirVolumeToTheExponent) {
+  EXPECT_DOUBLE_EQ(pieceStrength(8.0, 1, 8, 1.0 / 3.0), 4.0);
+  EXPECT_DOUBLE_EQ(pieceStrength(8.0, 1, 8, 0.0), 8.0);
+  World w;
+  const ShapeId cube = w.addShape("cube6", solidBox(6, 6, 6));
+  const EntityId a = w.addEntity(spec(cube, Vec3::Zero(), "a", 10.0));
+  const std::vector<EntityId> pieces = w.breakEntity(a, Vec3(0.0, 0.0, -0.15), Vec3::UnitY());
+  ASSERT_GE(pieces.size(), 2u);
+  for (const EntityId piece : pieces) {
+    const std::size_t i = *w.indexOf(piece);
+    const double share = static_cast<double>(w.shape(w.bodyShapes()[i]).voxels.occupiedCount()) / 216.0;
+    EXPECT_NEAR(w.bodies()[i].material.strength, 10.0 * std::pow(share, 5.0 / 6.0), 1e-12);
+  }
+}
+
+TEST(FractureWorld, TreeCostIsUnknownUntilMeasuredThenTheLargestRecentRate) {
+  TreeCostEstimate cost;
+  EXPECT_EQ(cost.seconds(10), std::numeric_limits<double>::infinity());
+  cost.record(100, 1e-3);
+  EXPECT_DOUBLE_EQ(cost.seconds(50), 0.5e-3);
+  cost.record(100, 0.5e-3);  // faster: 10 % of the older rate forgotten
+  EXPECT_DOUBLE_EQ(cost.seconds(100), 0.9e-3);
+  cost.record(100, 2e-3);    // slower: taken at once
+  EXPECT_DOUBLE_EQ(cost.seconds(100), 2e-3);
+}
+
+TEST(FractureWorld, OverBudgetTicksBuildOneTreeEach) {
+  // Three equal rocks hit the slab alike in the same tick; every tick is over
+  // budget, so each tick builds one tree (the queue always moves) and defers
+  // the rest. Their pieces are equal: once the first rock's trees exist, the
+  // others break in the same tick, for free.
   World w = dropScene(1.0);
   const ShapeId rock = w.bodyShapes()[*w.indexOf(*w.findByName("rock"))];
   for (const double y : {-1.0, 1.0}) {
@@ -367,14 +489,16 @@ TEST(FractureWorld, OverBudgetBreaksGoOnePerTick) {
   }
   double now = 0.0;
   w.setClock([&now] { return now += 1e-3; });
-  std::size_t breaks = 0, most_deferred = 0;
+  std::size_t breaks = 0, most_deferred = 0, trees = 0;
   for (int i = 0; i < 120; ++i) {
     const TickReport r = w.step(kDt, Budget::ofTickSeconds(1e-4));
-    EXPECT_LE(r.fractures, 1u) << "tick " << i;
+    EXPECT_LE(r.piece_trees, 1u) << "tick " << i;
     breaks += r.fractures;
+    trees += r.piece_trees;
     most_deferred = std::max(most_deferred, r.fractures_deferred);
   }
   EXPECT_GE(breaks, 3u);
+  EXPECT_GE(trees, 2u);
   EXPECT_GE(most_deferred, 2u);
   for (const char* name : {"rock", "rock0", "rock1"}) EXPECT_FALSE(w.findByName(name).has_value()) << name;
 }
@@ -404,6 +528,19 @@ TEST(FractureWorld, BadStrengthIsRejectedNamingTheField) {
     }
   }
   EXPECT_EQ(w.entityCount(), 0u);
+}
+
+TEST(FractureWorld, BadStrengthExponentIsRejectedNamingTheField) {
+  for (const double bad : {-0.5, std::numeric_limits<double>::quiet_NaN()}) {
+    WorldConfig config;
+    config.fracture.strength_exponent = bad;
+    try {
+      World w(config);
+      FAIL() << "accepted strength_exponent " << bad;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), "fracture.strength_exponent");
+    }
+  }
 }
 
 }  // namespace
