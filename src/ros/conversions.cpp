@@ -2,6 +2,8 @@
 
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <Eigen/LU>
+
 #include <climits>
 #include <map>
 
@@ -42,6 +44,20 @@ geometry_msgs::Pose toPoseMsg(const stc::Pose& pose) {
   geometry_msgs::Pose m;
   m.position = toPointMsg(pose.position);
   m.orientation = toQuaternionMsg(pose.orientation);
+  return m;
+}
+
+geometry_msgs::Inertia toInertiaMsg(const stc::BodyState& body) {
+  geometry_msgs::Inertia m;
+  if (body.is_static || !(body.inv_mass > 0.0)) return m;
+  m.m = 1.0 / body.inv_mass;
+  const stc::Mat3 inertia = body.inv_inertia_body.inverse();
+  m.ixx = inertia(0, 0);
+  m.ixy = inertia(0, 1);
+  m.ixz = inertia(0, 2);
+  m.iyy = inertia(1, 1);
+  m.iyz = inertia(1, 2);
+  m.izz = inertia(2, 2);
   return m;
 }
 

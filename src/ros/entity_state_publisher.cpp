@@ -40,6 +40,7 @@ void EntityStatePublisher::publishListIfChanged(const stc::World& world, const F
     e.frame = frameOf(frames, ids[i], fallback);
     e.shape = world.shape(world.bodyShapes()[i]).key;
     e.is_static = world.bodies()[i].is_static;
+    e.inertia = toInertiaMsg(world.bodies()[i]);
   }
   list_pub_.publish(list);
 }

@@ -355,6 +355,10 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.real_time_factor = clock_.realTimeFactor();
   s.paused = paused_;
   s.sleeping = static_cast<std::uint32_t>(r.sleeping);
+  s.fractures = static_cast<std::uint32_t>(r.fractures);
+  s.fractures_waiting = static_cast<std::uint32_t>(r.fractures_deferred);
+  s.piece_trees = static_cast<std::uint32_t>(r.piece_trees);
+  s.fracture_ms = r.fracture_s * 1e3;
   diagnostics_->onTick(s);
   if (stats_pub_.getNumSubscribers() > 0) stats_pub_.publish(s);
 }

@@ -1,11 +1,13 @@
 // Conversions between ROS messages and core types. ROS side only.
 #pragma once
 
+#include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/ros/entity_request.hpp"
 #include "sphere_tree_collision/types.hpp"
 
 #include <sphere_tree_collision/SpawnEntity.h>
 
+#include <geometry_msgs/Inertia.h>
 #include <geometry_msgs/Point.h>
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Quaternion.h>
@@ -30,6 +32,9 @@ geometry_msgs::Vector3 toVector3Msg(const stc::Vec3& v);
 geometry_msgs::Quaternion toQuaternionMsg(const stc::Quat& q);
 geometry_msgs::Pose toPoseMsg(const stc::Pose& pose);
 std_msgs::ColorRGBA toColorMsg(float r, float g, float b, float a);
+// Mass and inertia tensor in the body frame (origin at the centre of mass,
+// so com is 0); all 0 for a static body.
+geometry_msgs::Inertia toInertiaMsg(const stc::BodyState& body);
 
 // The message of an InputError without its "field: " prefix, for re-raising
 // the error under another field name.
