@@ -6,6 +6,8 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <sstream>
 #include <system_error>
@@ -14,6 +16,12 @@ namespace stc {
 namespace {
 
 const std::string kFileScheme = "file://";
+
+bool isDae(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".dae";
+}
 
 std::string number(double v) {
   std::ostringstream out;
@@ -34,7 +42,7 @@ std::string meshResourcePath(const std::string& resource) {
   return resource;
 }
 
-TriangleMesh loadTriangleMesh(const std::string& resource, const Vec3& scale) {
+TriangleMesh loadTriangleMesh(const std::string& resource, const Vec3& scale, ColladaUpAxis up_axis) {
   if (!scale.allFinite() || !(scale.minCoeff() > 0.0)) {
     throw InputError("scale", "every component must be finite and > 0, got (" + number(scale.x()) + ", " +
                                   number(scale.y()) + ", " + number(scale.z()) + ")");
@@ -47,7 +55,11 @@ TriangleMesh loadTriangleMesh(const std::string& resource, const Vec3& scale) {
     throw InputError("mesh_resource", resource + ": not a regular file");
   }
   Assimp::Importer importer;
-  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
+  // assimp turns a DAE whose up axis is not Y_UP so that it is (its root
+  // node's transform), unless told to ignore the up axis; the unit is
+  // applied either way.
+  const bool to_z_up = up_axis == ColladaUpAxis::ToZUp && isDae(path);
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, !to_z_up);
   // No welding or normal fixing: the voxeliser copes with duplicated vertices
   // and reports them; node transforms are baked into the vertices.
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices);
@@ -60,7 +72,9 @@ TriangleMesh loadTriangleMesh(const std::string& resource, const Vec3& scale) {
     const auto base = static_cast<std::int32_t>(mesh.vertices.size());
     for (unsigned v = 0; v < in.mNumVertices; ++v) {
       const aiVector3D& p = in.mVertices[v];
-      mesh.vertices.push_back(Vec3(p.x, p.y, p.z).cwiseProduct(scale));
+      // assimp's y up to ROS's z up: +90 degrees about x.
+      const Vec3 vertex = to_z_up ? Vec3(p.x, -p.z, p.y) : Vec3(p.x, p.y, p.z);
+      mesh.vertices.push_back(vertex.cwiseProduct(scale));
     }
     for (unsigned f = 0; f < in.mNumFaces; ++f) {
       const aiFace& face = in.mFaces[f];

@@ -6,7 +6,8 @@
 
 namespace stc {
 
-std::string meshShapeKey(const std::string& resource, const Vec3& scale, const VoxeliseOptions& options) {
+std::string meshShapeKey(const std::string& resource, const Vec3& scale, const VoxeliseOptions& options,
+                         ColladaUpAxis up_axis) {
   std::ostringstream key;
   key.precision(17);
   key << "mesh:" << resource << '@' << scale.x() << ',' << scale.y() << ',' << scale.z() << '/';
@@ -15,14 +16,16 @@ std::string meshShapeKey(const std::string& resource, const Vec3& scale, const V
   } else {
     key << 'r' << options.resolution;
   }
+  if (up_axis == ColladaUpAxis::ToZUp) key << "/z_up";
   return key.str();
 }
 
-ShapeId addMeshShape(World& world, const std::string& resource, const Vec3& scale, VoxeliseOptions options) {
-  const std::string key = meshShapeKey(resource, scale, options);
+ShapeId addMeshShape(World& world, const std::string& resource, const Vec3& scale, VoxeliseOptions options,
+                     ColladaUpAxis up_axis) {
+  const std::string key = meshShapeKey(resource, scale, options, up_axis);
   if (const auto found = world.findShape(key)) return *found;
   options.source = resource;
-  VoxelisedMesh voxels = voxeliseMesh(loadTriangleMesh(resource, scale), options);
+  VoxelisedMesh voxels = voxeliseMesh(loadTriangleMesh(resource, scale, up_axis), options);
   return world.addShape(key, std::move(voxels.shape));
 }
 

@@ -62,11 +62,13 @@ void writeObj(const TriangleMesh& mesh, const std::string& path) {
   for (const auto& t : mesh.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
 }
 
-void writeDae(const TriangleMesh& mesh, const std::string& path) {
+void writeDae(const TriangleMesh& mesh, const std::string& path, const std::string& up_axis,
+              double metres_per_unit) {
   std::ofstream out = open(path);
   out << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
          "<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n"
-         " <asset><unit name=\"meter\" meter=\"1\"/><up_axis>Z_UP</up_axis></asset>\n"
+         " <asset><unit name=\"unit\" meter=\"" << metres_per_unit << "\"/><up_axis>" << up_axis
+      << "</up_axis></asset>\n"
          " <library_geometries><geometry id=\"shape\"><mesh>\n"
          "  <source id=\"shape-positions\">\n"
          "   <float_array id=\"shape-positions-array\" count=\"" << 3 * mesh.vertices.size() << "\">";

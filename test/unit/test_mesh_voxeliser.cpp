@@ -215,6 +215,53 @@ TEST_F(MeshFiles, EveryFormatLoadsToTheSameSolid) {
   }
 }
 
+TEST_F(MeshFiles, DaeUpAxisIsAsWrittenByDefaultAndTurnedToZUpOnRequest) {
+  // A box from (0,0,0) to (1,2,3): its extent shows which way it was turned.
+  const TriangleMesh box = truth::boxMesh(Vec3::Zero(), Vec3(1.0, 2.0, 3.0));
+  const std::string z_up = file("z_up.dae"), y_up = file("y_up.dae"), x_up = file("x_up.dae"),
+                    y_up_cm = file("y_up_cm.DAE"), stl = file("box.stl");
+  truth::writeDae(box, z_up, "Z_UP");
+  truth::writeDae(box, y_up, "Y_UP");
+  truth::writeDae(box, x_up, "X_UP");
+  truth::writeDae(box, y_up_cm, "Y_UP", 0.01);
+  truth::writeStlAscii(box, stl);
+  const auto bounds = [](const std::string& path, ColladaUpAxis up, const Vec3& scale = Vec3::Ones()) {
+    const MeshStats s = computeMeshStats(loadTriangleMesh(path, scale, up));
+    return std::make_pair(s.min, s.max);
+  };
+  const auto expect_bounds = [&](const std::string& path, ColladaUpAxis up, const Vec3& lo, const Vec3& hi) {
+    const auto [min, max] = bounds(path, up);
+    EXPECT_LT((min - lo).norm(), 1e-9) << path << " min " << min.transpose();
+    EXPECT_LT((max - hi).norm(), 1e-9) << path << " max " << max.transpose();
+  };
+  // As written (rviz, MoveIt, Gazebo): the up axis changes nothing, the unit applies.
+  for (const std::string& path : {z_up, y_up, x_up, stl}) {
+    expect_bounds(path, ColladaUpAxis::AsWritten, Vec3::Zero(), Vec3(1.0, 2.0, 3.0));
+  }
+  expect_bounds(y_up_cm, ColladaUpAxis::AsWritten, Vec3::Zero(), Vec3(0.01, 0.02, 0.03));
+  // To z up: the file's up axis becomes +z. Z_UP and STL stay; Y_UP turns
+  // +90 deg about x ((x, y, z) -> (x, -z, y)); X_UP's +x becomes +z.
+  expect_bounds(z_up, ColladaUpAxis::ToZUp, Vec3::Zero(), Vec3(1.0, 2.0, 3.0));
+  expect_bounds(stl, ColladaUpAxis::ToZUp, Vec3::Zero(), Vec3(1.0, 2.0, 3.0));
+  expect_bounds(y_up, ColladaUpAxis::ToZUp, Vec3(0.0, -3.0, 0.0), Vec3(1.0, 0.0, 2.0));
+  expect_bounds(x_up, ColladaUpAxis::ToZUp, Vec3(-2.0, -3.0, 0.0), Vec3(0.0, 0.0, 1.0));
+  expect_bounds(y_up_cm, ColladaUpAxis::ToZUp, Vec3(0.0, -0.03, 0.0), Vec3(0.01, 0.0, 0.02));
+  // The scale is per axis of the result.
+  const auto [min, max] = bounds(y_up, ColladaUpAxis::ToZUp, Vec3(2.0, 1.0, 1.0));
+  EXPECT_NEAR(max.x() - min.x(), 2.0, 1e-9);
+
+  // The two readings are two shapes, keyed apart.
+  World world;
+  const ShapeId as_written = addMeshShape(world, y_up, Vec3::Ones(), atResolution(8));
+  const ShapeId turned = addMeshShape(world, y_up, Vec3::Ones(), atResolution(8), ColladaUpAxis::ToZUp);
+  EXPECT_NE(as_written, turned);
+  EXPECT_EQ(world.shape(turned).key, meshShapeKey(y_up, Vec3::Ones(), atResolution(8), ColladaUpAxis::ToZUp));
+  const VoxelShape& a = world.shape(as_written).voxels;
+  const VoxelShape& b = world.shape(turned).voxels;
+  EXPECT_EQ(a.nz(), b.ny()) << "the long side (z as written) is along y once turned";
+  EXPECT_EQ(a.occupiedCount(), b.occupiedCount());
+}
+
 TEST_F(MeshFiles, FileUriAndScaleAreApplied) {
   const std::string path = file("cube.stl");
   truth::writeStlAscii(cubeMesh(1.0), path);
