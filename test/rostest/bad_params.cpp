@@ -92,6 +92,7 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"scene", heavy_scene}}, "scene gravity"},
       {world, {{"gravity", list({0, 0, 1e308})}}, "gravity"},
       {world, {{"max_speed", -1.0}}, "max_speed"},
+      {world, {{"strength_exponent", -0.5}}, "strength_exponent"},
       {world, {{"min_density", 10.0}, {"max_density", 1.0}}, "min_density"},
       {world, {{"scene", "rockfall"}, {"scene_entities", 30000}}, "scene_entities"},
       {world, {{"entity_states_rate", 0.0}}, "entity_states_rate"},
