@@ -24,6 +24,8 @@ std::string meshResourcePath(const std::string& resource);
 // file is turned +90 degrees about x and a Z_UP file stays as written.
 // STL and OBJ have no up axis: both read them as written.
 enum class ColladaUpAxis : std::uint8_t { AsWritten, ToZUp };
+// "" or "as_written" | "z_up"; throws InputError("up_axis").
+ColladaUpAxis parseColladaUpAxis(const std::string& name);
 
 // Every triangle of every mesh in the file, with the scene's node transforms
 // (and a DAE's unit and, by `up_axis`, its up axis) applied, then scaled per

@@ -31,6 +31,12 @@ std::string number(double v) {
 
 }  // namespace
 
+ColladaUpAxis parseColladaUpAxis(const std::string& name) {
+  if (name.empty() || name == "as_written") return ColladaUpAxis::AsWritten;
+  if (name == "z_up") return ColladaUpAxis::ToZUp;
+  throw InputError("up_axis", "'" + name + "' is not one of as_written, z_up");
+}
+
 std::string meshResourcePath(const std::string& resource) {
   if (resource.empty()) throw InputError("mesh_resource", "is empty");
   if (resource.compare(0, kFileScheme.size(), kFileScheme) == 0) return resource.substr(kFileScheme.size());

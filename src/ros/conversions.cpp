@@ -89,9 +89,12 @@ EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg,
     const stc::Vec3 scale = toEigen(msg.scale);
     r.mesh_scale = scale.isZero(0.0) ? stc::Vec3::Ones() : scale;
     r.mesh_voxel_size = msg.voxel_size;
+    r.mesh_up_axis = stc::parseColladaUpAxis(msg.up_axis);
     const std::uint32_t resolution = msg.resolution == 0 ? default_resolution : msg.resolution;
     if (resolution > 1024) throw stc::InputError("resolution", "must be <= 1024 for a mesh");
     r.preset_params.resolution = static_cast<int>(resolution);
+  } else if (!msg.up_axis.empty()) {
+    throw stc::InputError("up_axis", "only for a mesh_resource");
   } else if (!msg.preset.empty()) {
     if (has_grid) throw stc::InputError("preset", "give either a preset or dims + occupancy, not both");
     r.preset = msg.preset;

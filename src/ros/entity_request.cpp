@@ -88,7 +88,8 @@ stc::EntityId addRequest(stc::World& world, EntityRequest request) {
     options.resolution = request.preset_params.resolution;
     options.limits = world.config().voxel_limits;
     request.spec.shape =
-        stc::addMeshShape(world, resolveMeshResource(request.mesh_resource), request.mesh_scale, options);
+        stc::addMeshShape(world, resolveMeshResource(request.mesh_resource), request.mesh_scale, options,
+                          request.mesh_up_axis);
   } else if (!request.preset.empty()) {
     if (request.grid) throw stc::InputError("preset", "give either a preset or an explicit grid, not both");
     const std::string key = presetShapeKey(request.preset, request.preset_params);

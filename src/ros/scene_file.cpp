@@ -117,16 +117,25 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   checkKeys(node, p,
             {"name", "preset", "resolution", "voxel_size", "seed", "position", "orientation", "velocity",
              "angular_velocity", "density", "restitution", "friction", "color", "static", "box_mode",
-             "repeat", "mesh_resource", "scale", "strength"});
+             "repeat", "mesh_resource", "scale", "strength", "up_axis"});
   EntityRequest r;
   if (node["mesh_resource"]) {
     r.mesh_resource = readString(node["mesh_resource"], p + "mesh_resource");
     if (node["preset"]) throw InputError(p + "mesh_resource", "give a mesh or a preset, not both");
     if (node["scale"]) r.mesh_scale = readVec3(node["scale"], p + "scale");
     if (node["voxel_size"]) r.mesh_voxel_size = readDouble(node["voxel_size"], p + "voxel_size");
+    if (node["up_axis"]) {
+      const std::string up_axis = readString(node["up_axis"], p + "up_axis");
+      try {
+        r.mesh_up_axis = stc::parseColladaUpAxis(up_axis);
+      } catch (const InputError& e) {
+        throw InputError(p + "up_axis", reasonOf(e));
+      }
+    }
   } else {
     if (!node["preset"]) throw InputError(p + "preset", "missing (or give a mesh_resource)");
     if (node["scale"]) throw InputError(p + "scale", "only for a mesh_resource");
+    if (node["up_axis"]) throw InputError(p + "up_axis", "only for a mesh_resource");
     r.preset = readString(node["preset"], p + "preset");
   }
   if (node["name"]) r.spec.name = readString(node["name"], p + "name");

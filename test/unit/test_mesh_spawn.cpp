@@ -15,7 +15,7 @@
 #include <ros/package.h>
 
 #include <cstdlib>
-
+#include <functional>
 #include <string>
 
 namespace stc_ros {
@@ -109,6 +109,53 @@ TEST_F(MeshSpawn, SpawnMessageWithAMeshAddsItScaled) {
   } catch (const stc::InputError& e) {
     EXPECT_EQ(e.field(), "mesh_resource");
   }
+}
+
+TEST_F(MeshSpawn, ADaeUpAxisIsAsWrittenUnlessZUpIsAsked) {
+  // A Y_UP box 0.2 x 0.4 x 0.6 m: as written (rviz) its long side is z; with
+  // up_axis z_up the file's y becomes z, so the long side lies along y.
+  const std::string dae = dir_.file("box_y_up.dae");
+  stc::truth::writeDae(stc::truth::boxMesh(stc::Vec3::Zero(), stc::Vec3(0.2, 0.4, 0.6)), dae, "Y_UP");
+  sphere_tree_collision::SpawnEntity msg;
+  msg.mesh_resource = "file://" + dae;
+  msg.voxel_size = 0.05;
+  msg.density = 1000.0;
+  msg.pose.orientation.w = 1.0;
+  stc::World world;
+  addRequest(world, toEntityRequest(msg, 8));
+  msg.up_axis = "z_up";
+  msg.pose.position.x = 2.0;
+  addRequest(world, toEntityRequest(msg, 8));
+  const stc::VoxelShape& as_written = world.shape(world.bodyShapes()[0]).voxels;
+  const stc::VoxelShape& turned = world.shape(world.bodyShapes()[1]).voxels;
+  EXPECT_EQ(as_written.nz(), 12);
+  EXPECT_EQ(turned.ny(), 12);
+  EXPECT_EQ(turned.nz(), 8);
+  EXPECT_EQ(as_written.occupiedCount(), turned.occupiedCount());
+
+  // The scene file says the same; bad values are refused by name.
+  const Scene scene = parseSceneYaml("entities:\n  - {mesh_resource: '" + dae +
+                                     "', voxel_size: 0.05, up_axis: z_up}\n");
+  ASSERT_EQ(scene.entities.size(), 1u);
+  EXPECT_EQ(scene.entities[0].request.mesh_up_axis, stc::ColladaUpAxis::ToZUp);
+  const auto field_of = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const stc::InputError& e) {
+      return e.field();
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(field_of([&] { parseSceneYaml("entities:\n  - {mesh_resource: '" + dae + "', up_axis: sideways}\n"); }),
+            "entities[0].up_axis");
+  EXPECT_EQ(field_of([&] { parseSceneYaml("entities:\n  - {preset: cube, up_axis: z_up}\n"); }),
+            "entities[0].up_axis");
+  msg.up_axis = "sideways";
+  EXPECT_EQ(field_of([&] { toEntityRequest(msg, 8); }), "up_axis");
+  msg.mesh_resource.clear();
+  msg.preset = "cube";
+  msg.up_axis = "z_up";
+  EXPECT_EQ(field_of([&] { toEntityRequest(msg, 8); }), "up_axis");
 }
 
 TEST_F(MeshSpawn, PackageResourcesOfUnknownPackagesAreRejected) {

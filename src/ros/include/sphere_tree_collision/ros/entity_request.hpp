@@ -3,6 +3,7 @@
 // One path for both, so scenes and spawns validate and share shapes alike.
 #pragma once
 
+#include "sphere_tree_collision/mesh_loader.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <array>
@@ -31,6 +32,7 @@ struct EntityRequest {
   std::string mesh_resource;
   stc::Vec3 mesh_scale = stc::Vec3::Ones();
   double mesh_voxel_size = 0.0;
+  stc::ColladaUpAxis mesh_up_axis = stc::ColladaUpAxis::AsWritten;  // of a DAE (mesh_loader.hpp)
 };
 
 // Shape cache key of a preset: equal keys share one shape and one tree.
