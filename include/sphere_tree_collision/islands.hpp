@@ -2,16 +2,17 @@
 //
 // An island is a set of movable bodies connected by the tick's contacts
 // (static bodies do not connect islands: two rocks on the same floor are two
-// islands). When every body of an island has moved slower than the
-// thresholds for `time_to_sleep`, the island sleeps, as in Box2D v3 and Jolt:
-// velocities zero, pose kept exactly. During a tick a sleeping body is held
+// islands). A body rests while it stays in place (rest_test.hpp: its centre
+// and its surface stay within balls of radius linear_speed * time_to_sleep / 2);
+// when every body of an island has rested for `time_to_sleep` (its least rest
+// timer, as Box2D v3), the island sleeps: velocities zero, pose kept exactly. During a tick a sleeping body is held
 // as a static one (BodyState::is_static set from beginTick to endTick), so
 // integration, the broad-phase box update, the sweep, the narrow phase of
 // sleeping-sleeping and sleeping-static pairs and the solver all skip it with
 // the tests they already make for static bodies.
 //
 // An island wakes whole (every body that fell asleep with it): when a
-// broad-phase box of a moving body (awake and above the thresholds) or of a
+// broad-phase box of a moving body (awake and not resting) or of a
 // body added since the last tick overlaps one of its bodies, when one of its bodies is
 // edited through World::bodies() (pose or velocity changed), removed, or
 // touches (box overlap) a removed body, on World::wake and on a change of
@@ -21,6 +22,7 @@
 
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/rest_test.hpp"
 
 #include <cstdint>
 #include <vector>
@@ -29,20 +31,24 @@ namespace stc {
 
 struct SleepOptions {
   bool enabled = true;
-  double linear_speed = 0.05;  // m/s: a body slower than this (and ...
-  double angular_speed = 0.1;  // rad/s: ... turning slower than this) is resting
+  // m/s: a body whose centre and surface points moved on average slower than
+  // this over time_to_sleep is resting (a spin counts by the surface speed it
+  // gives, reach * |w|): each point stays in a ball of radius
+  // linear_speed * time_to_sleep / 2 (5 mm), whatever its speed of the moment.
+  double linear_speed = 0.02;
   double time_to_sleep = 0.5;  // s: an island whose bodies all rested this long sleeps
 };
 // Throws InputError naming the field ("sleeping.linear_speed",
-// "sleeping.angular_speed", "sleeping.time_to_sleep"): each finite and >= 0.
+// "sleeping.time_to_sleep"): each finite and >= 0.
 void validateSleepOptions(const SleepOptions& options);
 
 class Islands {
  public:
   // Mirror the World's dense arrays: a body appended (awake; its box
-  // overlaps wake sleepers at the next broad phase), a body swap-removed
-  // (index takes last's place), all removed.
-  void add();
+  // overlaps wake sleepers at the next broad phase; `reach`: its largest
+  // distance from its centre of mass), a body swap-removed (index takes
+  // last's place), all removed.
+  void add(double reach);
   void remove(std::size_t index, std::size_t last);
   void clear();
 
@@ -56,8 +62,8 @@ class Islands {
   // wake; the others are held as static for the tick.
   void beginTick(std::vector<BodyState>& bodies, const SleepOptions& options);
   // For each broad-phase pair (dense indices), before its pair test is set
-  // up: an overlap of a held body with a moving one (awake and faster than
-  // the thresholds at the end of the last tick, or edited) or a new one wakes
+  // up: an overlap of a held body with a moving one (awake and not resting
+  // at the end of the last tick, or edited) or a new one wakes
   // the held body's island. A resting awake body beside a sleeping island
   // does not wake it: it sees the island as static until it moves. True when releaseWoken() has something to release.
   bool noteOverlap(std::uint32_t a, std::uint32_t b, const std::vector<BodyState>& bodies) {
@@ -87,9 +93,10 @@ class Islands {
   std::vector<std::uint32_t> group_;  // per body: island it fell asleep with, kAwake while awake
   std::vector<std::uint8_t> held_;    // per body: held as static this tick
   std::vector<std::uint8_t> fresh_;   // per body: added since the last tick
-  std::vector<std::uint8_t> moving_;  // per body: above the thresholds at the last endTick, or edited
+  std::vector<std::uint8_t> moving_;  // per body: not resting at the last endTick, or edited
   std::vector<Pose> rest_pose_;       // per body: pose it fell asleep at (edits wake)
-  std::vector<double> rest_time_;     // per body: seconds below the thresholds
+  std::vector<double> rest_time_;     // per body: seconds resting
+  RestTest rest_test_;
   std::vector<std::uint32_t> parent_;       // union-find over the tick's contacts
   std::vector<double> island_rest_;         // per root: least rest time of its bodies
   std::vector<std::uint32_t> island_group_; // per root: group it sleeps as (kAwake: none yet)

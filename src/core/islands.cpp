@@ -24,11 +24,11 @@ bool samePose(const Pose& a, const Pose& b) {
 
 void validateSleepOptions(const SleepOptions& options) {
   requireNonNegative(options.linear_speed, "sleeping.linear_speed");
-  requireNonNegative(options.angular_speed, "sleeping.angular_speed");
   requireNonNegative(options.time_to_sleep, "sleeping.time_to_sleep");
 }
 
-void Islands::add() {
+void Islands::add(double reach) {
+  rest_test_.add(reach);
   group_.push_back(kAwake);
   held_.push_back(0);
   fresh_.push_back(1);
@@ -43,6 +43,7 @@ void Islands::remove(std::size_t index, std::size_t last) {
     requestWake(index);
     applyWakes(nullptr);
   }
+  rest_test_.remove(index, last);
   group_[index] = group_[last];
   held_[index] = held_[last];
   fresh_[index] = fresh_[last];
@@ -64,6 +65,7 @@ void Islands::clear() {
   moving_.clear();
   rest_pose_.clear();
   rest_time_.clear();
+  rest_test_.clear();
   to_wake_.clear();
   sleeping_ = 0;
 }
@@ -82,6 +84,7 @@ void Islands::applyWakes(std::vector<BodyState>* bodies) {
     if (std::find(to_wake_.begin(), to_wake_.end(), group_[i]) == to_wake_.end()) continue;
     group_[i] = kAwake;
     rest_time_[i] = 0.0;
+    rest_test_.restart(i);
     --sleeping_;
     if (held_[i] != 0 && bodies != nullptr) {
       held_[i] = 0;
@@ -99,6 +102,7 @@ void Islands::wake(std::size_t body) {
 void Islands::wakeAll() {
   std::fill(group_.begin(), group_.end(), kAwake);
   std::fill(rest_time_.begin(), rest_time_.end(), 0.0);
+  for (std::size_t i = 0; i < group_.size(); ++i) rest_test_.restart(i);
   to_wake_.clear();
   sleeping_ = 0;
 }
@@ -160,14 +164,13 @@ void Islands::endTick(std::vector<BodyState>& bodies, const std::vector<Contact>
     if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
   }
 
-  // Rest timers, and each island's least.
+  // Rest timers, and each island's least. A point moving steadily at
+  // linear_speed goes a ball's diameter in time_to_sleep (a tick at least).
   island_rest_.assign(n, std::numeric_limits<double>::infinity());
-  const double lin_sq = options.linear_speed * options.linear_speed;
-  const double ang_sq = options.angular_speed * options.angular_speed;
+  const double max_radius = 0.5 * options.linear_speed * std::max(options.time_to_sleep, dt);
   for (std::size_t i = 0; i < n; ++i) {
     if (!movable(i)) continue;
-    const BodyState& body = bodies[i];
-    const bool resting = body.linear_velocity.squaredNorm() <= lin_sq && body.angular_velocity.squaredNorm() <= ang_sq;
+    const bool resting = rest_test_.update(i, bodies[i].pose, dt, options.time_to_sleep, max_radius);
     rest_time_[i] = resting ? rest_time_[i] + dt : 0.0;
     moving_[i] = resting ? 0 : 1;
     double& least = island_rest_[find(static_cast<std::uint32_t>(i))];

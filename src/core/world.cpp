@@ -165,7 +165,7 @@ EntityId World::addEntity(const EntitySpec& spec) {
   index_of_.emplace(id, index);
   if (!spec.name.empty()) id_by_name_.emplace(spec.name, id);
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
-  islands_.add();
+  islands_.add(info.bounding_radius);
   ++next_id_;
   invalidateLastTick();
   return id;
