@@ -1,7 +1,8 @@
 // Priority-queue scheduling (paper 3.4.3). The perceptual model only picks
 // one of K queues; inside a queue pairs go round-robin; the highest non-empty
-// queue is always served next. After each pass over a queue, the pairs it
-// stepped are re-measured and move queue when their priority crossed a bin edge.
+// queue is always served next. A pair stepped by a pass over a queue is
+// re-measured and moves to the back of another queue when its priority
+// crossed a bin edge; that queue is served once the pass is over.
 //
 // Priority: f(e, g) / c^a, c the sphere tests of the pair's next step (see
 // SchedulerOptions::cost_exponent; a = 0 is the paper's f). Bins are
@@ -20,17 +21,19 @@
 //   the geometric mean of its bodies'. g before any step is the paper's
 //   estimate, the projected distance of the entity origins.
 // - After a step, g is the reach r_a + r_b of a frontier sphere pair times the
-//   pair's pixels per metre, and c the exact tests of the next step: both kept
-//   by the PairTest as it steps and copied beside the queued index. A
-//   re-measure is a multiply, a divide and K - 1 branch-free comparisons with
-//   the bin edges; no projection after the start.
+//   pair's pixels per metre (queued beside its index), and c the exact tests
+//   of the next step: both kept by the PairTest as it steps. The re-measure
+//   is done right after the step, while the PairTest is in cache: a
+//   multiply, a divide and the bin, which for the default ratio 2 is the
+//   exponent of f / fmax (O(1); other ratios: K - 1 branch-free comparisons
+//   with the bin edges). No projection after the start.
 //   (The reach is an upper bound of the paper's g: the distance of two
 //   intersecting centres is at most their reach.)
 // - Queue 0 is the end of the line: its pairs (the rest, and weight 0 when a
 //   body is behind the camera) go round-robin and are not re-measured (a
 //   step rarely raises a priority: the reach shrinks and the cost grows).
 // - Queues are vectors reused across runs: appending is O(1), a pass
-//   compacts in place, and nothing is sorted. A pass prefetches the
+//   compacts the pairs that stay in place, and nothing is sorted. A pass prefetches the
 //   PairTests it will step (a queue is in no memory order).
 // Without a fixation, with one queue, or without the pairs' body indices,
 // every pair sits in queue 0: plain round-robin in list order, and no
@@ -39,6 +42,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace stc::detail {
 namespace {
@@ -58,7 +62,8 @@ PriorityQueueScheduler::PriorityQueueScheduler(const SchedulerOptions& options)
       log_ratio_(std::log(options.queue_ratio)),
       cost_exponent_(options.cost_exponent),
       queues_(static_cast<std::size_t>(options.queue_count)),
-      lower_edge_(static_cast<std::size_t>(options.queue_count)) {}
+      lower_edge_(static_cast<std::size_t>(options.queue_count)),
+      binary_bins_(options.queue_ratio == 2.0) {}
 
 inline const PriorityQueueScheduler::BodyGaze& PriorityQueueScheduler::gazeOf(
     std::uint32_t body, const PairBody& pair_body, const Perception& perception) {
@@ -77,11 +82,22 @@ inline double PriorityQueueScheduler::perCost(double f, int cost) const {
   return cost_exponent_ == 1.0 ? f / cost : f / std::pow(static_cast<double>(cost), cost_exponent_);
 }
 
-// The bin of a priority: how many bin edges it reaches. No logarithm and no
-// branch per edge: a step moves a priority by several bins, so walking the
-// edges from the old bin mispredicts a branch at each.
+// The bin of a priority: how many bin edges it reaches. With a ratio of 2
+// (the default) that is read off the exponent of f / fmax: O(1), no branch
+// per edge and no logarithm. Other ratios count the edges it reaches,
+// branch-free (a step moves a priority by several bins, so walking the edges
+// from the old bin would mispredict a branch at each).
 inline int PriorityQueueScheduler::binOf(double priority) const {
   if (!(priority > 0.0)) return 0;
+  if (binary_bins_) {
+    // floor(log2(f / fmax)) from the IEEE exponent; subnormal ratios land in
+    // queue 0, ratios >= 1 (a priority above the start's largest) at the top.
+    const double x = priority * inverse_reference_;
+    std::uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    const int exponent = static_cast<int>((bits >> 52) & 0x7ff) - 1023;
+    return std::clamp(queue_count_ + exponent, 0, queue_count_ - 1);
+  }
   int q = 0;
   for (int e = 1; e < queue_count_; ++e) q += priority >= lower_edge_[static_cast<std::size_t>(e)];
   return q;
@@ -98,8 +114,7 @@ void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t co
   scale_.resize(count);
   double reference = 0.0;
   for (std::size_t i = 0; i < count; ++i) {
-    priorities_[i] = 0.0;
-    scale_[i] = 0.0;
+    priorities_[i] = -1.0;  // resolved: not queued
     if (tests[i].resolved()) continue;
     const BodyGaze& a = gazeOf(bodies.of_pair[i][0], tests[i].bodyA(), perception);
     const BodyGaze& b = gazeOf(bodies.of_pair[i][1], tests[i].bodyB(), perception);
@@ -110,14 +125,15 @@ void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t co
     reference = std::max(reference, priorities_[i]);
   }
   // Queue q >= 1 holds f >= fmax / r^(K - q).
+  inverse_reference_ = reference > 0.0 ? 1.0 / reference : 0.0;
   lower_edge_[0] = 0.0;
   for (int q = 1; q < queue_count_; ++q) {
     lower_edge_[static_cast<std::size_t>(q)] = reference * std::exp(-(queue_count_ - q) * log_ratio_);
   }
   for (std::size_t i = 0; i < count; ++i) {
-    if (tests[i].resolved()) continue;
+    if (priorities_[i] < 0.0) continue;
     queues_[static_cast<std::size_t>(binOf(priorities_[i]))].push_back(
-        Queued{static_cast<std::uint32_t>(i), scale_[i], 0.0f, 1});
+        Queued{static_cast<std::uint32_t>(i), scale_[i]});
   }
 }
 
@@ -126,7 +142,7 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
                                           BudgetTracker& budget) {
   ScheduleStats stats;
   OverheadClock overhead;  // the set-up: measuring and binning every pair
-  SampledClock requeue(run_);  // the re-measuring after each pass
+  SampledClock requeue(run_);  // choosing the queue to serve after each pass
   overhead.start();
   for (auto& q : queues_) q.clear();
   stats.used_perception = perceptionActive(perception) && queue_count_ > 1 && bodies.of_pair != nullptr;
@@ -134,7 +150,7 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
     binAll(tests, count, bodies, *perception);
   } else {
     for (std::size_t i = 0; i < count; ++i) {
-      if (!tests[i].resolved()) queues_[0].push_back(Queued{static_cast<std::uint32_t>(i), 0.0f, 0.0f, 1});
+      if (!tests[i].resolved()) queues_[0].push_back(Queued{static_cast<std::uint32_t>(i), 0.0f});
     }
   }
   overhead.stop();
@@ -146,41 +162,33 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
     requeue.stop();
     if (q < 0) break;  // everything resolved
     auto& queue = queues_[static_cast<std::size_t>(q)];
-    // One round-robin pass; pairs still unresolved are compacted in place, order kept.
+    // One round-robin pass. A pair still unresolved is re-measured as soon as
+    // it is stepped (its reach and next cost are in cache then): it stays, in
+    // order, compacted in place, or goes to the back of its new queue, which
+    // is not served before this pass ends. Queue 0 is not re-measured.
+    const bool remeasure = stats.used_perception && q > 0;
+    const std::size_t size = queue.size();
     std::size_t kept = 0;
-    bool out_of_budget = false;
-    for (std::size_t r = 0; r < queue.size(); ++r) {
-      if (r + kPrefetchAhead < queue.size()) prefetch(tests[queue[r + kPrefetchAhead].pair]);
-      PairTest& test = tests[queue[r].pair];
+    for (std::size_t r = 0; r < size; ++r) {
+      if (r + kPrefetchAhead < size) prefetch(tests[queue[r + kPrefetchAhead].pair]);
+      const Queued entry = queue[r];
+      PairTest& test = tests[entry.pair];
       if (!budgetedStep(test, budget, stats)) {
-        out_of_budget = true;
+        stats.interrupted = true;
         break;
       }
       if (test.resolved()) continue;
-      Queued& entry = queue[kept++];
-      entry = queue[r];
-      entry.reach = static_cast<float>(test.frontierReach());
-      entry.cost = test.nextStepTests();
-    }
-    if (out_of_budget) {
-      stats.interrupted = true;
-      break;
-    }
-    queue.resize(kept);
-    requeue.start();
-    if (!stats.used_perception || q == 0) continue;
-    // Re-measure what the pass refined; movers go to the back of their new queue.
-    kept = 0;
-    for (std::size_t r = 0; r < queue.size(); ++r) {
-      const Queued entry = queue[r];
-      const int moved = binOf(perCost(static_cast<double>(entry.reach) * entry.scale, entry.cost));
+      const int moved =
+          remeasure ? binOf(perCost(test.frontierReach() * entry.scale, test.nextStepTests())) : q;
       if (moved == q) {
         queue[kept++] = entry;
       } else {
         queues_[static_cast<std::size_t>(moved)].push_back(entry);
       }
     }
+    if (stats.interrupted) break;
     queue.resize(kept);
+    requeue.start();
   }
   stats.overhead_seconds = overhead.seconds() + requeue.seconds();
   return stats;
