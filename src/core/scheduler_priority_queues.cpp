@@ -20,18 +20,21 @@
 //   product of two per-body factors exp(-e_body/200); its pixels per metre
 //   the geometric mean of its bodies'. g before any step is the paper's
 //   estimate, the projected distance of the entity origins.
-// - After a step, g is the reach r_a + r_b of a frontier sphere pair times the
-//   pair's pixels per metre (queued beside its index), and c the exact tests
-//   of the next step: both kept by the PairTest as it steps. The re-measure
+// - After a step, g is the paper's estimate: the distance of the centres of
+//   an intersecting sphere pair (the frontier's first), times the pair's
+//   pixels per metre (queued beside its index), and c the exact tests of the
+//   next step: both kept by the PairTest as it steps. The re-measure
 //   is done right after the step, while the PairTest is in cache: a
 //   multiply, a divide and the bin, which for the default ratio 2 is the
 //   exponent of f / fmax (O(1); other ratios: K - 1 branch-free comparisons
 //   with the bin edges). No projection after the start.
-//   (The reach is an upper bound of the paper's g: the distance of two
-//   intersecting centres is at most their reach.)
+//   (Measured against the reach r_a + r_b of that pair, which this used
+//   before: the centre distance also tells a deep overlap, likely a real
+//   contact whose gap is 0, from a shallow one, and left 5-15 % less true P
+//   at equal sphere tests; docs/error_vs_runtime.md.)
 // - Queue 0 is the end of the line: its pairs (the rest, and weight 0 when a
 //   body is behind the camera) go round-robin and are not re-measured (a
-//   step rarely raises a priority: the reach shrinks and the cost grows).
+//   step rarely raises a priority: the spheres shrink and the cost grows).
 // - Queues are vectors reused across runs: appending is O(1), a pass
 //   compacts the pairs that stay in place, and nothing is sorted. A pass prefetches the
 //   PairTests it will step (a queue is in no memory order).
@@ -61,7 +64,7 @@ PriorityQueueScheduler::PriorityQueueScheduler(const SchedulerOptions& options)
     : queue_count_(options.queue_count),
       log_ratio_(std::log(options.queue_ratio)),
       cost_exponent_(options.cost_exponent),
-      queues_(static_cast<std::size_t>(options.queue_count)),
+      sizes_(static_cast<std::size_t>(options.queue_count)),
       lower_edge_(static_cast<std::size_t>(options.queue_count)),
       binary_bins_(options.queue_ratio == 2.0) {}
 
@@ -103,6 +106,25 @@ inline int PriorityQueueScheduler::binOf(double priority) const {
   return q;
 }
 
+// The bin of a stepped pair: g x weight x pixels per metre, per cost. With
+// bins a factor 2 apart and the priority per sphere test (the defaults) this
+// is floor(log2(y / c)) of y = g x scale / fmax, found without dividing: the
+// exponents' difference, less one when y's mantissa is below c's.
+inline int PriorityQueueScheduler::binAfterStep(const PairTest& test, float scale) const {
+  const double y = test.frontierGap() * scale;
+  const int cost = test.nextStepTests();
+  if (!binary_bins_ || cost_exponent_ != 1.0) return binOf(perCost(y, cost));
+  const double x = y * inverse_reference_;
+  if (!(x > 0.0)) return 0;
+  const double c = static_cast<double>(cost);
+  std::uint64_t xb, cb;
+  std::memcpy(&xb, &x, sizeof xb);
+  std::memcpy(&cb, &c, sizeof cb);
+  constexpr std::uint64_t kMantissa = (std::uint64_t{1} << 52) - 1;
+  const int exponent = static_cast<int>(xb >> 52) - static_cast<int>(cb >> 52) - ((xb & kMantissa) < (cb & kMantissa));
+  return std::clamp(queue_count_ + exponent, 0, queue_count_ - 1);
+}
+
 void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t count,
                                     const PairBodies& bodies, const Perception& perception) {
   if (gaze_.size() < bodies.body_count) gaze_.resize(bodies.body_count);
@@ -132,8 +154,13 @@ void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t co
   }
   for (std::size_t i = 0; i < count; ++i) {
     if (priorities_[i] < 0.0) continue;
-    queues_[static_cast<std::size_t>(binOf(priorities_[i]))].push_back(
-        Queued{static_cast<std::uint32_t>(i), scale_[i]});
+    // Field by field: a Queued built on the stack and copied whole stalls on
+    // store forwarding (two 4-byte writes read back as one 8-byte load).
+    const int q = binOf(priorities_[i]);
+    Queued& entry = slotEnd(q);
+    entry.pair = static_cast<std::uint32_t>(i);
+    entry.scale = scale_[i];
+    ++sizes_[static_cast<std::size_t>(q)];
   }
 }
 
@@ -144,13 +171,21 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
   OverheadClock overhead;  // the set-up: measuring and binning every pair
   SampledClock requeue(run_);  // choosing the queue to serve after each pass
   overhead.start();
-  for (auto& q : queues_) q.clear();
+  // Each queue has room for every pair and one more (see the pass below);
+  // the storage only grows, with the pair count.
+  stride_ = count + 1;
+  if (slots_.size() < stride_ * sizes_.size()) slots_.resize(stride_ * sizes_.size());
+  std::fill(sizes_.begin(), sizes_.end(), 0);
   stats.used_perception = perceptionActive(perception) && queue_count_ > 1 && bodies.of_pair != nullptr;
   if (stats.used_perception) {
     binAll(tests, count, bodies, *perception);
   } else {
     for (std::size_t i = 0; i < count; ++i) {
-      if (!tests[i].resolved()) queues_[0].push_back(Queued{static_cast<std::uint32_t>(i), 0.0f});
+      if (tests[i].resolved()) continue;
+      Queued& entry = slotEnd(0);
+      entry.pair = static_cast<std::uint32_t>(i);
+      entry.scale = 0.0f;
+      ++sizes_[0];
     }
   }
   overhead.stop();
@@ -158,36 +193,41 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
   requeue.start();  // choosing the next queue is decision work too
   for (;;) {
     int q = queue_count_ - 1;
-    while (q >= 0 && queues_[static_cast<std::size_t>(q)].empty()) --q;
+    while (q >= 0 && sizes_[static_cast<std::size_t>(q)] == 0) --q;
     requeue.stop();
     if (q < 0) break;  // everything resolved
-    auto& queue = queues_[static_cast<std::size_t>(q)];
+    Queued* queue = slots_.data() + static_cast<std::size_t>(q) * stride_;
     // One round-robin pass. A pair still unresolved is re-measured as soon as
-    // it is stepped (its reach and next cost are in cache then): it stays, in
-    // order, compacted in place, or goes to the back of its new queue, which
-    // is not served before this pass ends. Queue 0 is not re-measured.
+    // it is stepped (its gap estimate and next cost are in cache then): it
+    // stays, in order, compacted in place, or goes to the back of its new
+    // queue, which is not served before this pass ends. Queue 0 is not
+    // re-measured. No branch on the outcome (it is a coin toss to predict):
+    // the entry is written both at the compaction point and at the end of
+    // its new queue, and only one of the two counts. Writing past this
+    // queue's end is what the spare slot is for, and the compaction point is
+    // never ahead of the pass.
     const bool remeasure = stats.used_perception && q > 0;
-    const std::size_t size = queue.size();
+    const std::size_t size = sizes_[static_cast<std::size_t>(q)];
     std::size_t kept = 0;
     for (std::size_t r = 0; r < size; ++r) {
       if (r + kPrefetchAhead < size) prefetch(tests[queue[r + kPrefetchAhead].pair]);
       const Queued entry = queue[r];
       PairTest& test = tests[entry.pair];
+      if (remeasure) test.trackFrontierGap();  // its next step keeps g for the re-measure
       if (!budgetedStep(test, budget, stats)) {
         stats.interrupted = true;
         break;
       }
       if (test.resolved()) continue;
-      const int moved =
-          remeasure ? binOf(perCost(test.frontierReach() * entry.scale, test.nextStepTests())) : q;
-      if (moved == q) {
-        queue[kept++] = entry;
-      } else {
-        queues_[static_cast<std::size_t>(moved)].push_back(entry);
-      }
+      const int moved = remeasure ? binAfterStep(test, entry.scale) : q;
+      const bool stays = moved == q;
+      queue[kept] = entry;
+      kept += stays;
+      slotEnd(moved) = entry;
+      sizes_[static_cast<std::size_t>(moved)] += !stays;
     }
     if (stats.interrupted) break;
-    queue.resize(kept);
+    sizes_[static_cast<std::size_t>(q)] = kept;
     requeue.start();
   }
   stats.overhead_seconds = overhead.seconds() + requeue.seconds();
