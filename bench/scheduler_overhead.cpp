@@ -24,6 +24,7 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
+#include "scene_sim.hpp"
 #include "tick_clock.hpp"
 
 #include <cstdio>
@@ -76,12 +77,10 @@ int main(int argc, char** argv) {
     }
   }
   const SceneKind kind = parseScene(scene);
-  WorldConfig config;
-  config.gravity = sceneGravity(kind);
-  config.scheduler.kind = SchedulerKind::RoundRobin;
-  World sim(config);
-  const SceneSpec spec = populateScene(sim, kind);
-  sim.perception().setCamera(spec.camera);
+  stc_bench::SceneSim scene_sim = stc_bench::makeSceneSim(kind);
+  World& sim = *scene_sim.world;
+  const SceneSpec& spec = scene_sim.spec;
+  const WorldConfig config = sim.config();
   const int warmup = kind == SceneKind::Rockfall ? 80 : 36;
   for (int i = 0; i < warmup; ++i) sim.step(spec.dt, Budget::unlimited());
   GazeParams follow;
