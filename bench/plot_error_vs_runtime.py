@@ -4,7 +4,8 @@
 One row of panels per scene: perceived error (true P, the sum of f(e, g_true)
 over the accepted unresolved pairs) and geometric error (the true 3D gap, FCL
 distance, summed over the same pairs), per tick, against the median
-narrow-phase wall time per tick. One line per scheduler through its
+narrow-phase time per tick (of ticks that kept their core, so wall time equals
+thread CPU time). One line per scheduler through its
 wall-clock budgets: the point is the median over the repeats, the band their
 min-max. A user picks a scheduler by reading across at the time they have.
 
@@ -85,7 +86,7 @@ def plot(src, dst):
         for j, (field, label) in enumerate(FIELDS):
             ax = axes[i][j]
             draw(ax, rows, scene, field)
-            ax.set_xlabel("narrow-phase wall time per tick, median [ms]")
+            ax.set_xlabel("narrow-phase time per tick, median [ms]\n(ticks that kept their core: wall = thread CPU time)")
             ax.set_ylabel(label)
             ax.set_title(title)
             if i == 0 and j == 0:

@@ -92,10 +92,14 @@ class PairTest {
   int deepestLevel() const { return deepest_level_; }  // max tree level tested
   std::int64_t sphereTests() const { return sphere_tests_; }
   // What the next step() will cost, known from the last one: its sphere
-  // tests (1 after reset; 0 once resolved) and r_a + r_b of the first sphere
-  // pair of the frontier (0 before any step). A scheduler's priority needs no more.
+  // tests (1 after reset; 0 once resolved). And, once asked for with
+  // trackFrontierGap() (until the next reset), the distance of the centres of
+  // the frontier's first sphere pair, the paper's gap estimate g for it, made
+  // by each step while its spheres are in cache (0 before). A scheduler's
+  // priority needs no more.
   int nextStepTests() const { return next_tests_; }
-  double frontierReach() const { return frontier_reach_; }
+  void trackFrontierGap() { track_gap_ = true; }
+  double frontierGap() const { return frontier_gap_; }
 
   // Intersecting sphere pairs found by the last step that found any: leaf
   // pairs when Colliding, the current frontier when Unresolved.
@@ -136,12 +140,13 @@ class PairTest {
   mutable bool best_valid_ = false;
   PairStatus status_ = PairStatus::Unresolved;
   bool first_contact_only_ = false;
+  bool track_gap_ = false;
   // Body frame s to body frame 1 - s, made at the first step.
   Mat3 rot_to_other_[2] = {Mat3::Identity(), Mat3::Identity()};
   Vec3 pos_to_other_[2] = {Vec3::Zero(), Vec3::Zero()};
   int steps_ = 0;
   int next_tests_ = 1;           // sum of the frontier hits' test_count
-  double frontier_reach_ = 0.0;
+  double frontier_gap_ = 0.0;
   int deepest_level_ = -1;
   std::int64_t sphere_tests_ = 0;
 };

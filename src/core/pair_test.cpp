@@ -92,7 +92,8 @@ void PairTest::reset(const PairBody& a, const PairBody& b, PairArena* arena) {
   status_ = PairStatus::Unresolved;
   steps_ = 0;
   next_tests_ = 1;
-  frontier_reach_ = 0.0;
+  track_gap_ = false;
+  frontier_gap_ = 0.0;
   deepest_level_ = -1;
   sphere_tests_ = 0;
 }
@@ -172,7 +173,10 @@ int PairTest::step() {
       next_tests += next.test_count;
     }
     next_tests_ = next_tests;
-    frontier_reach_ = nodes[0][pair_out[0].a].radius + nodes[1][pair_out[0].b].radius;
+    if (track_gap_) {  // centres compared in B's body frame, as the step tested them
+      frontier_gap_ = (rot_to_other_[0] * nodes[0][pair_out[0].a].centre + pos_to_other_[0] -
+                       nodes[1][pair_out[0].b].centre).norm();
+    }
     pair_count = hit_count;
     store.hits_used = new_hits_begin + hit_count;
     hits_begin_ = new_hits_begin;

@@ -118,22 +118,30 @@ class PriorityQueueScheduler final : public Scheduler {
               const Perception& perception);
   double perCost(double f, int cost) const;
   int binOf(double priority) const;
+  int binAfterStep(const PairTest& test, float scale) const;
 
-  // A queued pair and what its re-measure needs, copied from the PairTest as
-  // the pass steps it, so the re-measure reads one array and no PairTest:
-  // its weight x pixels per metre, and the reach and cost of its next step.
+  // A queued pair and its weight x pixels per metre: with the gap estimate and
+  // next-step cost the PairTest keeps, all a re-measure needs.
   struct Queued {
     std::uint32_t pair = 0;
     float scale = 0.0f;
-    float reach = 0.0f;
-    std::int32_t cost = 1;
   };
 
   int queue_count_;
   double log_ratio_;
   double cost_exponent_;
-  std::vector<std::vector<Queued>> queues_;  // [0] lowest .. [K-1] highest; capacity reused
+  // Queue q ([0] lowest .. [K-1] highest) is slots_[q * stride_, + sizes_[q]);
+  // stride_ = pairs + 1. Storage reused across runs.
+  std::vector<Queued> slots_;
+  std::vector<std::size_t> sizes_;
+  std::size_t stride_ = 0;
+  Queued& slotEnd(int q) {
+    const auto qi = static_cast<std::size_t>(q);
+    return slots_[qi * stride_ + sizes_[qi]];
+  }
   std::vector<double> lower_edge_;           // f at the bottom of each queue, this run
+  double inverse_reference_ = 0.0;           // 1 / fmax, this run
+  bool binary_bins_;                         // queue_ratio 2: the bin is f / fmax's exponent
   // Capacity reused: per body, its projection; per pair, this run's initial
   // priority and weight x pixels per metre.
   std::vector<BodyGaze> gaze_;

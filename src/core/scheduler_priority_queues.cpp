@@ -1,7 +1,8 @@
 // Priority-queue scheduling (paper 3.4.3). The perceptual model only picks
 // one of K queues; inside a queue pairs go round-robin; the highest non-empty
-// queue is always served next. After each pass over a queue, the pairs it
-// stepped are re-measured and move queue when their priority crossed a bin edge.
+// queue is always served next. A pair stepped by a pass over a queue is
+// re-measured and moves to the back of another queue when its priority
+// crossed a bin edge; that queue is served once the pass is over.
 //
 // Priority: f(e, g) / c^a, c the sphere tests of the pair's next step (see
 // SchedulerOptions::cost_exponent; a = 0 is the paper's f). Bins are
@@ -19,18 +20,23 @@
 //   product of two per-body factors exp(-e_body/200); its pixels per metre
 //   the geometric mean of its bodies'. g before any step is the paper's
 //   estimate, the projected distance of the entity origins.
-// - After a step, g is the reach r_a + r_b of a frontier sphere pair times the
-//   pair's pixels per metre, and c the exact tests of the next step: both kept
-//   by the PairTest as it steps and copied beside the queued index. A
-//   re-measure is a multiply, a divide and K - 1 branch-free comparisons with
-//   the bin edges; no projection after the start.
-//   (The reach is an upper bound of the paper's g: the distance of two
-//   intersecting centres is at most their reach.)
+// - After a step, g is the paper's estimate: the distance of the centres of
+//   an intersecting sphere pair (the frontier's first), times the pair's
+//   pixels per metre (queued beside its index), and c the exact tests of the
+//   next step: both kept by the PairTest as it steps. The re-measure
+//   is done right after the step, while the PairTest is in cache: a
+//   multiply, a divide and the bin, which for the default ratio 2 is the
+//   exponent of f / fmax (O(1); other ratios: K - 1 branch-free comparisons
+//   with the bin edges). No projection after the start.
+//   (Measured against the reach r_a + r_b of that pair, which this used
+//   before: the centre distance also tells a deep overlap, likely a real
+//   contact whose gap is 0, from a shallow one, and left 5-15 % less true P
+//   at equal sphere tests; docs/error_vs_runtime.md.)
 // - Queue 0 is the end of the line: its pairs (the rest, and weight 0 when a
 //   body is behind the camera) go round-robin and are not re-measured (a
-//   step rarely raises a priority: the reach shrinks and the cost grows).
+//   step rarely raises a priority: the spheres shrink and the cost grows).
 // - Queues are vectors reused across runs: appending is O(1), a pass
-//   compacts in place, and nothing is sorted. A pass prefetches the
+//   compacts the pairs that stay in place, and nothing is sorted. A pass prefetches the
 //   PairTests it will step (a queue is in no memory order).
 // Without a fixation, with one queue, or without the pairs' body indices,
 // every pair sits in queue 0: plain round-robin in list order, and no
@@ -39,6 +45,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace stc::detail {
 namespace {
@@ -57,8 +64,9 @@ PriorityQueueScheduler::PriorityQueueScheduler(const SchedulerOptions& options)
     : queue_count_(options.queue_count),
       log_ratio_(std::log(options.queue_ratio)),
       cost_exponent_(options.cost_exponent),
-      queues_(static_cast<std::size_t>(options.queue_count)),
-      lower_edge_(static_cast<std::size_t>(options.queue_count)) {}
+      sizes_(static_cast<std::size_t>(options.queue_count)),
+      lower_edge_(static_cast<std::size_t>(options.queue_count)),
+      binary_bins_(options.queue_ratio == 2.0) {}
 
 inline const PriorityQueueScheduler::BodyGaze& PriorityQueueScheduler::gazeOf(
     std::uint32_t body, const PairBody& pair_body, const Perception& perception) {
@@ -77,14 +85,44 @@ inline double PriorityQueueScheduler::perCost(double f, int cost) const {
   return cost_exponent_ == 1.0 ? f / cost : f / std::pow(static_cast<double>(cost), cost_exponent_);
 }
 
-// The bin of a priority: how many bin edges it reaches. No logarithm and no
-// branch per edge: a step moves a priority by several bins, so walking the
-// edges from the old bin mispredicts a branch at each.
+// The bin of a priority: how many bin edges it reaches. With a ratio of 2
+// (the default) that is read off the exponent of f / fmax: O(1), no branch
+// per edge and no logarithm. Other ratios count the edges it reaches,
+// branch-free (a step moves a priority by several bins, so walking the edges
+// from the old bin would mispredict a branch at each).
 inline int PriorityQueueScheduler::binOf(double priority) const {
   if (!(priority > 0.0)) return 0;
+  if (binary_bins_) {
+    // floor(log2(f / fmax)) from the IEEE exponent; subnormal ratios land in
+    // queue 0, ratios >= 1 (a priority above the start's largest) at the top.
+    const double x = priority * inverse_reference_;
+    std::uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    const int exponent = static_cast<int>((bits >> 52) & 0x7ff) - 1023;
+    return std::clamp(queue_count_ + exponent, 0, queue_count_ - 1);
+  }
   int q = 0;
   for (int e = 1; e < queue_count_; ++e) q += priority >= lower_edge_[static_cast<std::size_t>(e)];
   return q;
+}
+
+// The bin of a stepped pair: g x weight x pixels per metre, per cost. With
+// bins a factor 2 apart and the priority per sphere test (the defaults) this
+// is floor(log2(y / c)) of y = g x scale / fmax, found without dividing: the
+// exponents' difference, less one when y's mantissa is below c's.
+inline int PriorityQueueScheduler::binAfterStep(const PairTest& test, float scale) const {
+  const double y = test.frontierGap() * scale;
+  const int cost = test.nextStepTests();
+  if (!binary_bins_ || cost_exponent_ != 1.0) return binOf(perCost(y, cost));
+  const double x = y * inverse_reference_;
+  if (!(x > 0.0)) return 0;
+  const double c = static_cast<double>(cost);
+  std::uint64_t xb, cb;
+  std::memcpy(&xb, &x, sizeof xb);
+  std::memcpy(&cb, &c, sizeof cb);
+  constexpr std::uint64_t kMantissa = (std::uint64_t{1} << 52) - 1;
+  const int exponent = static_cast<int>(xb >> 52) - static_cast<int>(cb >> 52) - ((xb & kMantissa) < (cb & kMantissa));
+  return std::clamp(queue_count_ + exponent, 0, queue_count_ - 1);
 }
 
 void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t count,
@@ -98,8 +136,7 @@ void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t co
   scale_.resize(count);
   double reference = 0.0;
   for (std::size_t i = 0; i < count; ++i) {
-    priorities_[i] = 0.0;
-    scale_[i] = 0.0;
+    priorities_[i] = -1.0;  // resolved: not queued
     if (tests[i].resolved()) continue;
     const BodyGaze& a = gazeOf(bodies.of_pair[i][0], tests[i].bodyA(), perception);
     const BodyGaze& b = gazeOf(bodies.of_pair[i][1], tests[i].bodyB(), perception);
@@ -110,14 +147,20 @@ void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t co
     reference = std::max(reference, priorities_[i]);
   }
   // Queue q >= 1 holds f >= fmax / r^(K - q).
+  inverse_reference_ = reference > 0.0 ? 1.0 / reference : 0.0;
   lower_edge_[0] = 0.0;
   for (int q = 1; q < queue_count_; ++q) {
     lower_edge_[static_cast<std::size_t>(q)] = reference * std::exp(-(queue_count_ - q) * log_ratio_);
   }
   for (std::size_t i = 0; i < count; ++i) {
-    if (tests[i].resolved()) continue;
-    queues_[static_cast<std::size_t>(binOf(priorities_[i]))].push_back(
-        Queued{static_cast<std::uint32_t>(i), scale_[i], 0.0f, 1});
+    if (priorities_[i] < 0.0) continue;
+    // Field by field: a Queued built on the stack and copied whole stalls on
+    // store forwarding (two 4-byte writes read back as one 8-byte load).
+    const int q = binOf(priorities_[i]);
+    Queued& entry = slotEnd(q);
+    entry.pair = static_cast<std::uint32_t>(i);
+    entry.scale = scale_[i];
+    ++sizes_[static_cast<std::size_t>(q)];
   }
 }
 
@@ -126,15 +169,23 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
                                           BudgetTracker& budget) {
   ScheduleStats stats;
   OverheadClock overhead;  // the set-up: measuring and binning every pair
-  SampledClock requeue(run_);  // the re-measuring after each pass
+  SampledClock requeue(run_);  // choosing the queue to serve after each pass
   overhead.start();
-  for (auto& q : queues_) q.clear();
+  // Each queue has room for every pair and one more (see the pass below);
+  // the storage only grows, with the pair count.
+  stride_ = count + 1;
+  if (slots_.size() < stride_ * sizes_.size()) slots_.resize(stride_ * sizes_.size());
+  std::fill(sizes_.begin(), sizes_.end(), 0);
   stats.used_perception = perceptionActive(perception) && queue_count_ > 1 && bodies.of_pair != nullptr;
   if (stats.used_perception) {
     binAll(tests, count, bodies, *perception);
   } else {
     for (std::size_t i = 0; i < count; ++i) {
-      if (!tests[i].resolved()) queues_[0].push_back(Queued{static_cast<std::uint32_t>(i), 0.0f, 0.0f, 1});
+      if (tests[i].resolved()) continue;
+      Queued& entry = slotEnd(0);
+      entry.pair = static_cast<std::uint32_t>(i);
+      entry.scale = 0.0f;
+      ++sizes_[0];
     }
   }
   overhead.stop();
@@ -142,45 +193,42 @@ ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::siz
   requeue.start();  // choosing the next queue is decision work too
   for (;;) {
     int q = queue_count_ - 1;
-    while (q >= 0 && queues_[static_cast<std::size_t>(q)].empty()) --q;
+    while (q >= 0 && sizes_[static_cast<std::size_t>(q)] == 0) --q;
     requeue.stop();
     if (q < 0) break;  // everything resolved
-    auto& queue = queues_[static_cast<std::size_t>(q)];
-    // One round-robin pass; pairs still unresolved are compacted in place, order kept.
+    Queued* queue = slots_.data() + static_cast<std::size_t>(q) * stride_;
+    // One round-robin pass. A pair still unresolved is re-measured as soon as
+    // it is stepped (its gap estimate and next cost are in cache then): it
+    // stays, in order, compacted in place, or goes to the back of its new
+    // queue, which is not served before this pass ends. Queue 0 is not
+    // re-measured. No branch on the outcome (it is a coin toss to predict):
+    // the entry is written both at the compaction point and at the end of
+    // its new queue, and only one of the two counts. Writing past this
+    // queue's end is what the spare slot is for, and the compaction point is
+    // never ahead of the pass.
+    const bool remeasure = stats.used_perception && q > 0;
+    const std::size_t size = sizes_[static_cast<std::size_t>(q)];
     std::size_t kept = 0;
-    bool out_of_budget = false;
-    for (std::size_t r = 0; r < queue.size(); ++r) {
-      if (r + kPrefetchAhead < queue.size()) prefetch(tests[queue[r + kPrefetchAhead].pair]);
-      PairTest& test = tests[queue[r].pair];
+    for (std::size_t r = 0; r < size; ++r) {
+      if (r + kPrefetchAhead < size) prefetch(tests[queue[r + kPrefetchAhead].pair]);
+      const Queued entry = queue[r];
+      PairTest& test = tests[entry.pair];
+      if (remeasure) test.trackFrontierGap();  // its next step keeps g for the re-measure
       if (!budgetedStep(test, budget, stats)) {
-        out_of_budget = true;
+        stats.interrupted = true;
         break;
       }
       if (test.resolved()) continue;
-      Queued& entry = queue[kept++];
-      entry = queue[r];
-      entry.reach = static_cast<float>(test.frontierReach());
-      entry.cost = test.nextStepTests();
+      const int moved = remeasure ? binAfterStep(test, entry.scale) : q;
+      const bool stays = moved == q;
+      queue[kept] = entry;
+      kept += stays;
+      slotEnd(moved) = entry;
+      sizes_[static_cast<std::size_t>(moved)] += !stays;
     }
-    if (out_of_budget) {
-      stats.interrupted = true;
-      break;
-    }
-    queue.resize(kept);
+    if (stats.interrupted) break;
+    sizes_[static_cast<std::size_t>(q)] = kept;
     requeue.start();
-    if (!stats.used_perception || q == 0) continue;
-    // Re-measure what the pass refined; movers go to the back of their new queue.
-    kept = 0;
-    for (std::size_t r = 0; r < queue.size(); ++r) {
-      const Queued entry = queue[r];
-      const int moved = binOf(perCost(static_cast<double>(entry.reach) * entry.scale, entry.cost));
-      if (moved == q) {
-        queue[kept++] = entry;
-      } else {
-        queues_[static_cast<std::size_t>(moved)].push_back(entry);
-      }
-    }
-    queue.resize(kept);
   }
   stats.overhead_seconds = overhead.seconds() + requeue.seconds();
   return stats;

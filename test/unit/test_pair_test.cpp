@@ -263,6 +263,36 @@ TEST_F(Cubes, CrossoverAlternatesTheTrees) {
   EXPECT_EQ(t.status(), PairStatus::Colliding);
 }
 
+// What a scheduler reads after a step: the next step's tests exactly, and the
+// paper's gap estimate for the frontier's first sphere pair (its centres' distance).
+TEST_F(Cubes, NextStepCostAndFrontierGapAreWhatTheNextStepSees) {
+  b.pose.position = Vec3(0.7, 0.1, 0.05);
+  b.pose.orientation = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
+  PairTest t;
+  t.reset(a.view(1), b.view(2));
+  t.trackFrontierGap();
+  EXPECT_EQ(t.nextStepTests(), 1);
+  EXPECT_EQ(t.frontierGap(), 0.0);
+  int unresolved_steps = 0;
+  while (!t.resolved()) {
+    const int expected = t.nextStepTests();
+    EXPECT_EQ(t.step(), expected);
+    if (t.resolved()) break;
+    ++unresolved_steps;
+    const SpherePair first = t.lastPairs()[0];
+    const Vec3 ca = a.pose.apply(a.tree.node(first.a).centre);
+    const Vec3 cb = b.pose.apply(b.tree.node(first.b).centre);
+    EXPECT_NEAR(t.frontierGap(), (cb - ca).norm(), 1e-12);
+    EXPECT_LE(t.frontierGap(), a.tree.node(first.a).radius + b.tree.node(first.b).radius);  // they intersect
+  }
+  EXPECT_EQ(t.nextStepTests(), 0);
+  EXPECT_GE(unresolved_steps, 3);
+  t.reset(a.view(1), b.view(2));  // tracking ends with the test it was asked of
+  t.step();
+  ASSERT_FALSE(t.resolved());
+  EXPECT_EQ(t.frontierGap(), 0.0);
+}
+
 TEST_F(Cubes, SphereTestsAreTheSumOfTheSteps) {
   b.pose.position = Vec3(0.75, 0.2, -0.1);
   PairTest t;

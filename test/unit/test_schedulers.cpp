@@ -426,6 +426,45 @@ TEST(SchedulerSceneTest, UnlimitedBudgetGivesRoundRobinsResultsOnBothScenes) {
   }
 }
 
+// Priority queues find a pair's bin two ways: from the exponent of f / fmax
+// when the bins are a factor 2 apart (the default), by comparing with each bin
+// edge otherwise. The two must bin alike: under budgets that interrupt the
+// run, a ratio of 2 and one a hair above it step every pair of a real scene alike.
+TEST(SchedulerSceneTest, PriorityQueuesBinAlikeByExponentAndByEdges) {
+  SceneParams params;
+  params.entities = 125;
+  WorldConfig config;
+  config.gravity = sceneGravity(SceneKind::PackedBox);
+  World sim(config);
+  const SceneSpec spec = populateScene(sim, SceneKind::PackedBox, params);
+  for (int i = 0; i < 20; ++i) sim.step(spec.dt, Budget::unlimited());
+  config.response.enabled = false;
+  World eval(config);
+  populateScene(eval, SceneKind::PackedBox, params);
+  for (std::size_t i = 0; i < sim.entityCount(); ++i) eval.bodies()[i].pose = sim.bodies()[i].pose;
+  eval.perception().setCamera(spec.camera);
+  const auto fixation = eval.perception().project(sim.bodies()[sim.entityCount() / 2].pose.position);
+  ASSERT_TRUE(fixation && eval.perception().onScreen(*fixation));
+  eval.perception().setFixation(*fixation);
+  const std::int64_t total = eval.step(0.0, Budget::unlimited()).sphere_tests;
+
+  auto stepsUnder = [&](double ratio, std::int64_t budget) {
+    SchedulerOptions options;  // priority queues, 16 queues, cost exponent 1
+    options.queue_ratio = ratio;
+    eval.setScheduler(options);
+    eval.step(0.0, Budget::ofSphereTests(budget));
+    std::vector<std::int64_t> tests;
+    for (std::size_t i = 0; i < eval.pairCount(); ++i) tests.push_back(eval.pairTests()[i].sphereTests());
+    return tests;
+  };
+  for (double share : {0.02, 0.1, 0.3}) {
+    const auto budget = static_cast<std::int64_t>(share * static_cast<double>(total));
+    const auto by_exponent = stepsUnder(2.0, budget);
+    EXPECT_EQ(by_exponent, stepsUnder(2.0 + 1e-12, budget)) << share;
+    EXPECT_NE(by_exponent, stepsUnder(4.0, budget)) << share;  // the bins matter at this budget
+  }
+}
+
 TEST(SchedulerOptionsTest, BadOptionsNameTheField) {
   auto field = [](SchedulerOptions o) {
     try {

@@ -1,0 +1,230 @@
+// What any scheduling order could gain at equal sphere tests (issue 11): the
+// perceived error left by ideal orders, with no bookkeeping cost at all,
+// against round-robin's, on the snapshots bench_error_vs_runtime uses.
+//
+// Per snapshot (packed box after 36, 42, ... ticks; gaze on a random rock),
+// each pair's FCL distance and its full cost C (sphere tests to resolve it).
+// True P left is summed as bench_error_vs_runtime does (e from where each
+// unresolved pair stopped); the oracle values a pair at its resolved state. Orders, each run under a sphere-test budget:
+//   round_robin    Hubbard's, list order
+//   greedy g=reach the pair of highest w s (r_a + r_b) / c steps next, exactly
+//                  (w the gaze weight, s pixels per metre, c the next step's
+//                  tests; a heap-free argmax per step: no bins, no cost)
+//   greedy g=paper the same with g the centre distance of a frontier sphere pair
+//   priority_queues the library's scheduler with its defaults
+//   oracle         pairs resolved whole by v / C, highest first: knows each
+//                  pair's outcome and cost in advance, so no scheduler can match it
+// Printed: true P left, summed over the snapshots, over round-robin's.
+//
+// Usage: bench_scheduler_order_bound [--scene packed_box|rockfall] [--snapshots N]
+#include "sphere_tree_collision/scenes.hpp"
+#include "sphere_tree_collision/world.hpp"
+
+#include "fcl_mesh.hpp"
+#include "scene_sim.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace stc;
+
+struct PairFacts {
+  PairBody a, b;
+  std::array<std::uint32_t, 2> bodies{};  // dense indices
+  double weight = 0, px_per_metre = 0;  // gaze weight and scale from the two bodies (as priority queues)
+  double gap = 0;                       // FCL distance, metres
+  double value = 0;                     // f(e, g_true) at the resolved state (for the oracle)
+  double cost = 0;                      // sphere tests to resolve
+};
+
+using Priority = std::function<double(const PairTest&, const PairFacts&)>;
+
+// True P of the pairs left unresolved, as bench_error_vs_runtime sums it: e
+// from each pair's centre of collision where it stopped, g_true in pixels there.
+double trueP(const std::vector<PairTest>& tests, const std::vector<PairFacts>& facts, const Perception& perception) {
+  double sum = 0;
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    if (tests[i].resolved()) continue;
+    if (const auto depth = perception.depthOf(tests[i].centreOfCollision())) {
+      sum += perceivedInaccuracy(perception.measure(tests[i]).eccentricity_px,
+                                 facts[i].gap * perception.focalPx() / *depth);
+    }
+  }
+  return sum;
+}
+
+// True P left after stepping by `priority` (argmax each step; nullptr: round-robin) under `budget` tests.
+double pLeft(const std::vector<PairFacts>& facts, const Priority& priority, std::int64_t budget,
+             const Perception& perception) {
+  const std::size_t n = facts.size();
+  std::vector<PairTest> tests(n);
+  for (std::size_t i = 0; i < n; ++i) tests[i].reset(facts[i].a, facts[i].b);
+  std::int64_t spent = 0;
+  if (!priority) {
+    for (bool any = true; any && spent < budget;) {
+      any = false;
+      for (std::size_t i = 0; i < n && spent < budget; ++i) {
+        if (!tests[i].resolved()) spent += tests[i].step(), any = true;
+      }
+    }
+  } else {
+    std::vector<double> p(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      tests[i].trackFrontierGap();
+      p[i] = priority(tests[i], facts[i]);
+    }
+    while (spent < budget) {
+      std::size_t best = n;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!tests[i].resolved() && (best == n || p[i] > p[best])) best = i;
+      }
+      if (best == n) break;
+      spent += tests[best].step();
+      p[best] = priority(tests[best], facts[best]);
+    }
+  }
+  return trueP(tests, facts, perception);
+}
+
+// True P left by the library's priority queues (defaults) under `budget` tests.
+double queuesLeft(const std::vector<PairFacts>& facts, std::size_t body_count, const Perception& perception,
+                  std::int64_t budget) {
+  std::vector<PairTest> tests(facts.size());
+  std::vector<std::array<std::uint32_t, 2>> of_pair(facts.size());
+  for (std::size_t i = 0; i < facts.size(); ++i) {
+    tests[i].reset(facts[i].a, facts[i].b);
+    of_pair[i] = facts[i].bodies;
+  }
+  BudgetTracker tracker(Budget::ofSphereTests(budget));
+  makeScheduler(SchedulerOptions{})->run(tests, tests.size(), PairBodies{of_pair.data(), body_count}, &perception,
+                                         tracker);
+  return trueP(tests, facts, perception);
+}
+
+double oracleLeft(const std::vector<PairFacts>& facts, std::int64_t budget) {
+  std::vector<const PairFacts*> order;
+  for (const PairFacts& f : facts) order.push_back(&f);
+  std::sort(order.begin(), order.end(),
+            [](const PairFacts* x, const PairFacts* y) { return x->value * y->cost > y->value * x->cost; });
+  double spent = 0, left = 0;
+  for (const PairFacts* f : order) {
+    if (spent + f->cost <= static_cast<double>(budget)) {
+      spent += f->cost;
+    } else {
+      left += f->value;
+    }
+  }
+  return left;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scene = "packed_box";
+  int snapshots = 6;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+    if (a == "--scene") scene = next();
+    else if (a == "--snapshots") snapshots = std::stoi(next());
+    else {
+      std::fprintf(stderr, "unknown argument %s\n", a.c_str());
+      return 2;
+    }
+  }
+  const SceneKind kind = parseScene(scene);
+  stc_bench::SceneSim scene_sim = stc_bench::makeSceneSim(kind);
+  World& sim = *scene_sim.world;
+  const SceneSpec& spec = scene_sim.spec;
+  WorldConfig config = sim.config();
+  config.response.enabled = false;
+  World eval(config);
+  populateScene(eval, kind);
+  eval.perception().setCamera(spec.camera);
+  std::vector<std::shared_ptr<truth::FclMesh>> meshes;
+  auto meshOf = [&](std::size_t body) -> const truth::FclMesh& {
+    const ShapeId id = eval.bodyShapes()[body];
+    if (meshes.size() <= id) meshes.resize(id + 1);
+    if (!meshes[id]) meshes[id] = truth::makeFclMesh(eval.shape(id).voxels, eval.shape(id).body_origin);
+    return *meshes[id];
+  };
+
+  const std::vector<double> shares = {0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.4};
+  const Priority by_reach = [](const PairTest& t, const PairFacts& f) {
+    double g = 0.5;  // before any step: a constant (the root test costs 1)
+    if (t.stepsDone() > 0) {
+      const SpherePair first = t.lastPairs()[0];
+      g = t.bodyA().tree->node(first.a).radius + t.bodyB().tree->node(first.b).radius;
+    }
+    return f.weight * f.px_per_metre * g / t.nextStepTests();
+  };
+  const Priority by_gap = [](const PairTest& t, const PairFacts& f) {
+    return f.weight * f.px_per_metre * (t.stepsDone() > 0 ? t.frontierGap() : 0.5) / t.nextStepTests();
+  };
+  std::vector<std::vector<double>> left(5, std::vector<double>(shares.size(), 0.0));
+  std::mt19937 pick(11);  // the gaze targets of bench_error_vs_runtime
+  double t = 0.0;
+  const int warmup = kind == SceneKind::Rockfall ? 75 : 30;
+  for (int i = 0; i < warmup; ++i, t += spec.dt) sim.step(spec.dt, Budget::unlimited());
+  for (int s = 0; s < snapshots; ++s) {
+    for (int i = 0; i < 6; ++i, t += spec.dt) sim.step(spec.dt, Budget::unlimited());
+    GazeParams follow;
+    follow.mode = GazeMode::Follow;
+    follow.target = spec.movers[pick() % spec.movers.size()];
+    GazeModel gaze(follow);
+    for (std::size_t i = 0; i < sim.entityCount(); ++i) eval.bodies()[i].pose = sim.bodies()[i].pose;
+    eval.perception().setFixation(gaze.fixationAt(t, sim));
+    const TickReport full = eval.step(0.0, Budget::unlimited());
+    const Perception& perception = eval.perception();
+    std::vector<PairFacts> facts(eval.pairCount());
+    for (std::size_t i = 0; i < facts.size(); ++i) {
+      const PairTest& test = eval.pairTests()[i];
+      PairFacts& f = facts[i];
+      f.a = test.bodyA();
+      f.b = test.bodyB();
+      const auto ga = perception.gazeWeight(f.a.pose->position);
+      const auto gb = perception.gazeWeight(f.b.pose->position);
+      f.weight = std::sqrt(ga.weight * gb.weight);
+      f.px_per_metre = std::sqrt(ga.px_per_metre * gb.px_per_metre);
+      f.cost = static_cast<double>(test.sphereTests());
+      f.bodies = {static_cast<std::uint32_t>(*eval.indexOf(f.a.id)), static_cast<std::uint32_t>(*eval.indexOf(f.b.id))};
+      const truth::FclMesh& ma = meshOf(*eval.indexOf(f.a.id));
+      const truth::FclMesh& mb = meshOf(*eval.indexOf(f.b.id));
+      const bool touching = truth::exactCollide(ma, *f.a.pose, mb, *f.b.pose);
+      f.gap = touching ? 0.0 : truth::exactDistance(ma, *f.a.pose, mb, *f.b.pose);
+      if (const auto depth = perception.depthOf(test.centreOfCollision())) {
+        f.value = perceivedInaccuracy(perception.measure(test).eccentricity_px, f.gap * perception.focalPx() / *depth);
+      }
+    }
+    for (std::size_t b = 0; b < shares.size(); ++b) {
+      const auto budget = std::llround(shares[b] * static_cast<double>(full.sphere_tests));
+      left[0][b] += pLeft(facts, nullptr, budget, perception);
+      left[1][b] += pLeft(facts, by_reach, budget, perception);
+      left[2][b] += pLeft(facts, by_gap, budget, perception);
+      left[3][b] += queuesLeft(facts, eval.bodies().size(), perception, budget);
+      left[4][b] += oracleLeft(facts, budget);
+    }
+    std::fprintf(stderr, "  snapshot %d/%d\n", s + 1, snapshots);
+  }
+  std::printf("%s, %d snapshots: true P left / round-robin's, at a share of the full sphere tests\n\n| order |",
+              scene.c_str(), snapshots);
+  for (double share : shares) std::printf(" %.1f %% |", 100 * share);
+  std::printf("\n|---|");
+  for (std::size_t b = 0; b < shares.size(); ++b) std::printf("---|");
+  const char* names[] = {"round_robin", "greedy, g = reach", "greedy, g = paper's estimate",
+                         "priority_queues (defaults)", "oracle"};
+  for (int o = 0; o < 5; ++o) {
+    std::printf("\n| %s |", names[o]);
+    for (std::size_t b = 0; b < shares.size(); ++b) std::printf(" %.2f |", left[o][b] / left[0][b]);
+  }
+  std::printf("\n");
+  return 0;
+}
