@@ -290,7 +290,10 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
     contact.normal = normal;
     contact.depth = std::max(0.0, rep.overlap);
     contact.separation = clusterSeparation(candidates_, cluster, normal, geometry, rep.separation);
-    contact.gap_bound = test.gapBound();
+    // h_a + h_b of the representative's spheres (PairTest::gapBound would
+    // scan all of lastPairs() again for its deepest pair).
+    contact.gap_bound = test.hasLastPair() ? test.bodyA().tree->node(rep.node_a).h + test.bodyB().tree->node(rep.node_b).h
+                                           : test.gapBound();
     contact.level = std::max(0, test.deepestLevel());
     contact.resolved = status == PairStatus::Colliding;
     contact.priority = priority;
