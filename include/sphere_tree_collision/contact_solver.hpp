@@ -91,6 +91,7 @@ class ContactSolver {
     Vec3 ang_a[3], ang_b[3];
     double inv_ma = 0.0, inv_mb = 0.0;
     double mass[3] = {0.0, 0.0, 0.0};  // 1 / effective mass along n, t1, t2
+    double coupling[2] = {0.0, 0.0};   // normal velocity change per unit impulse along t1, t2
     double friction = 0.0;
     double speculative = 0.0;          // closing speed allowed by a gap: max(s, 0) / dt
     double lambda[3] = {0.0, 0.0, 0.0};
@@ -147,7 +148,7 @@ class ContactSolver {
   std::vector<Row> rows_;
   std::vector<RowInfo> info_;
   std::vector<std::uint32_t> manifold_start_;  // rows of one body pair: [start[m], start[m + 1])
-  std::vector<std::uint32_t> order_, active_, level_start_;
+  std::vector<std::uint32_t> order_, active_, level_start_, wave_rows_;
   std::vector<Motion> motion_;  // solver velocities, one per body
   std::vector<Motion> delta_;   // Jacobi: impulses of one iteration, applied together
   std::vector<Motion> pseudo_;  // split-impulse pseudo-velocities

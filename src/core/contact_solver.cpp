@@ -18,12 +18,18 @@ void tangentBasis(const Vec3& n, Vec3& t1, Vec3& t2) {
 
 namespace {
 
+#if defined(__GNUC__)
+#define STC_HOT_INLINE inline __attribute__((always_inline))
+#else
+#define STC_HOT_INLINE inline
+#endif
+
 constexpr int kUnreached = std::numeric_limits<int>::max();
 
 std::uint64_t pairKey(EntityId a, EntityId b) { return (std::uint64_t{a} << 32) | std::uint64_t{b}; }
 
 // Relative velocity of b's point to a's point.
-inline Vec3 relativeVelocity(const ContactSolver::Row& row, const Vec3& va, const Vec3& wa, const Vec3& vb,
+STC_HOT_INLINE Vec3 relativeVelocity(const ContactSolver::Row& row, const Vec3& va, const Vec3& wa, const Vec3& vb,
                              const Vec3& wb) {
   return vb + wb.cross(row.rb) - va - wa.cross(row.ra);
 }
@@ -31,7 +37,7 @@ inline Vec3 relativeVelocity(const ContactSolver::Row& row, const Vec3& va, cons
 // Friction of one row from the relative velocity now, clamped to the cone of
 // its normal impulse so far (incl. the bounce); adds to its lambdas and
 // returns the change along t1, t2.
-inline Eigen::Vector2d frictionStep(ContactSolver::Row& row, const Vec3& vrel, double mass_t1, double mass_t2) {
+STC_HOT_INLINE Eigen::Vector2d frictionStep(ContactSolver::Row& row, const Vec3& vrel, double mass_t1, double mass_t2) {
   const double limit = row.friction * (row.lambda[0] + row.bounce_impulse);
   const double t1 = row.lambda[1] - mass_t1 * vrel.dot(row.t1);
   const double t2 = row.lambda[2] - mass_t2 * vrel.dot(row.t2);
@@ -44,7 +50,7 @@ inline Eigen::Vector2d frictionStep(ContactSolver::Row& row, const Vec3& vrel, d
 }
 
 // Impulse `d1` along t1 plus `d2` along t2 (b gets +, a gets -).
-inline void applyFriction(const ContactSolver::Row& row, double d1, double d2, ContactSolver::Motion& a,
+STC_HOT_INLINE void applyFriction(const ContactSolver::Row& row, double d1, double d2, ContactSolver::Motion& a,
                           ContactSolver::Motion& b) {
   const Vec3 p = d1 * row.t1 + d2 * row.t2;
   a.v -= row.inv_ma * p;
@@ -53,7 +59,7 @@ inline void applyFriction(const ContactSolver::Row& row, double d1, double d2, C
   b.w += d1 * row.ang_b[1] + d2 * row.ang_b[2];
 }
 
-inline void applyNormal(const ContactSolver::Row& row, double impulse, ContactSolver::Motion& a,
+STC_HOT_INLINE void applyNormal(const ContactSolver::Row& row, double impulse, ContactSolver::Motion& a,
                         ContactSolver::Motion& b) {
   a.v -= row.inv_ma * impulse * row.n;
   b.v += row.inv_mb * impulse * row.n;
@@ -61,18 +67,24 @@ inline void applyNormal(const ContactSolver::Row& row, double impulse, ContactSo
   b.w += impulse * row.ang_b[0];
 }
 
-}  // namespace
-
-void ContactSolver::relax(Row& row, Motion& a, Motion& b) {
+// One sequential-impulse step of a row (ContactSolver::relax).
+STC_HOT_INLINE void relaxRow(ContactSolver::Row& row, ContactSolver::Motion& a, ContactSolver::Motion& b) {
   // Friction first, bounded by the normal impulse so far (Box2D order).
-  const Eigen::Vector2d d = frictionStep(row, relativeVelocity(row, a.v, a.w, b.v, b.w), row.mass[1], row.mass[2]);
+  const Vec3 vrel = relativeVelocity(row, a.v, a.w, b.v, b.w);
+  const Eigen::Vector2d d = frictionStep(row, vrel, row.mass[1], row.mass[2]);
   applyFriction(row, d.x(), d.y(), a, b);
-  const double vn = relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n);
+  // The normal velocity after the friction impulse, without a second pass
+  // over both bodies' velocities.
+  const double vn = vrel.dot(row.n) + d.x() * row.coupling[0] + d.y() * row.coupling[1];
   const double normal = std::max(0.0, row.lambda[0] + row.mass[0] * (-row.speculative - vn));
   const double dn = normal - row.lambda[0];
   row.lambda[0] = normal;
   applyNormal(row, dn, a, b);
 }
+
+}  // namespace
+
+void ContactSolver::relax(Row& row, Motion& a, Motion& b) { relaxRow(row, a, b); }
 
 void ContactSolver::prepare(const std::vector<BodyState>& bodies,
                             const std::vector<Contact>& contacts, const ResponseOptions& options,
@@ -144,6 +156,9 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
       row.mass[k] = k_total > 0.0 ? 1.0 / k_total : 0.0;
       const double k_shock = (info.move_a ? ka : 0.0) + (info.move_b ? kb : 0.0);
       info.shock_mass[k] = k_shock > 0.0 ? 1.0 / k_shock : 0.0;
+    }
+    for (int k = 1; k < 3; ++k) {
+      row.coupling[k - 1] = row.ra.cross(row.n).dot(row.ang_a[k]) + row.rb.cross(row.n).dot(row.ang_b[k]);
     }
     row.lambda[0] = row.lambda[1] = row.lambda[2] = 0.0;
     row.bounce_impulse = 0.0;
@@ -358,7 +373,7 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
       Row* const end = rows_.data() + manifold_start_[m + 1];
       Motion a = motion_[row->a];
       Motion b = motion_[row->b];
-      for (; row != end; ++row) relax(*row, a, b);
+      for (; row != end; ++row) relaxRow(*row, a, b);
       motion_[(end - 1)->a] = a;
       motion_[(end - 1)->b] = b;
     }
@@ -392,16 +407,18 @@ void ContactSolver::collide(const ResponseOptions& options, SolveStats& stats) {
   }
   if (!any) return;
   for (int wave = 0; wave < options.iterations; ++wave) {
-    for (RowInfo& info : info_) {
+    wave_rows_.clear();  // iterated alone: a wave is a few rows of many
+    for (std::uint32_t r = 0; r < info_.size(); ++r) {
+      RowInfo& info = info_[r];
       if (info.wave == wave) {
         ++stats.bounced;
         info.lambda_wave = 0.0;
+        wave_rows_.push_back(r);
       }
     }
     for (int it = 0; it < options.iterations; ++it) {
-      for (std::size_t r = 0; r < rows_.size(); ++r) {
+      for (const std::uint32_t r : wave_rows_) {
         RowInfo& info = info_[r];
-        if (info.wave != wave) continue;
         Row& row = rows_[r];
         const double target = -info.restitution * info.bounce_from;
         const double impulse = std::max(0.0, info.lambda_wave + row.mass[0] * (target - normalVelocity(row)));
