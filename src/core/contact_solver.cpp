@@ -115,6 +115,13 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   rows_.resize(order_.size());
   info_.resize(order_.size());
   manifold_start_.clear();
+  // Everything sized by the rows grows with them, in the same tick (no
+  // allocation in a later tick whose waves or manifolds happen to be larger;
+  // both warm-start buffers, as they swap every tick).
+  manifold_start_.reserve(rows_.size() + 1);
+  wave_rows_.reserve(rows_.size());
+  for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_}) v->reserve(rows_.size());
+  for (std::vector<CachedPoint>* v : {&cache_, &next_cache_}) v->reserve(rows_.size());
   for (std::size_t r = 0; r < order_.size(); ++r) {
     const std::uint32_t ci = order_[r];
     const Contact& c = contacts[ci];
