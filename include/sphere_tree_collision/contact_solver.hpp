@@ -91,7 +91,6 @@ class ContactSolver {
     Vec3 ang_a[3], ang_b[3];
     double inv_ma = 0.0, inv_mb = 0.0;
     double mass[3] = {0.0, 0.0, 0.0};  // 1 / effective mass along n, t1, t2
-    double coupling[2] = {0.0, 0.0};   // normal velocity change per unit impulse along t1, t2
     double friction = 0.0;
     double speculative = 0.0;          // closing speed allowed by a gap: max(s, 0) / dt
     double lambda[3] = {0.0, 0.0, 0.0};
