@@ -26,8 +26,6 @@ void tangentBasis(const Vec3& n, Vec3& t1, Vec3& t2);
 struct SolveStats {
   std::size_t contacts = 0;
   std::size_t warm_started = 0;     // contacts that found last tick's impulse
-  std::size_t warm_by_feature = 0;  // ... of those, by the same feature id (leaf sphere pair)
-  std::size_t manifolds = 0;        // body pairs with contacts (rows of one pair are solved together)
   std::size_t bounced = 0;          // contacts that got a restitution impulse
   double max_penetration = 0.0;     // max(-separation) over the contacts, metres
   int velocity_passes = 0;          // velocity iterations run (>= 1 with contacts)
@@ -57,12 +55,8 @@ struct SolveBudget {
 // Position correction by split impulse: pseudo-velocities that move the
 // bodies out of penetration beyond the slop and are then discarded, so no
 // kinetic energy is added. Contacts' normal_impulse/friction_impulse are
-// filled in. The contacts of one body pair (its manifold: consecutive in the
-// array, as ContactBuilder emits them) are solved together. Warm starting
-// keeps each pair's manifold from tick to tick: a point takes the impulse of
-// last tick's point with the same feature id (Contact::node_a/node_b, the
-// leaf sphere pair it was built from), else of the nearest one in body A's
-// frame within half the gap bound; each old point is used once. Stopped early by the
+// filled in. Warm starting matches contacts by entity pair and the contact
+// point in body A's frame (within half the gap bound). Stopped early by the
 // budget, the state is as consistent as after a full solve: normal impulses
 // >= 0, friction clamped to the cone as each pass goes, and velocities what
 // the impulses sum to (shock propagation aside: it holds supports still).
@@ -70,72 +64,53 @@ class ContactSolver {
  public:
   SolveStats solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
                    const ResponseOptions& options, double dt, const SolveBudget& budget = SolveBudget{});
-  void forget() {  // drop warm-start impulses
-    cache_.clear();
-    cache_manifolds_.clear();
-  }
+  void forget() { cache_.clear(); }  // drop warm-start impulses
 
-  // A body's velocities as the solver sees them: one cache line per body.
-  struct Motion {
-    Vec3 v = Vec3::Zero();
-    Vec3 w = Vec3::Zero();
-  };
-  // What the iterations read and write of one contact point: its normal and
-  // two tangent rows. Everything else about the contact is in RowInfo, so
-  // each pass streams only this.
+ private:
+  // One contact's constraint rows: normal, two tangents.
   struct Row {
     std::uint32_t a = 0, b = 0;
+    std::uint32_t contact = 0;  // index into the contacts array
     Vec3 ra, rb;  // contact point relative to the centres of mass
     Vec3 n, t1, t2;
     // Angular velocity change per unit impulse along n, t1, t2 (I^-1 (r x d)).
     Vec3 ang_a[3], ang_b[3];
     double inv_ma = 0.0, inv_mb = 0.0;
     double mass[3] = {0.0, 0.0, 0.0};  // 1 / effective mass along n, t1, t2
-    double friction = 0.0;
-    double speculative = 0.0;          // closing speed allowed by a gap: max(s, 0) / dt
-    double lambda[3] = {0.0, 0.0, 0.0};
-    double bounce_impulse = 0.0;       // of all its restitution waves (before the solve)
-  };
-  // One sequential-impulse step of a row (friction, then non-penetration)
-  // on the velocities of its two bodies: the unit of work of a pass.
-  static void relax(Row& row, Motion& a, Motion& b);
-
- private:
-  // The rest of a row: the restitution waves, shock propagation and the
-  // position pass read it; the velocity iterations do not.
-  struct RowInfo {
-    std::uint32_t contact = 0;  // index into the contacts array
-    int level = 0;              // contact-graph distance of the lower body from a static one
-    bool move_a = true, move_b = true;   // shock propagation holds the supporting body
-    double shock_mass[3] = {0.0, 0.0, 0.0};  // 1 / effective mass with the support held
-    double restitution = 0.0;
+    double k_a[3] = {0.0, 0.0, 0.0};   // each body's part of the effective inverse mass
+    double k_b[3] = {0.0, 0.0, 0.0};
+    int level = 0;             // contact-graph distance of the lower body from a static one
+    std::uint8_t support = 0;  // 1: a supports b (a is nearer the ground), 2: b supports a, 0: neither
+    double friction = 0.0, restitution = 0.0;
     double approach = 0.0;     // normal relative velocity before the solve (< 0: closing)
+    double speculative = 0.0;  // closing speed allowed by a gap: max(s, 0) / dt
     double push = 0.0;         // split impulse: target normal pseudo-velocity
+    double lambda[3] = {0.0, 0.0, 0.0};
     double lambda_main = 0.0;  // normal impulse before restitution (what warm starts)
     double lambda_push = 0.0;
     double bounce_from = 0.0;  // normal velocity its bounce reverses (< 0), in its wave
     double lambda_wave = 0.0;  // impulse of the current restitution wave
+    double bounce_impulse = 0.0;  // of all its restitution waves (before the solve)
     int wave = -1;             // restitution wave it bounced in (-1: none)
     bool bounced = false;      // took a restitution impulse this tick
   };
-  // Last tick's manifold of a body pair: its points' impulses, by feature id
-  // (the leaf sphere pair a point was built from) and position in A's frame.
-  struct CachedPoint {
-    std::int32_t node_a = 0, node_b = 0;
-    Vec3 local_a = Vec3::Zero();
+  struct Cached {
+    EntityId a = kInvalidEntity, b = kInvalidEntity;
+    Vec3 local_a = Vec3::Zero();  // contact point in body A's frame
     double normal = 0.0;
     Vec3 friction = Vec3::Zero();  // world frame
   };
-  struct CachedManifold {
-    std::uint64_t pair = 0;              // entity ids a, b packed: the sort key
-    std::uint32_t first = 0, count = 0;  // its points in cache_
-  };
   void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
                const ResponseOptions& options, double dt, SolveStats& stats);
-  void orderFromTheGround(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
+  void orderFromTheGround(const std::vector<BodyState>& bodies);
   void warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
                  SolveStats& stats);
-  void commitJacobi(std::vector<Motion>& motion);
+  void commitJacobi(std::vector<Vec3>& v, std::vector<Vec3>& w);
+  static void applyNormal(const Row& row, double impulse, std::vector<Vec3>& v, std::vector<Vec3>& w);
+  // Friction of one row from the velocities now, clamped to the cone of its
+  // normal impulse so far (incl. the bounce); adds to its lambdas and returns
+  // the change along t1, t2.
+  Eigen::Vector2d frictionStep(Row& row, double mass_t1, double mass_t2) const;
   void solveVelocities(const ResponseOptions& options, int passes);
   int affordableIterations(const ResponseOptions& options, int cap, double pass_seconds,
                            double seconds_left) const;
@@ -144,18 +119,15 @@ class ContactSolver {
   int solvePositions(const ResponseOptions& options, const Deadline& deadline);
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
 
-  std::vector<Row> rows_;
-  std::vector<RowInfo> info_;
-  std::vector<std::uint32_t> manifold_start_;  // rows of one body pair: [start[m], start[m + 1])
-  std::vector<std::uint32_t> order_, active_, level_start_, wave_rows_;
-  std::vector<Motion> motion_;  // solver velocities, one per body
-  std::vector<Motion> delta_;   // Jacobi: impulses of one iteration, applied together
-  std::vector<Motion> pseudo_;  // split-impulse pseudo-velocities
+  std::vector<Row> rows_, sorted_rows_;
+  std::vector<std::uint32_t> order_, level_start_;
+  std::vector<Vec3> v_, w_;    // solver velocities, one per body
+  std::vector<Vec3> dv_, dw_;  // Jacobi: impulses of one iteration, applied together
+  std::vector<Vec3> pv_, pw_;  // split-impulse pseudo-velocities
   std::vector<int> contact_count_;
   std::vector<int> depth_, adjacency_start_, fill_;  // contact graph, for the row order
   std::vector<std::uint32_t> adjacency_, queue_;
-  std::vector<CachedPoint> cache_, next_cache_;
-  std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // sorted by pair
+  std::vector<Cached> cache_, next_cache_;
 };
 
 // One-shot solve without warm starting (tests, tools).
