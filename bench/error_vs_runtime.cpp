@@ -35,6 +35,7 @@
 #include "sphere_tree_collision/world.hpp"
 
 #include "fcl_mesh.hpp"
+#include "bench_args.hpp"
 #include "tick_clock.hpp"
 
 #include <algorithm>
@@ -448,23 +449,19 @@ std::string report(const std::map<RowKey, Row>& rows, const Options& opt) {
 
 int main(int argc, char** argv) {
   Options opt;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+  for (stc_bench::Args args(argc, argv); args.more();) {
+    const std::string& a = args.flag();
     if (a == "--quick") opt.quick = true;
-    else if (a == "--csv") opt.csv = next();
-    else if (a == "--markdown") opt.markdown = next();
-    else if (a == "--snapshots") opt.snapshots = std::stoi(next());
-    else if (a == "--repeats") opt.repeats = std::max(1, std::stoi(next()));
-    else if (a == "--scene") opt.scene = next();
-    else if (a == "--gaze") opt.gaze = next();
-    else if (a == "--queues") opt.queues = std::stoi(next());
-    else if (a == "--ratio") opt.ratio = std::stod(next());
-    else if (a == "--cost-exponent") opt.cost_exponent = std::stod(next());
-    else {
-      std::fprintf(stderr, "unknown argument %s\n", a.c_str());
-      return 2;
-    }
+    else if (a == "--csv") opt.csv = args.value();
+    else if (a == "--markdown") opt.markdown = args.value();
+    else if (a == "--snapshots") opt.snapshots = std::stoi(args.value());
+    else if (a == "--repeats") opt.repeats = std::max(1, std::stoi(args.value()));
+    else if (a == "--scene") opt.scene = args.value();
+    else if (a == "--gaze") opt.gaze = args.value();
+    else if (a == "--queues") opt.queues = std::stoi(args.value());
+    else if (a == "--ratio") opt.ratio = std::stod(args.value());
+    else if (a == "--cost-exponent") opt.cost_exponent = std::stod(args.value());
+    else return args.unknown();
   }
   std::map<RowKey, Row> rows;
   LoadStats load;

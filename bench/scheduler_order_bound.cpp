@@ -21,6 +21,7 @@
 #include "sphere_tree_collision/world.hpp"
 
 #include "fcl_mesh.hpp"
+#include "bench_args.hpp"
 #include "scene_sim.hpp"
 
 #include <algorithm>
@@ -130,15 +131,11 @@ double oracleLeft(const std::vector<PairFacts>& facts, std::int64_t budget) {
 int main(int argc, char** argv) {
   std::string scene = "packed_box";
   int snapshots = 6;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--scene") scene = next();
-    else if (a == "--snapshots") snapshots = std::stoi(next());
-    else {
-      std::fprintf(stderr, "unknown argument %s\n", a.c_str());
-      return 2;
-    }
+  for (stc_bench::Args args(argc, argv); args.more();) {
+    const std::string& a = args.flag();
+    if (a == "--scene") scene = args.value();
+    else if (a == "--snapshots") snapshots = std::stoi(args.value());
+    else return args.unknown();
   }
   const SceneKind kind = parseScene(scene);
   stc_bench::SceneSim scene_sim = stc_bench::makeSceneSim(kind);

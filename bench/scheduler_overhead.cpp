@@ -24,6 +24,7 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
+#include "bench_args.hpp"
 #include "scene_sim.hpp"
 #include "tick_clock.hpp"
 
@@ -64,17 +65,13 @@ int main(int argc, char** argv) {
   std::string scene = "packed_box", only = "all";
   int ticks = 60;
   double retry_s = 20e-6;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--scene") scene = next();
-    else if (a == "--scheduler") only = next();
-    else if (a == "--ticks") ticks = std::stoi(next());
+  for (stc_bench::Args args(argc, argv); args.more();) {
+    const std::string& a = args.flag();
+    if (a == "--scene") scene = args.value();
+    else if (a == "--scheduler") only = args.value();
+    else if (a == "--ticks") ticks = std::stoi(args.value());
     else if (a == "--no-retry") retry_s = 1e9;
-    else {
-      std::fprintf(stderr, "unknown argument %s\n", a.c_str());
-      return 2;
-    }
+    else return args.unknown();
   }
   const SceneKind kind = parseScene(scene);
   stc_bench::SceneSim scene_sim = stc_bench::makeSceneSim(kind);

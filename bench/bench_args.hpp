@@ -1,0 +1,30 @@
+// Command-line flags of the benchmarks: `--name value` pairs and bare switches,
+// walked in order, so each bench lists only its own flags.
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+namespace stc_bench {
+
+class Args {
+ public:
+  Args(int argc, char** argv) : argc_(argc), argv_(argv) {}
+  bool more() const { return next_ < argc_; }
+  const std::string& flag() { return flag_ = argv_[next_++]; }
+  // The value after the current flag ("" when the flag ends the line).
+  std::string value() { return next_ < argc_ ? argv_[next_++] : ""; }
+  // Says which flag is unknown; the exit code for main.
+  int unknown() const {
+    std::fprintf(stderr, "unknown argument %s\n", flag_.c_str());
+    return 2;
+  }
+
+ private:
+  int argc_;
+  char** argv_;
+  int next_ = 1;
+  std::string flag_;
+};
+
+}  // namespace stc_bench
