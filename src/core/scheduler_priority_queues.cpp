@@ -87,7 +87,7 @@ inline int PriorityQueueScheduler::binOf(double priority) const {
   return q;
 }
 
-void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t count,
+void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
                                     const PairBodies& bodies, const Perception& perception) {
   if (gaze_.size() < bodies.body_count) gaze_.resize(bodies.body_count);
   if (++run_ == 0) {  // the stamp wrapped: forget every body's projection
@@ -121,7 +121,7 @@ void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t co
   }
 }
 
-ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::size_t count,
+ScheduleStats PriorityQueueScheduler::run(PairTest* tests, std::size_t count,
                                           const PairBodies& bodies, const Perception* perception,
                                           BudgetTracker& budget) {
   ScheduleStats stats;
