@@ -130,6 +130,11 @@ class ContactSolver {
   // rows(begin, end) over every colour's rows in turn, a colour's body-pair
   // groups split over the workers; each range holds whole groups.
   void forEachColour(RangeFn rows);
+  // Shock propagation's order: the levels from the ground (unreached rows
+  // aside), and a level's rows colour by colour, as forEachColour.
+  std::size_t shockLevels() const { return level_segment_start_.empty() ? 0 : level_segment_start_.size() - 1; }
+  void forEachColourOfLevel(std::size_t level, RangeFn rows);
+  void forEachGroupRun(std::uint32_t first, std::uint32_t end, RangeFn rows) const;  // groups [first, end)
 
   std::vector<Row> rows_, sorted_rows_;
   std::vector<std::uint32_t> order_, level_start_;
@@ -142,11 +147,19 @@ class ContactSolver {
   std::vector<Cached> cache_, next_cache_;
   // Colouring (contact_solver_colours.cpp): the body-pair groups of the rows,
   // their colours, and in colour order where each colour's groups and each
-  // group's rows start; by_level_: row positions in the order from the ground.
+  // group's rows start.
   const Workers* workers_ = nullptr;
   ContactColouring colouring_;
   std::vector<ColourGroup> groups_;
-  std::vector<std::uint32_t> group_of_row_, colour_group_start_, group_row_start_, by_level_, group_order_;
+  std::vector<std::uint32_t> group_of_row_, colour_group_start_, group_row_start_, group_order_;
+  // Per level from the ground: its runs of groups, one per colour
+  // (positions in colour order); the levels' first runs.
+  struct GroupRun {
+    std::uint32_t first = 0, end = 0;
+  };
+  std::vector<GroupRun> level_runs_;
+  std::vector<std::uint32_t> level_segment_start_, cursor_;
+  std::vector<int> levels_;
 };
 
 // One-shot solve without warm starting (tests, tools).

@@ -165,19 +165,14 @@ void ContactSolver::orderFromTheGround(const std::vector<BodyState>& bodies) {
 // supporting body of each row held still. Unreached rows (nothing static
 // below them) are left as the iterations made them.
 void ContactSolver::propagateShock(const ResponseOptions& options) {
-  constexpr int kUnreached = std::numeric_limits<int>::max();
   const int passes = std::max(2, options.iterations / 2);
-  // In the order from the ground (rows_ is in colour order).
-  const auto at = [&](std::size_t k) -> Row& { return rows_[by_level_[k]]; };
-  std::size_t begin = 0;
-  while (begin < rows_.size() && at(begin).level != kUnreached) {
-    std::size_t end = begin;
-    while (end < rows_.size() && at(end).level == at(begin).level) ++end;
-    for (int pass = 0; pass < passes; ++pass) {
+  // Level by level; a level's rows colour by colour (forEachColourOfLevel).
+  for (std::size_t level = 0; level < shockLevels(); ++level) {
+    for (int pass = 0; pass < passes; ++pass) forEachColourOfLevel(level, [&](std::size_t begin, std::size_t end) {
       for (std::size_t r = begin; r < end; ++r) {
-        Row& row = at(r);
-        const bool move_a = row.support != 1;  // a is held when it supports b
-        const bool move_b = row.support != 2;
+        Row& row = rows_[r];
+        const bool move_a = row.support != 1 && !row.static_a;  // a is held when it supports b
+        const bool move_b = row.support != 2 && !row.static_b;
         double mass[3];
         for (int k = 0; k < 3; ++k) {
           const double kk = (move_a ? row.k_a[k] : 0.0) + (move_b ? row.k_b[k] : 0.0);
@@ -202,8 +197,7 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
         apply(0, normal - row.lambda[0]);
         row.lambda[0] = normal;
       }
-    }
-    begin = end;
+    });
   }
 }
 

@@ -2,6 +2,8 @@
 // runs a pass over them colour by colour, each colour's groups in parallel.
 #include "sphere_tree_collision/contact_solver.hpp"
 
+#include <limits>
+
 namespace stc {
 namespace {
 
@@ -16,8 +18,10 @@ void ContactSolver::colourRows(std::size_t body_count) {
   // and stay so in the order from the ground, which is stable).
   groups_.clear();
   group_of_row_.clear();  // here: each group's first row, in the order from the ground
+  levels_.clear();        // the levels met, in that order
   for (std::size_t r = 0; r < rows_.size(); ++r) {
     const Row& row = rows_[r];
+    if (levels_.empty() || levels_.back() != row.level) levels_.push_back(row.level);
     if (r > 0 && row.a == rows_[r - 1].a && row.b == rows_[r - 1].b) continue;
     ColourGroup group;
     group.a = row.static_a ? ColourGroup::kStatic : row.a;
@@ -37,27 +41,51 @@ void ContactSolver::colourRows(std::size_t body_count) {
   group_row_start_.assign(colour_group_start_.begin(), colour_group_start_.end() - 1);  // fill positions
   for (std::uint32_t g = 0; g < groups_.size(); ++g) group_order_[group_row_start_[colour[g]]++] = g;
   group_row_start_.resize(groups_.size() + 1);
-  by_level_.resize(rows_.size());
   sorted_rows_.clear();
   for (std::size_t pos = 0; pos < group_order_.size(); ++pos) {
     const std::uint32_t g = group_order_[pos];
     group_row_start_[pos] = static_cast<std::uint32_t>(sorted_rows_.size());
-    for (std::uint32_t r = group_of_row_[g]; r < group_of_row_[g + 1]; ++r) {
-      by_level_[r] = static_cast<std::uint32_t>(sorted_rows_.size());
-      sorted_rows_.push_back(rows_[r]);
-    }
+    for (std::uint32_t r = group_of_row_[g]; r < group_of_row_[g + 1]; ++r) sorted_rows_.push_back(rows_[r]);
   }
   group_row_start_[groups_.size()] = static_cast<std::uint32_t>(sorted_rows_.size());
   rows_.swap(sorted_rows_);
+
+  // Shock propagation's runs: within a colour the groups are in the order
+  // from the ground, so each level takes the next run of every colour.
+  // Restricted to one level, colour order still meets each body's rows in
+  // the serial order: a level colour by colour gives the serial bits too.
+  constexpr int kUnreached = std::numeric_limits<int>::max();
+  level_runs_.clear();
+  level_segment_start_.clear();
+  cursor_.assign(colour_group_start_.begin(), colour_group_start_.end() - 1);
+  for (const int level : levels_) {
+    if (level == kUnreached) break;  // nothing static below: no shock to pass on
+    level_segment_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
+    for (std::size_t c = 0; c < cursor_.size(); ++c) {
+      std::uint32_t end = cursor_[c];
+      while (end < colour_group_start_[c + 1] && rows_[group_row_start_[end]].level == level) ++end;
+      if (end > cursor_[c]) level_runs_.push_back(GroupRun{cursor_[c], end});
+      cursor_[c] = end;
+    }
+  }
+  if (!level_segment_start_.empty()) level_segment_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
+}
+
+void ContactSolver::forEachGroupRun(std::uint32_t first, std::uint32_t end, RangeFn rows) const {
+  forEachIndex(workers_, end - first, kGroupsPerTask, [&](std::size_t begin, std::size_t stop) {
+    rows(group_row_start_[first + begin], group_row_start_[first + stop]);
+  });
 }
 
 void ContactSolver::forEachColour(RangeFn rows) {
   for (std::size_t c = 0; c + 1 < colour_group_start_.size(); ++c) {
-    const std::uint32_t first = colour_group_start_[c];
-    const std::uint32_t groups = colour_group_start_[c + 1] - first;
-    forEachIndex(workers_, groups, kGroupsPerTask, [&](std::size_t begin, std::size_t end) {
-      rows(group_row_start_[first + begin], group_row_start_[first + end]);
-    });
+    forEachGroupRun(colour_group_start_[c], colour_group_start_[c + 1], rows);
+  }
+}
+
+void ContactSolver::forEachColourOfLevel(std::size_t level, RangeFn rows) {
+  for (std::uint32_t k = level_segment_start_[level]; k < level_segment_start_[level + 1]; ++k) {
+    forEachGroupRun(level_runs_[k].first, level_runs_[k].end, rows);
   }
 }
 
