@@ -9,7 +9,7 @@ namespace {
 
 // Body-pair groups a task of a colour takes at least (a row is ~50 ns a pass):
 // a smaller colour is solved on the calling thread.
-constexpr std::size_t kGroupsPerTask = 8;
+constexpr std::size_t kGroupsPerTask = 128;
 
 }  // namespace
 
