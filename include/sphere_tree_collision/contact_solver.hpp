@@ -9,8 +9,10 @@
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/contact_colouring.hpp"
 #include "sphere_tree_collision/response_options.hpp"
 #include "sphere_tree_collision/types.hpp"
+#include "sphere_tree_collision/workers.hpp"
 
 #include <cstdint>
 #include <limits>
@@ -31,6 +33,7 @@ struct SolveStats {
   int velocity_passes = 0;          // velocity iterations run (>= 1 with contacts)
   int position_passes = 0;          // split-impulse iterations run (>= 1 with penetration)
   double refinement_seconds = 0.0;  // spent in the iterations a deadline may cut (set with one)
+  std::uint32_t colours = 0;        // colours of the contacts (contact_colouring.hpp): passes' sync points
 };
 
 // What the tick lets the solver spend: the response is refineable (paper 3.5
@@ -65,6 +68,9 @@ class ContactSolver {
   SolveStats solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
                    const ResponseOptions& options, double dt, const SolveBudget& budget = SolveBudget{});
   void forget() { cache_.clear(); }  // drop warm-start impulses
+  // Threads of the velocity and position iterations (nullptr: the caller's
+  // alone); the result is the same whatever they are (contact_colouring.hpp).
+  void setWorkers(const Workers* workers) { workers_ = workers; }
 
  private:
   // One contact's constraint rows: normal, two tangents.
@@ -93,6 +99,7 @@ class ContactSolver {
     double bounce_impulse = 0.0;  // of all its restitution waves (before the solve)
     int wave = -1;             // restitution wave it bounced in (-1: none)
     bool bounced = false;      // took a restitution impulse this tick
+    bool static_a = false, static_b = false;  // never moves: its velocity is not written
   };
   struct Cached {
     EntityId a = kInvalidEntity, b = kInvalidEntity;
@@ -118,6 +125,16 @@ class ContactSolver {
   void collide(const ResponseOptions& options, SolveStats& stats);
   int solvePositions(const ResponseOptions& options, const Deadline& deadline);
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
+  // After orderFromTheGround: rows_ reordered by colour (contact_solver_colours.cpp).
+  void colourRows(std::size_t body_count);
+  // rows(begin, end) over every colour's rows in turn, a colour's body-pair
+  // groups split over the workers; each range holds whole groups.
+  void forEachColour(RangeFn rows);
+  // Shock propagation's order: the levels from the ground (unreached rows
+  // aside), and a level's rows colour by colour, as forEachColour.
+  std::size_t shockLevels() const { return level_segment_start_.empty() ? 0 : level_segment_start_.size() - 1; }
+  void forEachColourOfLevel(std::size_t level, RangeFn rows);
+  void forEachGroupRun(std::uint32_t first, std::uint32_t end, RangeFn rows) const;  // groups [first, end)
 
   std::vector<Row> rows_, sorted_rows_;
   std::vector<std::uint32_t> order_, level_start_;
@@ -128,6 +145,21 @@ class ContactSolver {
   std::vector<int> depth_, adjacency_start_, fill_;  // contact graph, for the row order
   std::vector<std::uint32_t> adjacency_, queue_;
   std::vector<Cached> cache_, next_cache_;
+  // Colouring (contact_solver_colours.cpp): the body-pair groups of the rows,
+  // their colours, and in colour order where each colour's groups and each
+  // group's rows start.
+  const Workers* workers_ = nullptr;
+  ContactColouring colouring_;
+  std::vector<ColourGroup> groups_;
+  std::vector<std::uint32_t> group_of_row_, colour_group_start_, group_row_start_, group_order_;
+  // Per level from the ground: its runs of groups, one per colour
+  // (positions in colour order); the levels' first runs.
+  struct GroupRun {
+    std::uint32_t first = 0, end = 0;
+  };
+  std::vector<GroupRun> level_runs_;
+  std::vector<std::uint32_t> level_segment_start_, cursor_;
+  std::vector<int> levels_;
 };
 
 // One-shot solve without warm starting (tests, tools).

@@ -49,8 +49,10 @@ FreeRotation rotateFreely(const BodyState& body, double dt, bool gyroscopic = tr
 
 // x += v dt; orientation and angular velocity by rotateFreely; world inertia
 // refreshed. Static bodies untouched.
+void integratePosition(BodyState& body, const IntegrationOptions& options, double dt);
 void integratePositions(std::vector<BodyState>& bodies, const IntegrationOptions& options, double dt);
 // v += g dt for movable bodies; nothing at all when gravity is zero.
+void integrateVelocity(BodyState& body, const IntegrationOptions& options, double dt);
 void integrateVelocities(std::vector<BodyState>& bodies, const IntegrationOptions& options,
                          double dt);
 

@@ -8,6 +8,7 @@
 #include "sphere_tree_collision/continuous.hpp"
 #include "sphere_tree_collision/response_options.hpp"
 #include "sphere_tree_collision/shape_bounds.hpp"
+#include "sphere_tree_collision/workers.hpp"
 
 #include <array>
 #include <cstdint>
@@ -38,6 +39,7 @@ struct StepContext {
   bool accept_unresolved = true;  // policy accept: unresolved pairs give contacts too
   SolveBudget budget;             // what the solver may spend (respond)
   std::vector<Contact>* contacts = nullptr;  // respond's output
+  const Workers* workers = nullptr;  // threads of the parallel loops (nullptr: the caller's alone)
 };
 
 struct PhysicsReport {
@@ -68,7 +70,14 @@ class Physics {
   void forget() { solver_.forget(); }
 
  private:
-  ContactBuilder builder_;
+  void appendContacts(const StepContext& step, std::size_t first, std::size_t last, ContactBuilder& builder,
+                      std::vector<Contact>& out) const;
+
+  // A builder (its scratch) and the contacts of each chunk of the pairs
+  // (parallel contact building); capacity kept between ticks.
+  std::vector<ContactBuilder> builders_;
+  std::vector<std::vector<Contact>> chunk_contacts_;
+  std::size_t builder_turn_ = 0;
   ContactSolver solver_;
   double gravity_speed_ = 0.0;  // |g| dt of the last integrate
   std::vector<Pose> start_;

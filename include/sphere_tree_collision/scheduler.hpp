@@ -70,8 +70,14 @@ struct PairBodies {
 class Scheduler {
  public:
   virtual ~Scheduler() = default;
-  virtual ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
+  // tests[0..count) may be any run of a longer array (the World's parallel
+  // narrow phase gives each chunk of its pairs its own scheduler).
+  virtual ScheduleStats run(PairTest* tests, std::size_t count, const PairBodies& bodies,
                             const Perception* perception, BudgetTracker& budget) = 0;
+  ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
+                    const Perception* perception, BudgetTracker& budget) {
+    return run(tests.data(), count, bodies, perception, budget);
+  }
 };
 // Validates the options (see validateSchedulerOptions).
 std::unique_ptr<Scheduler> makeScheduler(const SchedulerOptions& options);

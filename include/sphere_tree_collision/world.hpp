@@ -9,6 +9,7 @@
 #include "sphere_tree_collision/fracture.hpp"
 #include "sphere_tree_collision/islands.hpp"
 #include "sphere_tree_collision/limits.hpp"
+#include "sphere_tree_collision/narrow_chunks.hpp"
 #include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
 #include "sphere_tree_collision/response.hpp"
@@ -16,6 +17,7 @@
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/sweep_and_prune.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
+#include "sphere_tree_collision/workers.hpp"
 
 #include <array>
 #include <deque>
@@ -50,6 +52,11 @@ struct WorldConfig {
   PhysicalLimits limits;  // inputs beyond them are rejected; bodies beyond them quarantined
   FractureOptions fracture;  // for bodies with a material strength (fracture.hpp)
   SleepOptions sleeping;  // islands at rest sleep (islands.hpp); validated as "sleeping.*"
+  // Threads of the tick (workers.hpp): 0 = every core, 1 = the calling thread
+  // alone (no task library), n = n. Results at an unlimited budget do not
+  // depend on it (docs/architecture.md, the parallel tick). Throws
+  // InputError("threads") outside [0, kMaxThreads].
+  int threads = 1;
 };
 
 struct EntitySpec {
@@ -205,6 +212,11 @@ class World {
   // Narrow-phase results of the last step: pairTests()[0..pairCount()).
   const std::vector<PairTest>& pairTests() const { return pair_tests_; }
   std::size_t pairCount() const { return pair_count_; }
+  // The narrow phase's chunks: pairs chunkRange(pairCount(), k, narrowChunks())
+  // were stepped by chunk k's scheduler under chunkShare(budget, k, ...).
+  std::size_t narrowChunks() const { return narrow_chunks_.size(); }
+  // Threads the tick runs on (WorldConfig::threads resolved: 0 -> the cores).
+  int threads() const { return workers_.threads(); }
   const std::vector<Contact>& contacts() const { return contacts_; }
   // The broad phase: its pairs and boxes as of the last step (checks and tests).
   const SweepAndPrune& broadPhase() const { return broad_phase_; }
@@ -245,9 +257,10 @@ class World {
   Aabb boxOf(std::size_t index) const;
   Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
-  bool setUpPairTests();  // of the broad phase's pairs; true when a sleeping island woke
+  bool setUpPairTests();  // bodies of the broad phase's pairs; true when a sleeping island woke
 
   WorldConfig config_;
+  Workers workers_;  // before the phases that use it
   std::deque<ShapeInfo> shapes_;  // deque: trees keep their address as shapes are added
   std::deque<ShapeBounds> shape_bounds_;  // by shape id, built in addShape; they point at the trees
   std::unordered_map<std::string, ShapeId> shape_by_key_;
@@ -263,12 +276,14 @@ class World {
   EntityId next_id_ = 0;
 
   SweepAndPrune broad_phase_;
-  std::unique_ptr<Scheduler> scheduler_;
+  std::vector<Aabb> boxes_;  // this tick's box of each body, by dense index (pooled)
+  // The narrow phase's chunks, one per thread (narrow_chunks.hpp): a
+  // scheduler each and the arena of its pair tests' hits; in a vector made
+  // once, so the arenas keep their address when the World is moved (the pair
+  // tests point at them).
+  std::vector<NarrowChunk> narrow_chunks_;
   Perception perception_;
   std::vector<PairTest> pair_tests_;  // pooled: capacity kept between ticks
-  // Hits and pairs of all pair tests of a tick; on the heap so that it keeps
-  // its address when the World is moved (the pair tests point at it).
-  std::unique_ptr<PairArena> pair_arena_ = std::make_unique<PairArena>();
   std::size_t pair_count_ = 0;
   std::vector<std::array<std::uint32_t, 2>> pair_bodies_;  // dense indices of each pair test's bodies
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)

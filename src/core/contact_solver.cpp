@@ -50,6 +50,8 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     row.b = c.index_b;
     row.inv_ma = ba.is_static ? 0.0 : ba.inv_mass;
     row.inv_mb = bb.is_static ? 0.0 : bb.inv_mass;
+    row.static_a = ba.is_static;
+    row.static_b = bb.is_static;
     if (row.inv_ma == 0.0 && row.inv_mb == 0.0) continue;  // two immovable bodies
     row.ra = c.point - ba.pose.position;
     row.rb = c.point - bb.pose.position;
@@ -89,6 +91,8 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   }
   stats.contacts = rows_.size();
   orderFromTheGround(bodies);
+  colourRows(body_count);
+  stats.colours = colouring_.colourCount();
 }
 
 // Gauss-Seidel converges fastest on a stack when the support is solved
@@ -161,17 +165,14 @@ void ContactSolver::orderFromTheGround(const std::vector<BodyState>& bodies) {
 // supporting body of each row held still. Unreached rows (nothing static
 // below them) are left as the iterations made them.
 void ContactSolver::propagateShock(const ResponseOptions& options) {
-  constexpr int kUnreached = std::numeric_limits<int>::max();
   const int passes = std::max(2, options.iterations / 2);
-  std::size_t begin = 0;
-  while (begin < rows_.size() && rows_[begin].level != kUnreached) {
-    std::size_t end = begin;
-    while (end < rows_.size() && rows_[end].level == rows_[begin].level) ++end;
-    for (int pass = 0; pass < passes; ++pass) {
+  // Level by level; a level's rows colour by colour (forEachColourOfLevel).
+  for (std::size_t level = 0; level < shockLevels(); ++level) {
+    for (int pass = 0; pass < passes; ++pass) forEachColourOfLevel(level, [&](std::size_t begin, std::size_t end) {
       for (std::size_t r = begin; r < end; ++r) {
         Row& row = rows_[r];
-        const bool move_a = row.support != 1;  // a is held when it supports b
-        const bool move_b = row.support != 2;
+        const bool move_a = row.support != 1 && !row.static_a;  // a is held when it supports b
+        const bool move_b = row.support != 2 && !row.static_b;
         double mass[3];
         for (int k = 0; k < 3; ++k) {
           const double kk = (move_a ? row.k_a[k] : 0.0) + (move_b ? row.k_b[k] : 0.0);
@@ -196,8 +197,7 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
         apply(0, normal - row.lambda[0]);
         row.lambda[0] = normal;
       }
-    }
-    begin = end;
+    });
   }
 }
 
@@ -254,10 +254,15 @@ void ContactSolver::commitJacobi(std::vector<Vec3>& v, std::vector<Vec3>& w) {
 
 void ContactSolver::applyNormal(const Row& row, double impulse, std::vector<Vec3>& v,
                                 std::vector<Vec3>& w) {
-  v[row.a] -= row.inv_ma * impulse * row.n;
-  v[row.b] += row.inv_mb * impulse * row.n;
-  w[row.a] -= impulse * row.ang_a[0];
-  w[row.b] += impulse * row.ang_b[0];
+  // A static body's velocity is never written: colours do not hold it apart.
+  if (!row.static_a) {
+    v[row.a] -= row.inv_ma * impulse * row.n;
+    w[row.a] -= impulse * row.ang_a[0];
+  }
+  if (!row.static_b) {
+    v[row.b] += row.inv_mb * impulse * row.n;
+    w[row.b] += impulse * row.ang_b[0];
+  }
 }
 
 Eigen::Vector2d ContactSolver::frictionStep(Row& row, double mass_t1, double mass_t2) const {
@@ -278,25 +283,33 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
   std::vector<Vec3>& out_v = jacobi ? dv_ : v_;
   std::vector<Vec3>& out_w = jacobi ? dw_ : w_;
   for (int it = 0; it < passes; ++it) {
-    for (Row& row : rows_) {
-      // Friction first, bounded by the normal impulse so far (Box2D order).
-      const Eigen::Vector2d d = frictionStep(row, row.mass[1], row.mass[2]);
-      const double d1 = d.x(), d2 = d.y();
-      const Vec3 pt = d1 * row.t1 + d2 * row.t2;
-      out_v[row.a] -= row.inv_ma * pt;
-      out_v[row.b] += row.inv_mb * pt;
-      out_w[row.a] -= d1 * row.ang_a[1] + d2 * row.ang_a[2];
-      out_w[row.b] += d1 * row.ang_b[1] + d2 * row.ang_b[2];
+    // Colour by colour; a colour's rows share no movable body (any split).
+    forEachColour([&](std::size_t begin, std::size_t end) {
+      for (std::size_t r = begin; r < end; ++r) {
+        Row& row = rows_[r];
+        // Friction first, bounded by the normal impulse so far (Box2D order).
+        const Eigen::Vector2d d = frictionStep(row, row.mass[1], row.mass[2]);
+        const double d1 = d.x(), d2 = d.y();
+        const Vec3 pt = d1 * row.t1 + d2 * row.t2;
+        if (!row.static_a) {
+          out_v[row.a] -= row.inv_ma * pt;
+          out_w[row.a] -= d1 * row.ang_a[1] + d2 * row.ang_a[2];
+        }
+        if (!row.static_b) {
+          out_v[row.b] += row.inv_mb * pt;
+          out_w[row.b] += d1 * row.ang_b[1] + d2 * row.ang_b[2];
+        }
 
-      // Non-penetration (Jacobi: v_ is untouched until the commit, so this is
-      // the same state the friction above saw).
-      const Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
-      const double normal =
-          std::max(0.0, row.lambda[0] + row.mass[0] * (-row.speculative - vrel.dot(row.n)));
-      const double dn = normal - row.lambda[0];
-      row.lambda[0] = normal;
-      applyNormal(row, dn, out_v, out_w);
-    }
+        // Non-penetration (Jacobi: v_ is untouched until the commit, so this is
+        // the same state the friction above saw).
+        const Vec3 vrel = v_[row.b] + w_[row.b].cross(row.rb) - v_[row.a] - w_[row.a].cross(row.ra);
+        const double normal =
+            std::max(0.0, row.lambda[0] + row.mass[0] * (-row.speculative - vrel.dot(row.n)));
+        const double dn = normal - row.lambda[0];
+        row.lambda[0] = normal;
+        applyNormal(row, dn, out_v, out_w);
+      }
+    });
     if (jacobi) commitJacobi(v_, w_);
   }
 }
@@ -371,18 +384,21 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
   int passes = 0;
   for (int it = 0; it < options.iterations; ++it, ++passes) {
     if (it > 0 && deadline.passed()) break;
-    for (Row& row : rows_) {
-      const Vec3 vrel =
-          pv_[row.b] + pw_[row.b].cross(row.rb) - pv_[row.a] - pw_[row.a].cross(row.ra);
-      // A contact that bounced across a speculative gap also closes the gap
-      // (may pull): the bounce starts at the surface, not where the gap
-      // was seen, so the rebound height does not gain up to |v| dt.
-      const double unclamped = row.lambda_push + row.mass[0] * (row.push - vrel.dot(row.n));
-      const double normal = row.bounced && row.push < 0.0 ? unclamped : std::max(0.0, unclamped);
-      const double delta = normal - row.lambda_push;
-      row.lambda_push = normal;
-      applyNormal(row, delta, out_v, out_w);
-    }
+    forEachColour([&](std::size_t begin, std::size_t end) {
+      for (std::size_t r = begin; r < end; ++r) {
+        Row& row = rows_[r];
+        const Vec3 vrel =
+            pv_[row.b] + pw_[row.b].cross(row.rb) - pv_[row.a] - pw_[row.a].cross(row.ra);
+        // A contact that bounced across a speculative gap also closes the gap
+        // (may pull): the bounce starts at the surface, not where the gap
+        // was seen, so the rebound height does not gain up to |v| dt.
+        const double unclamped = row.lambda_push + row.mass[0] * (row.push - vrel.dot(row.n));
+        const double normal = row.bounced && row.push < 0.0 ? unclamped : std::max(0.0, unclamped);
+        const double delta = normal - row.lambda_push;
+        row.lambda_push = normal;
+        applyNormal(row, delta, out_v, out_w);
+      }
+    });
     if (jacobi) commitJacobi(pv_, pw_);
   }
   return passes;

@@ -85,26 +85,29 @@ FreeRotation rotateFreely(const BodyState& body, double dt, bool gyroscopic) {
   return out;
 }
 
-void integratePositions(std::vector<BodyState>& bodies, const IntegrationOptions& options, double dt) {
-  for (BodyState& body : bodies) {
-    if (body.is_static) continue;
-    body.pose.position += body.linear_velocity * dt;
-    if (!body.angular_velocity.isZero(0.0)) {
-      const FreeRotation turned = rotateFreely(body, dt, options.gyroscopic);
-      body.pose.orientation = turned.orientation;
-      body.angular_velocity = turned.angular_velocity;
-      refreshWorldInertia(body);
-    }
+void integratePosition(BodyState& body, const IntegrationOptions& options, double dt) {
+  if (body.is_static) return;
+  body.pose.position += body.linear_velocity * dt;
+  if (!body.angular_velocity.isZero(0.0)) {
+    const FreeRotation turned = rotateFreely(body, dt, options.gyroscopic);
+    body.pose.orientation = turned.orientation;
+    body.angular_velocity = turned.angular_velocity;
+    refreshWorldInertia(body);
   }
+}
+
+void integratePositions(std::vector<BodyState>& bodies, const IntegrationOptions& options, double dt) {
+  for (BodyState& body : bodies) integratePosition(body, options, dt);
+}
+
+void integrateVelocity(BodyState& body, const IntegrationOptions& options, double dt) {
+  if (options.gravity.isZero(0.0)) return;
+  if (!body.is_static && body.inv_mass > 0.0) body.linear_velocity += options.gravity * dt;
 }
 
 void integrateVelocities(std::vector<BodyState>& bodies, const IntegrationOptions& options,
                          double dt) {
-  if (options.gravity.isZero(0.0)) return;
-  const Vec3 dv = options.gravity * dt;
-  for (BodyState& body : bodies) {
-    if (!body.is_static && body.inv_mass > 0.0) body.linear_velocity += dv;
-  }
+  for (BodyState& body : bodies) integrateVelocity(body, options, dt);
 }
 
 double kineticEnergy(const BodyState& body) {

@@ -11,6 +11,10 @@ namespace {
 
 // Approach slower than this many ticks of free fall is resting, not a bounce.
 constexpr double kRestingFallTicks = 4.0;
+// Bodies a task of the parallel integrate takes at least (a body is ~0.1 us).
+constexpr std::size_t kBodiesPerTask = 256;
+// Below this many pairs the contacts are built on the calling thread.
+constexpr std::size_t kPairsPerTask = 64;
 
 }  // namespace
 
@@ -20,12 +24,17 @@ void Physics::integrate(const StepContext& step) {
   report_.sweep = SweepStats{};
   gravity_speed_ = step.gravity.norm() * step.dt;
   start_.resize(bodies.size());
-  for (std::size_t i = 0; i < bodies.size(); ++i) start_[i] = bodies[i].pose;
   IntegrationOptions integration;
   integration.gravity = step.gravity;
   integration.gyroscopic = options.gyroscopic;
-  integratePositions(bodies, integration, step.dt);
-  integrateVelocities(bodies, integration, step.dt);
+  // Each body alone: any split of the bodies gives the same result.
+  forEachIndex(step.workers, bodies.size(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      start_[i] = bodies[i].pose;
+      integratePosition(bodies[i], integration, step.dt);
+      integrateVelocity(bodies[i], integration, step.dt);
+    }
+  });
   sweep_scratch_.fast.assign(bodies.size(), 0);
   // Without a response nothing would turn a body put back at its hit: no sweep.
   if (!(options.continuous && options.enabled && step.dt > 0.0)) return;
@@ -45,32 +54,26 @@ void Physics::sweep(const StepContext& step) {
                                   options.sweep_threshold, sweep_scratch_);
 }
 
-void Physics::respond(const StepContext& step) {
+// The contacts of pairs [first, last) appended to `out` in pair order.
+void Physics::appendContacts(const StepContext& step, std::size_t first, std::size_t last,
+                             ContactBuilder& builder, std::vector<Contact>& out) const {
   const ResponseOptions& options = *step.options;
   const std::vector<PairTest>& tests = *step.tests;
   const std::vector<std::array<std::uint32_t, 2>>& pair_bodies = *step.pair_bodies;
   const std::vector<double>& priorities = *step.priorities;
   const std::vector<std::uint32_t>& body_shapes = *step.body_shapes;
   const std::deque<ShapeBounds>& shape_bounds = *step.shape_bounds;
-  const std::size_t count = step.pair_count;
-  std::vector<Contact>& contacts = *step.contacts;
-  contacts.clear();
   ContactBuildOptions build;
   build.max_contacts_per_pair = options.max_contacts_per_pair;
   build.accept_unresolved = step.accept_unresolved;
   build.face_normals = options.face_normals;
-  sweep_hit_of_pair_.assign(count, -1);
-  for (const std::uint32_t body : sweep_scratch_.clamped) {
-    const SweepHit& hit = sweep_scratch_.hits[body];
-    if (hit.pair < count) sweep_hit_of_pair_[hit.pair] = static_cast<std::int32_t>(body);
-  }
-  for (std::size_t i = 0; i < count; ++i) {
+  for (std::size_t i = first; i < last; ++i) {
     const std::uint32_t ia = pair_bodies[i][0];
     const std::uint32_t ib = pair_bodies[i][1];
-    const std::size_t before = contacts.size();
-    builder_.append(tests[i], ia, ib, priorities[i], &shape_bounds[body_shapes[ia]],
-                    &shape_bounds[body_shapes[ib]], build, contacts);
-    if (contacts.size() == before && sweep_hit_of_pair_[i] >= 0) {
+    const std::size_t before = out.size();
+    builder.append(tests[i], ia, ib, priorities[i], &shape_bounds[body_shapes[ia]],
+                   &shape_bounds[body_shapes[ib]], build, out);
+    if (out.size() == before && sweep_hit_of_pair_[i] >= 0) {
       // The sweep held a body back at this pair's first touch but the test
       // (interrupted, or not accepted) gave no contact: the hit is the contact,
       // so the response turns the approach the sweep stopped.
@@ -84,13 +87,47 @@ void Physics::respond(const StepContext& step) {
       c.normal = hit.normal;
       c.resolved = true;
       c.priority = priorities[i];
-      contacts.push_back(c);
+      out.push_back(c);
+    }
+  }
+}
+
+void Physics::respond(const StepContext& step) {
+  const ResponseOptions& options = *step.options;
+  const std::size_t count = step.pair_count;
+  std::vector<Contact>& contacts = *step.contacts;
+  contacts.clear();
+  sweep_hit_of_pair_.assign(count, -1);
+  for (const std::uint32_t body : sweep_scratch_.clamped) {
+    const SweepHit& hit = sweep_scratch_.hits[body];
+    if (hit.pair < count) sweep_hit_of_pair_[hit.pair] = static_cast<std::int32_t>(body);
+  }
+  // Each pair's contacts depend on that pair alone: chunks of the pairs in
+  // parallel, each with its own builder, joined in pair order (the same
+  // contacts, in the same order, whatever the thread count).
+  const std::size_t chunks = step.workers != nullptr ? static_cast<std::size_t>(step.workers->threads()) : 1;
+  if (chunks == 1 || count < kPairsPerTask) {
+    appendContacts(step, 0, count, builders_.empty() ? builders_.emplace_back() : builders_[0], contacts);
+  } else {
+    if (builders_.size() < chunks) builders_.resize(chunks);
+    if (chunk_contacts_.size() < chunks) chunk_contacts_.resize(chunks);
+    // The builders take turns at the chunks, so each one's scratch grows to
+    // what any part of the pair list needs and then allocates no more.
+    ++builder_turn_;
+    step.workers->forChunks(chunks, [&](std::size_t k, std::size_t) {
+      chunk_contacts_[k].clear();
+      const auto [first, last] = chunkRange(count, k, chunks);
+      appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk_contacts_[k]);
+    });
+    for (std::size_t k = 0; k < chunks; ++k) {
+      contacts.insert(contacts.end(), chunk_contacts_[k].begin(), chunk_contacts_[k].end());
     }
   }
   report_.solve = SolveStats{};
   if (!options.enabled) return;
   ResponseOptions solve = options;
   solve.restitution_threshold = std::max(options.restitution_threshold, kRestingFallTicks * gravity_speed_);
+  solver_.setWorkers(step.workers);
   report_.solve = solver_.solve(*step.bodies, contacts, solve, step.dt, step.budget);
 }
 

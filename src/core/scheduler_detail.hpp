@@ -75,7 +75,7 @@ inline bool perceptionActive(const Perception* perception) {
 // Hubbard: one level for every unresolved pair in list order, then again.
 class RoundRobinScheduler final : public Scheduler {
  public:
-  ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
+  ScheduleStats run(PairTest* tests, std::size_t count, const PairBodies& bodies,
                     const Perception* perception, BudgetTracker& budget) override;
 
  private:
@@ -88,7 +88,7 @@ class RoundRobinScheduler final : public Scheduler {
 class SequentialScheduler final : public Scheduler {
  public:
   explicit SequentialScheduler(bool sort_by_priority) : sort_by_priority_(sort_by_priority) {}
-  ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
+  ScheduleStats run(PairTest* tests, std::size_t count, const PairBodies& bodies,
                     const Perception* perception, BudgetTracker& budget) override;
 
  private:
@@ -101,7 +101,7 @@ class SequentialScheduler final : public Scheduler {
 class PriorityQueueScheduler final : public Scheduler {
  public:
   explicit PriorityQueueScheduler(const SchedulerOptions& options);
-  ScheduleStats run(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
+  ScheduleStats run(PairTest* tests, std::size_t count, const PairBodies& bodies,
                     const Perception* perception, BudgetTracker& budget) override;
 
  private:
@@ -114,7 +114,7 @@ class PriorityQueueScheduler final : public Scheduler {
   };
   const BodyGaze& gazeOf(std::uint32_t body, const PairBody& pair_body, const Perception& perception);
   // Measures every unresolved pair, sets the bin edges from the largest priority, bins.
-  void binAll(std::vector<PairTest>& tests, std::size_t count, const PairBodies& bodies,
+  void binAll(PairTest* tests, std::size_t count, const PairBodies& bodies,
               const Perception& perception);
   double perCost(double f, int cost) const;
   int binOf(double priority) const;

@@ -125,7 +125,7 @@ inline int PriorityQueueScheduler::binAfterStep(const PairTest& test, float scal
   return std::clamp(queue_count_ + exponent, 0, queue_count_ - 1);
 }
 
-void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t count,
+void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
                                     const PairBodies& bodies, const Perception& perception) {
   if (gaze_.size() < bodies.body_count) gaze_.resize(bodies.body_count);
   if (++run_ == 0) {  // the stamp wrapped: forget every body's projection
@@ -164,7 +164,7 @@ void PriorityQueueScheduler::binAll(std::vector<PairTest>& tests, std::size_t co
   }
 }
 
-ScheduleStats PriorityQueueScheduler::run(std::vector<PairTest>& tests, std::size_t count,
+ScheduleStats PriorityQueueScheduler::run(PairTest* tests, std::size_t count,
                                           const PairBodies& bodies, const Perception* perception,
                                           BudgetTracker& budget) {
   ScheduleStats stats;

@@ -5,7 +5,7 @@
 
 namespace stc::detail {
 
-ScheduleStats RoundRobinScheduler::run(std::vector<PairTest>& tests, std::size_t count,
+ScheduleStats RoundRobinScheduler::run(PairTest* tests, std::size_t count,
                                        const PairBodies& /*bodies*/, const Perception* /*perception*/,
                                        BudgetTracker& budget) {
   ScheduleStats stats;

@@ -7,7 +7,7 @@
 
 namespace stc::detail {
 
-ScheduleStats SequentialScheduler::run(std::vector<PairTest>& tests, std::size_t count,
+ScheduleStats SequentialScheduler::run(PairTest* tests, std::size_t count,
                                        const PairBodies& /*bodies*/, const Perception* perception,
                                        BudgetTracker& budget) {
   ScheduleStats stats;

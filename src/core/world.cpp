@@ -24,6 +24,9 @@ constexpr double kReserveMargin = 1.1;
 // resolution 8: rod, plate and the flat L and ring pass; cube, sphere, rock do not.
 constexpr double kElongationRatio = 2.5;
 
+// Bodies a task of the parallel box update takes at least.
+constexpr std::size_t kBoxesPerTask = 256;
+
 // Max distance from `origin` to a corner of an occupied voxel: the radius of
 // a ball about the centre of mass that holds the shape in any orientation.
 double boundingRadius(const VoxelShape& shape, const Vec3& origin) {
@@ -63,7 +66,9 @@ bool isElongated(const VoxelShape& shape) {
 }  // namespace
 
 World::World(const WorldConfig& config)
-    : config_(config), scheduler_(makeScheduler(config.scheduler)) {
+    : config_(config),
+      workers_(config.threads),
+      narrow_chunks_(makeNarrowChunks(static_cast<std::size_t>(workers_.threads()), config.scheduler)) {
   validateLimits(config_.limits);
   validateGravity(config_.gravity, config_.limits);
   validateFractureOptions(config_.fracture);
@@ -228,8 +233,10 @@ void World::clear() {
 }
 
 void World::setScheduler(const SchedulerOptions& options) {
-  auto scheduler = makeScheduler(options);  // may throw: change nothing before it
-  scheduler_ = std::move(scheduler);
+  // All made before any is replaced (makeScheduler may throw: change nothing).
+  // The chunks stay: their arenas hold the last tick's pairs.
+  std::vector<NarrowChunk> made = makeNarrowChunks(narrow_chunks_.size(), options);
+  for (std::size_t k = 0; k < made.size(); ++k) narrow_chunks_[k].scheduler = std::move(made[k].scheduler);
   config_.scheduler = options;
 }
 
@@ -323,6 +330,7 @@ StepContext World::physicsStep() {
   step.priorities = &pair_priority_;
   step.accept_unresolved = config_.unresolved_policy == UnresolvedPolicy::Accept;
   step.contacts = &contacts_;
+  step.workers = &workers_;
   return step;
 }
 
@@ -375,9 +383,15 @@ Aabb World::sweptBoxOf(std::size_t index) const {
 }
 
 void World::broadPhase(TickReport& report) {
+  // The boxes in parallel (each body alone), then handed over in order.
+  boxes_.resize(ids_.size());
+  workers_.forEach(ids_.size(), kBoxesPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!bodies_[i].is_static) boxes_[i] = physics_.isFast(i) ? sweptBoxOf(i) : boxOf(i);
+    }
+  });
   for (std::size_t i = 0; i < ids_.size(); ++i) {
-    if (bodies_[i].is_static) continue;
-    broad_phase_.setBox(ids_[i], physics_.isFast(i) ? sweptBoxOf(i) : boxOf(i));
+    if (!bodies_[i].is_static) broad_phase_.setBox(ids_[i], boxes_[i]);
   }
   broad_phase_.update();
   report.broad_pairs = broad_phase_.pairs().size();
@@ -392,9 +406,10 @@ void World::broadPhase(TickReport& report) {
   if (setUpPairTests()) setUpPairTests();
 }
 
+// The pairs' bodies; the tests themselves are reset by their chunk of the
+// narrow phase, in parallel, each into its chunk's arena.
 bool World::setUpPairTests() {
   pair_count_ = 0;
-  pair_arena_->clear();
   if (islands_.quiet()) return false;  // all asleep: every pair is held-held or held-static
   bool woke = false;
   for (const BroadPair& pair : broad_phase_.pairs()) {
@@ -402,10 +417,6 @@ bool World::setUpPairTests() {
     const std::size_t ib = index_of_.find(pair.second)->second;
     woke |= islands_.noteOverlap(static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib), bodies_);
     if (bodies_[ia].is_static && bodies_[ib].is_static) continue;  // nothing can change (or asleep)
-    pair_tests_[pair_count_].reset(
-        PairBody{pair.first, &shapes_[body_shapes_[ia]].tree, &bodies_[ia].pose},
-        PairBody{pair.second, &shapes_[body_shapes_[ib]].tree, &bodies_[ib].pose},
-        pair_arena_.get());
     pair_bodies_[pair_count_] = {static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib)};
     ++pair_count_;
   }
@@ -430,10 +441,24 @@ double World::narrowPhase(const Budget& budget, const Deadline& tick_end, double
   }
   if (end < std::numeric_limits<double>::infinity()) report.narrow_budget_s = std::max(end - start, 0.0);
   const bool gaze = perception_.hasFixation();
-  BudgetTracker tracker(budget.sphere_tests, Deadline(&clock_, end));
-  const ScheduleStats stats =
-      scheduler_->run(pair_tests_, pair_count_, PairBodies{pair_bodies_.data(), bodies_.size()},
-                      gaze ? &perception_ : nullptr, tracker);
+  // Each chunk: reset its tests into its arena, then its scheduler over them
+  // under its share of the sphere tests; every chunk watches the deadline.
+  const std::size_t chunks = narrow_chunks_.size();
+  workers_.forChunks(chunks, [&](std::size_t k, std::size_t) {
+    NarrowChunk& chunk = narrow_chunks_[k];
+    const auto [first, last] = chunkRange(pair_count_, k, chunks);
+    chunk.arena.clear();
+    for (std::size_t i = first; i < last; ++i) {
+      const std::uint32_t ia = pair_bodies_[i][0], ib = pair_bodies_[i][1];
+      pair_tests_[i].reset(PairBody{ids_[ia], &shapes_[body_shapes_[ia]].tree, &bodies_[ia].pose},
+                           PairBody{ids_[ib], &shapes_[body_shapes_[ib]].tree, &bodies_[ib].pose}, &chunk.arena);
+    }
+    BudgetTracker tracker(chunkShare(budget.sphere_tests, k, chunks), Deadline(&clock_, end));
+    chunk.stats = chunk.scheduler->run(pair_tests_.data() + first, last - first,
+                                       PairBodies{pair_bodies_.data() + first, bodies_.size()},
+                                       gaze ? &perception_ : nullptr, tracker);
+  });
+  const ScheduleStats stats = mergedStats(narrow_chunks_);
   const double scheduled = clock_();
   report.sphere_tests = stats.sphere_tests;
   report.interrupted = stats.interrupted;

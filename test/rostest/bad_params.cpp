@@ -85,6 +85,7 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"queue_ratio", 0.5}}, "queue_ratio"},
       {world, {{"tree_levels", 12}}, "tree_levels"},
       {world, {{"max_entities", 0}}, "max_entities"},
+      {world, {{"threads", -1}}, "threads"},
       {world, {{"scene", "/nonexistent/scene.yaml"}}, "scene"},
       {world, {{"scene", bad_scene}}, "scene entities[0].position"},
       {world, {{"scene", "rockfal"}}, "scene"},

@@ -36,9 +36,10 @@ constexpr double kPi = 3.14159265358979323846;
 // Entities on a jittered lattice, packed so neighbours overlap, each moving
 // and turning back and forth: velocities flip every `half_period` ticks, so
 // the pair set keeps changing but the scene returns to where it was.
-World movingWorld(int per_side, SchedulerKind scheduler) {
+World movingWorld(int per_side, SchedulerKind scheduler, int threads = 1) {
   WorldConfig config;
   config.scheduler.kind = scheduler;
+  config.threads = threads;
   World w(config);
   PresetParams p;
   p.resolution = 8;
@@ -125,6 +126,25 @@ TEST(WorldAllocations, SteadyStateTicksDoNotAllocate) {
     EXPECT_EQ(ticked.allocations, 0) << toString(kind) << ", tick budget";
     EXPECT_GT(ticked.unresolved, 0u);
   }
+}
+
+// Two threads: the chunks' schedulers, arenas and contact builders and the
+// solver's colours keep their capacity too. The fake clock is read by both
+// threads: an atomic count of 10 us steps.
+TEST(WorldAllocations, ParallelTicksDoNotAllocate) {
+  World w = movingWorld(7, SchedulerKind::PriorityQueues, 2);
+  ASSERT_EQ(w.threads(), 2);
+  const TickTotals unlimited = countAllocations(w, Budget::unlimited(), 100, 50);
+  EXPECT_EQ(unlimited.allocations, 0) << "unlimited budget";
+  EXPECT_GT(unlimited.colliding, 0u);
+  const TickTotals interrupted = countAllocations(w, Budget::ofSphereTests(2000), 100, 50);
+  EXPECT_EQ(interrupted.allocations, 0) << "2000 sphere tests";
+  EXPECT_GT(interrupted.unresolved, 0u);
+  auto reads = std::make_shared<std::atomic<std::int64_t>>(0);
+  w.setClock([reads] { return 1e-5 * static_cast<double>(++*reads); });
+  const TickTotals ticked = countAllocations(w, Budget::ofTickSeconds(2e-3), 100, 50);
+  EXPECT_EQ(ticked.allocations, 0) << "tick budget";
+  EXPECT_GT(ticked.unresolved, 0u);
 }
 
 // Turning four times faster (8 rad/s), the long shapes' far ends move more

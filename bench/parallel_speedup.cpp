@@ -1,0 +1,222 @@
+// Speed-up of the parallel tick (issue 13): the same scene stepped at 1 and
+// at N threads (WorldConfig::threads, default N = 2) at an unlimited budget,
+// where both runs compute the same bits tick for tick (test_parallel_tick), so
+// they do the same work and only the time differs. The runs alternate in
+// blocks of ticks, so a shared machine's load falls on both alike.
+//
+// Per run: whole-tick wall time (mean, p50), process CPU time per tick (all
+// threads, TBB's workers included), and the phases' wall times from the
+// TickReport; the speed-up per phase; the serial fraction s of the tick from
+// Amdahl's law fitted to the two runs, t_N = t_1 (s + (1 - s) / N), and what
+// that s predicts for 8 and 16 cores. The load average is printed with the
+// figures: on a busy machine the parallel run waits for cores.
+//
+// Usage: bench_parallel_speedup [--scenes corner_drift:500,rockfall:1000,packed_box:500,cube_box:10000]
+//          [--threads 2] [--seconds 6] [--cube-seconds 1.5] [--settle 1]
+//   --seconds: simulated time timed per scene (cube_box: --cube-seconds);
+//   --settle: simulated time run first, untimed, at one thread (so the
+//   scene is moving and colliding when timing starts).
+// Last lines: SPEEDUP scene=<name> threads=<N> x=<wall ratio>.
+#include "sphere_tree_collision/scenes.hpp"
+#include "sphere_tree_collision/world.hpp"
+#include "tick_clock.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace stc;
+using stc_bench::loadAverage;
+using stc_bench::meanOf;
+using stc_bench::percentile;
+using stc_bench::wallSeconds;
+
+double processCpuSeconds() {
+  timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+struct Case {
+  SceneKind kind = SceneKind::CornerDrift;
+  int bodies = 500;
+};
+
+struct Options {
+  std::vector<Case> cases{{SceneKind::CornerDrift, 500},
+                          {SceneKind::Rockfall, 1000},
+                          {SceneKind::PackedBox, 500},
+                          {SceneKind::CubeBox, 10000}};
+  int threads = 2;
+  double seconds = 6.0;
+  double cube_seconds = 1.5;
+  double settle = 1.0;
+};
+
+// Per-tick samples of one run, seconds.
+struct Run {
+  std::vector<double> wall, cpu, integrate, broad, sweep, narrow, response, other;
+  double contacts = 0.0, colours = 0.0;  // sums over the ticks
+};
+
+World makeWorld(const Case& c, int threads, SceneSpec& spec) {
+  WorldConfig config;
+  config.gravity = sceneGravity(c.kind);
+  config.threads = threads;
+  World world(config);
+  SceneParams params;
+  params.entities = c.bodies;
+  spec = populateScene(world, c.kind, params);
+  return world;
+}
+
+void timedTicks(World& world, double dt, int ticks, Run& run) {
+  for (int t = 0; t < ticks; ++t) {
+    const double wall0 = wallSeconds(), cpu0 = processCpuSeconds();
+    const TickReport r = world.step(dt, Budget::unlimited());
+    run.wall.push_back(wallSeconds() - wall0);
+    run.cpu.push_back(processCpuSeconds() - cpu0);
+    run.integrate.push_back(r.integrate_s);
+    run.broad.push_back(r.broad_s);
+    run.sweep.push_back(r.sweep_s);
+    run.narrow.push_back(r.narrow_s);
+    run.response.push_back(r.response_s);
+    run.other.push_back(r.total_s - r.integrate_s - r.broad_s - r.sweep_s - r.narrow_s - r.response_s);
+    run.contacts += static_cast<double>(r.contacts);
+    run.colours += world.physicsReport().solve.colours;
+  }
+}
+
+double ms(double s) { return 1e3 * s; }
+double ratio(double a, double b) { return b > 0.0 ? a / b : NAN; }
+
+std::string name(const Case& c) { return std::string(toString(c.kind)) + "_" + std::to_string(c.bodies); }
+
+// Amdahl: t_n / t_1 = s + (1 - s) / n, solved for s from one n.
+double serialFraction(double t1, double tn, int n) {
+  const double r = tn / t1;
+  return (r - 1.0 / n) / (1.0 - 1.0 / n);
+}
+double amdahl(double s, int n) { return 1.0 / (s + (1.0 - s) / n); }
+
+double runCase(const Case& c, const Options& opt) {
+  SceneSpec spec;
+  World one = makeWorld(c, 1, spec);
+  World many = makeWorld(c, opt.threads, spec);
+  const int settle = static_cast<int>(std::lround(opt.settle / spec.dt));
+  for (int t = 0; t < settle; ++t) {
+    one.step(spec.dt, Budget::unlimited());
+    many.step(spec.dt, Budget::unlimited());
+  }
+  const double seconds = c.kind == SceneKind::CubeBox ? opt.cube_seconds : opt.seconds;
+  const int ticks = std::max(1, static_cast<int>(std::lround(seconds / spec.dt)));
+  const int block = 30;  // ticks per turn: the two runs take turns
+  Run r1, rn;
+  const double load_before = loadAverage();
+  for (int done = 0; done < ticks; done += block) {
+    const int n = std::min(block, ticks - done);
+    timedTicks(one, spec.dt, n, r1);
+    timedTicks(many, spec.dt, n, rn);
+  }
+  const double load_after = loadAverage();
+
+  std::printf("\n## %s: %d ticks timed after %d, threads 1 vs %d (load average %.2f -> %.2f)\n\n",
+              name(c).c_str(), ticks, settle, opt.threads, load_before, load_after);
+  std::printf("contacts %.0f, solver colours %.0f a tick (mean)\n\n", r1.contacts / ticks, r1.colours / ticks);
+  std::printf("| phase | 1 thread ms | %d threads ms | speed-up |\n|---|---|---|---|\n", opt.threads);
+  const auto row = [&](const char* label, const std::vector<double>& a, const std::vector<double>& b) {
+    std::printf("| %s | %.3f | %.3f | %.2f |\n", label, ms(meanOf(a)), ms(meanOf(b)), ratio(meanOf(a), meanOf(b)));
+  };
+  row("integrate", r1.integrate, rn.integrate);
+  row("broad phase", r1.broad, rn.broad);
+  row("sweep", r1.sweep, rn.sweep);
+  row("narrow phase", r1.narrow, rn.narrow);
+  row("response", r1.response, rn.response);
+  row("rest (fracture, islands)", r1.other, rn.other);
+  row("whole tick, wall", r1.wall, rn.wall);
+  std::printf("| whole tick, wall p50 | %.3f | %.3f | %.2f |\n", ms(percentile(r1.wall, 0.5)),
+              ms(percentile(rn.wall, 0.5)), ratio(percentile(r1.wall, 0.5), percentile(rn.wall, 0.5)));
+  std::printf("| whole tick, process CPU | %.3f | %.3f | %.2f (CPU ratio) |\n", ms(meanOf(r1.cpu)), ms(meanOf(rn.cpu)),
+              ratio(meanOf(rn.cpu), meanOf(r1.cpu)));
+  const double x = ratio(meanOf(r1.wall), meanOf(rn.wall));
+  const double s = serialFraction(meanOf(r1.wall), meanOf(rn.wall), opt.threads);
+  std::printf("\nserial fraction (Amdahl fit, 1 vs %d threads): %.3f; model: 8 cores %.2fx, 16 cores %.2fx\n",
+              opt.threads, s, amdahl(std::max(s, 0.0), 8), amdahl(std::max(s, 0.0), 16));
+  std::fflush(stdout);
+  return x;
+}
+
+Case parseCase(const std::string& item) {
+  const std::size_t colon = item.find(':');
+  Case c;
+  c.kind = parseScene(item.substr(0, colon));
+  if (colon != std::string::npos) c.bodies = std::stoi(item.substr(colon + 1));
+  if (c.bodies < 1) throw InputError("--scenes", "entity count must be >= 1");
+  return c;
+}
+
+Options parseOptions(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const auto next = [&]() -> std::string {
+      if (i + 1 >= argc) throw InputError(a, "needs a value");
+      return argv[++i];
+    };
+    if (a == "--scenes") {
+      o.cases.clear();
+      std::string list = next();
+      std::size_t start = 0;
+      while (start <= list.size()) {
+        const std::size_t comma = list.find(',', start);
+        o.cases.push_back(parseCase(list.substr(start, comma - start)));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+      }
+    } else if (a == "--threads") {
+      o.threads = std::stoi(next());
+      validateThreads(o.threads);
+      if (o.threads < 2) throw InputError("--threads", "compare with at least 2");
+    } else if (a == "--seconds") {
+      o.seconds = std::stod(next());
+    } else if (a == "--cube-seconds") {
+      o.cube_seconds = std::stod(next());
+    } else if (a == "--settle") {
+      o.settle = std::stod(next());
+    } else {
+      throw InputError(a, "unknown option (see the comment at the top of bench/parallel_speedup.cpp)");
+    }
+  }
+  if (!(o.seconds > 0.0) || !(o.cube_seconds > 0.0) || !(o.settle >= 0.0)) {
+    throw InputError("--seconds", "seconds must be > 0 and --settle >= 0");
+  }
+  return o;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options opt;
+  try {
+    opt = parseOptions(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_parallel_speedup: %s\n", e.what());
+    return 2;
+  }
+  std::printf("# Parallel tick: 1 vs %d threads, unlimited budget (load average %.2f)\n", opt.threads, loadAverage());
+  std::vector<std::string> lines;
+  for (const Case& c : opt.cases) {
+    const double x = runCase(c, opt);
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "SPEEDUP scene=%s threads=%d x=%.2f", name(c).c_str(), opt.threads, x);
+    lines.emplace_back(buf);
+  }
+  std::printf("\n");
+  for (const std::string& line : lines) std::printf("%s\n", line.c_str());
+  return 0;
+}

@@ -1,0 +1,39 @@
+// The narrow phase cut for the workers (World::step): the pair list in
+// static chunks, one per thread, in pair order. Each chunk has its own
+// scheduler (the same kind and options), its own arena for its tests' hits
+// and its share of the sphere-test budget, so chunks share nothing but the
+// deadline while they run, and a chunk's result depends only on its pairs
+// and its share: the same thread count gives the same chunks and results.
+#pragma once
+
+#include "sphere_tree_collision/pair_test.hpp"
+#include "sphere_tree_collision/scheduler.hpp"
+#include "sphere_tree_collision/workers.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace stc {
+
+struct NarrowChunk {
+  std::unique_ptr<Scheduler> scheduler;
+  PairArena arena;    // hits and pairs of this chunk's tests
+  ScheduleStats stats;  // of this tick's run
+};
+
+// Chunk k's share of a sphere-test budget: equal parts, the remainder to the
+// first chunks, so the shares sum to the budget.
+inline std::int64_t chunkShare(std::int64_t budget, std::size_t k, std::size_t chunks) {
+  const auto n = static_cast<std::int64_t>(chunks);
+  return budget / n + (static_cast<std::int64_t>(k) < budget % n ? 1 : 0);
+}
+
+// `chunks` chunks with a scheduler each (makeScheduler: validates the options).
+std::vector<NarrowChunk> makeNarrowChunks(std::size_t chunks, const SchedulerOptions& options);
+
+// The chunks' stats as one run's: tests and overhead summed, interrupted and
+// used_perception when any chunk was.
+ScheduleStats mergedStats(const std::vector<NarrowChunk>& chunks);
+
+}  // namespace stc

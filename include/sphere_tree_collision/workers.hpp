@@ -1,0 +1,72 @@
+// Workers: the threads one World's tick may use, a oneTBB task arena of
+// WorldConfig::threads threads (0: every core). With one thread every loop
+// runs on the calling thread and the task library is not involved at all.
+// The loops here only split work: each index must write its own slots, so
+// the result does not depend on how the range was cut.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <type_traits>
+#include <utility>
+
+namespace stc {
+
+// WorldConfig::threads and ~threads: 0 (all cores) .. kMaxThreads.
+constexpr int kMaxThreads = 256;
+// Throws InputError("threads") outside [0, kMaxThreads].
+void validateThreads(int threads);
+// The thread count `threads` stands for: 0 -> the cores the process may use.
+int resolveThreads(int threads);
+
+// A callable f(begin, end) seen through a pointer: no copy, no allocation.
+// Valid while the callable lives (a loop's body, for the loop's call).
+class RangeFn {
+ public:
+  template <typename F, typename = std::enable_if_t<!std::is_same_v<std::decay_t<F>, RangeFn>>>
+  RangeFn(F&& f)  // NOLINT: implicit, so a lambda can be passed as is
+      : object_(const_cast<void*>(static_cast<const void*>(&f))),
+        call_([](void* o, std::size_t b, std::size_t e) { (*static_cast<std::remove_reference_t<F>*>(o))(b, e); }) {}
+  void operator()(std::size_t begin, std::size_t end) const { call_(object_, begin, end); }
+
+ private:
+  void* object_;
+  void (*call_)(void*, std::size_t, std::size_t);
+};
+
+class Workers {
+ public:
+  // Throws InputError("threads") as validateThreads.
+  explicit Workers(int threads = 1);
+  ~Workers();
+  Workers(Workers&&) noexcept;
+  Workers& operator=(Workers&&) noexcept;
+
+  int threads() const { return threads_; }
+  // fn over [0, n) in pieces of at least `grain` indices, on the arena's
+  // threads (the caller among them); returns when all are done.
+  void forEach(std::size_t n, std::size_t grain, RangeFn fn) const;
+  // fn(k, k + 1) for each chunk k in [0, chunks), each one task.
+  void forChunks(std::size_t chunks, RangeFn fn) const;
+
+ private:
+  struct Arena;
+  std::unique_ptr<Arena> arena_;  // null with one thread
+  int threads_ = 1;
+};
+
+// Indices [first, second) of chunk k of `chunks` over [0, count): equal runs, in order.
+inline std::pair<std::size_t, std::size_t> chunkRange(std::size_t count, std::size_t k, std::size_t chunks) {
+  return {count * k / chunks, count * (k + 1) / chunks};
+}
+
+// workers->forEach, or fn(0, n) on the caller without workers.
+inline void forEachIndex(const Workers* workers, std::size_t n, std::size_t grain, RangeFn fn) {
+  if (workers != nullptr) {
+    workers->forEach(n, grain, fn);
+  } else if (n > 0) {
+    fn(0, n);
+  }
+}
+
+}  // namespace stc
