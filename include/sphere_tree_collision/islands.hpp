@@ -54,6 +54,8 @@ class Islands {
 
   bool isSleeping(std::size_t body) const { return group_[body] != kAwake; }
   std::size_t sleepingCount() const { return sleeping_; }
+  // Awake and not resting at the last endTick (or edited, or new).
+  bool isRestless(std::size_t body) const { return group_[body] == kAwake && moving_[body] != 0; }
   // Wakes the island of a body (nothing when it is awake), or all of them.
   void wake(std::size_t body);
   void wakeAll();
