@@ -101,6 +101,7 @@ class Islands {
   RestTest rest_test_;
   std::vector<std::uint32_t> parent_;       // union-find over the tick's contacts
   std::vector<double> island_rest_;         // per root: least rest time of its bodies
+  std::vector<std::uint8_t> beside_restless_; // per body: touches an awake body not rested yet
   std::vector<std::uint32_t> island_group_; // per root: group it sleeps as (kAwake: none yet)
   std::vector<std::uint32_t> to_wake_;      // groups to wake
   std::uint32_t next_group_ = 1;
