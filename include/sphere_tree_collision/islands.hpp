@@ -5,13 +5,16 @@
 // islands). A body rests while it stays in place (rest_test.hpp: its centre
 // and its surface stay within balls of radius linear_speed * time_to_sleep / 2);
 // when every body of an island has rested for `time_to_sleep` (its least rest
-// timer, as Box2D v3), the island sleeps: velocities zero, pose kept exactly. During a tick a sleeping body is held
+// timer, as Box2D v3), the island sleeps: velocities zero, pose kept exactly.
+// In an island that creeping bodies keep awake, a body rested that long that
+// touches no awake body short of it sleeps alone. During a tick a sleeping body is held
 // as a static one (BodyState::is_static set from beginTick to endTick), so
 // integration, the broad-phase box update, the sweep, the narrow phase of
 // sleeping-sleeping and sleeping-static pairs and the solver all skip it with
 // the tests they already make for static bodies.
 //
-// An island wakes whole (every body that fell asleep with it): when a
+// An island wakes whole (every body that fell asleep with it; a body that
+// slept alone wakes alone): when a
 // broad-phase box of a moving body (awake and not resting) or of a
 // body added since the last tick overlaps one of its bodies, when one of its bodies is
 // edited through World::bodies() (pose or velocity changed), removed, or
