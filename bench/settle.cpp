@@ -12,6 +12,10 @@
 // the angle turned (turned/turn near 0: rocking to and fro); where they are
 // (by the contact normals with static bodies: on a slope, on flat ground,
 // against a wall, on rocks only); pairs tested and contacts in the last tick.
+// A second line ("restless") counts the bodies failing the rest test
+// (World::isRestless), the ones that keep their islands awake: per tick mean
+// and max over the interval, how many different bodies, where they are, how
+// far they went and how many travelled faster than 0.05 m/s on average.
 //
 // Then --seconds of ticks timed in thread-CPU ms (p50 / p99 / max), with the
 // work done each tick (pair tests set up, sphere tests, contacts).
@@ -83,6 +87,7 @@ class Diagnosis {
     start_turn_.resize(dense_.size());
     path_.assign(dense_.size(), 0.0);
     turn_.assign(dense_.size(), 0.0);
+    restless_ever_.assign(dense_.size(), 0);
     restart();
   }
 
@@ -93,13 +98,25 @@ class Diagnosis {
     }
     std::fill(path_.begin(), path_.end(), 0.0);
     std::fill(turn_.begin(), turn_.end(), 0.0);
+    std::fill(restless_ever_.begin(), restless_ever_.end(), 0);
+    restless_ticks_ = 0;
+    restless_sum_ = 0;
+    restless_max_ = 0;
   }
 
   void tick(double dt) {
+    dt_ = dt;
+    int restless = 0;
     for (std::size_t k = 0; k < dense_.size(); ++k) {
       path_[k] += world_.bodies()[dense_[k]].linear_velocity.norm() * dt;
       turn_[k] += world_.bodies()[dense_[k]].angular_velocity.norm() * dt;
+      if (!world_.isRestless(world_.entityIds()[dense_[k]])) continue;
+      ++restless;
+      restless_ever_[k] = 1;
     }
+    ++restless_ticks_;
+    restless_sum_ += restless;
+    restless_max_ = std::max(restless_max_, restless);
   }
 
   void line(double t, const TickReport& r) {
@@ -162,11 +179,39 @@ class Diagnosis {
     std::printf(" where:");
     for (int p = 0; p < kPlaces; ++p) std::printf(" %s=%d", kPlaceNames[p], places[p]);
     std::printf(" pairs=%zu contacts=%zu\n", world_.pairCount(), r.contacts);
+    restlessLine();
     std::fflush(stdout);
     restart();
   }
 
  private:
+  // The bodies failing the rest test (World::isRestless): what keeps their
+  // islands awake. Per tick mean / max over the interval, how many different
+  // bodies that was, and of those: where they are (static contacts at the
+  // line's tick), how far they went over the interval (p50 / max) and how
+  // many of them moved faster than kSpeed on average (sliding or rolling
+  // away, against jitter in place).
+  void restlessLine() {
+    const std::vector<BodyState>& bodies = world_.bodies();
+    int distinct = 0, travelling = 0;
+    int places[kPlaces] = {0, 0, 0, 0};
+    std::vector<double> drift;
+    for (std::size_t k = 0; k < dense_.size(); ++k) {
+      if (restless_ever_[k] == 0) continue;
+      ++distinct;
+      ++places[place_[dense_[k]]];
+      const double d = (bodies[dense_[k]].pose.position - start_[k]).norm();
+      drift.push_back(d);
+      travelling += d > kSpeed * elapsed() ? 1 : 0;
+    }
+    std::printf("  restless per tick mean/max=%.1f/%d bodies=%d where:", restless_ticks_ > 0 ?
+                static_cast<double>(restless_sum_) / restless_ticks_ : 0.0, restless_max_, distinct);
+    for (int p = 0; p < kPlaces; ++p) std::printf(" %s=%d", kPlaceNames[p], places[p]);
+    std::printf(" drift p50/max=%.4f/%.4f m travelling(>%.2g m/s)=%d\n", stc_bench::percentile(drift, 0.5),
+                stc_bench::maxOf(drift), kSpeed, travelling);
+  }
+  double elapsed() const { return restless_ticks_ * dt_; }
+
   std::uint32_t find(std::uint32_t i) {
     while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
     return i;
@@ -179,6 +224,10 @@ class Diagnosis {
   std::vector<double> path_, turn_;
   std::vector<std::uint32_t> parent_;
   std::vector<Place> place_;
+  std::vector<std::uint8_t> restless_ever_;
+  int restless_ticks_ = 0, restless_max_ = 0;
+  long restless_sum_ = 0;
+  double dt_ = 0.0;
 };
 
 }  // namespace

@@ -5,13 +5,16 @@
 // islands). A body rests while it stays in place (rest_test.hpp: its centre
 // and its surface stay within balls of radius linear_speed * time_to_sleep / 2);
 // when every body of an island has rested for `time_to_sleep` (its least rest
-// timer, as Box2D v3), the island sleeps: velocities zero, pose kept exactly. During a tick a sleeping body is held
+// timer, as Box2D v3), the island sleeps: velocities zero, pose kept exactly.
+// In an island that creeping bodies keep awake, a body rested that long that
+// touches no awake body short of it sleeps alone. During a tick a sleeping body is held
 // as a static one (BodyState::is_static set from beginTick to endTick), so
 // integration, the broad-phase box update, the sweep, the narrow phase of
 // sleeping-sleeping and sleeping-static pairs and the solver all skip it with
 // the tests they already make for static bodies.
 //
-// An island wakes whole (every body that fell asleep with it): when a
+// An island wakes whole (every body that fell asleep with it; a body that
+// slept alone wakes alone): when a
 // broad-phase box of a moving body (awake and not resting) or of a
 // body added since the last tick overlaps one of its bodies, when one of its bodies is
 // edited through World::bodies() (pose or velocity changed), removed, or
@@ -54,6 +57,8 @@ class Islands {
 
   bool isSleeping(std::size_t body) const { return group_[body] != kAwake; }
   std::size_t sleepingCount() const { return sleeping_; }
+  // Awake and not resting at the last endTick (or edited, or new).
+  bool isRestless(std::size_t body) const { return group_[body] == kAwake && moving_[body] != 0; }
   // Wakes the island of a body (nothing when it is awake), or all of them.
   void wake(std::size_t body);
   void wakeAll();
@@ -99,6 +104,7 @@ class Islands {
   RestTest rest_test_;
   std::vector<std::uint32_t> parent_;       // union-find over the tick's contacts
   std::vector<double> island_rest_;         // per root: least rest time of its bodies
+  std::vector<std::uint8_t> beside_restless_; // per body: touches an awake body not rested yet
   std::vector<std::uint32_t> island_group_; // per root: group it sleeps as (kAwake: none yet)
   std::vector<std::uint32_t> to_wake_;      // groups to wake
   std::uint32_t next_group_ = 1;

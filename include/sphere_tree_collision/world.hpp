@@ -197,6 +197,9 @@ class World {
   // Sleeping islands (islands.hpp). wake: the entity's island; false for an unknown id.
   bool wake(EntityId id);
   bool isSleeping(EntityId id) const;
+  // Awake and failing the rest test at the last step (it moved out of its
+  // rest balls, rest_test.hpp): what keeps its island awake. False when asleep.
+  bool isRestless(EntityId id) const;
 
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.

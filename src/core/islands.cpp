@@ -154,8 +154,20 @@ void Islands::endTick(std::vector<BodyState>& bodies, const std::vector<Contact>
   std::fill(fresh_.begin(), fresh_.end(), 0);
   if (!options.enabled) return;
 
-  // Islands of the awake movable bodies: a contact joins two of them.
   const auto movable = [&](std::size_t i) { return !bodies[i].is_static && group_[i] == kAwake; };
+
+  // Rest timers. A point moving steadily at linear_speed goes a ball's
+  // diameter in time_to_sleep (a tick at least).
+  const double max_radius = 0.5 * options.linear_speed * std::max(options.time_to_sleep, dt);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!movable(i)) continue;
+    const bool resting = rest_test_.update(i, bodies[i].pose, dt, options.time_to_sleep, max_radius);
+    rest_time_[i] = resting ? rest_time_[i] + dt : 0.0;
+    moving_[i] = resting ? 0 : 1;
+  }
+
+  // Islands of the awake movable bodies: a contact joins two of them; each
+  // island's least rest time (Box2D v3).
   parent_.resize(n);
   std::iota(parent_.begin(), parent_.end(), 0u);
   for (const Contact& c : contacts) {
@@ -163,31 +175,40 @@ void Islands::endTick(std::vector<BodyState>& bodies, const std::vector<Contact>
     const std::uint32_t ra = find(c.index_a), rb = find(c.index_b);
     if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
   }
-
-  // Rest timers, and each island's least. A point moving steadily at
-  // linear_speed goes a ball's diameter in time_to_sleep (a tick at least).
   island_rest_.assign(n, std::numeric_limits<double>::infinity());
-  const double max_radius = 0.5 * options.linear_speed * std::max(options.time_to_sleep, dt);
   for (std::size_t i = 0; i < n; ++i) {
     if (!movable(i)) continue;
-    const bool resting = rest_test_.update(i, bodies[i].pose, dt, options.time_to_sleep, max_radius);
-    rest_time_[i] = resting ? rest_time_[i] + dt : 0.0;
-    moving_[i] = resting ? 0 : 1;
     double& least = island_rest_[find(static_cast<std::uint32_t>(i))];
     least = std::min(least, rest_time_[i]);
   }
 
-  // Islands that rested long enough sleep, each as one group.
+  // An island whose bodies all rested time_to_sleep sleeps whole, as one
+  // group. In a big island that a few creeping rocks keep awake (measured:
+  // bench_settle's restless line, docs/sleeping.md) a body that rested that
+  // long and touches no awake body short of it sleeps alone, its own group:
+  // the rested bodies touching the others stay awake around them, seeing the
+  // sleepers as static, and when one of them moves its box wakes the sleepers
+  // it reaches (noteOverlap), as any moving body's does.
+  const auto rested = [&](std::size_t i) { return rest_time_[i] >= options.time_to_sleep; };
+  beside_restless_.assign(n, 0);
+  for (const Contact& c : contacts) {
+    if (!movable(c.index_a) || !movable(c.index_b)) continue;
+    const bool ra = rested(c.index_a), rb = rested(c.index_b);
+    if (ra != rb) beside_restless_[ra ? c.index_a : c.index_b] = 1;
+  }
+  const auto newGroup = [&] {
+    const std::uint32_t group = next_group_;
+    next_group_ = next_group_ == std::numeric_limits<std::uint32_t>::max() ? 1 : next_group_ + 1;
+    return group;
+  };
   island_group_.assign(n, kAwake);
   for (std::size_t i = 0; i < n; ++i) {
     if (!movable(i)) continue;
     const std::uint32_t root = find(static_cast<std::uint32_t>(i));
-    if (!(island_rest_[root] >= options.time_to_sleep)) continue;
-    if (island_group_[root] == kAwake) {
-      island_group_[root] = next_group_;
-      next_group_ = next_group_ == std::numeric_limits<std::uint32_t>::max() ? 1 : next_group_ + 1;
-    }
-    group_[i] = island_group_[root];
+    const bool whole = island_rest_[root] >= options.time_to_sleep;
+    if (!whole && !(rested(i) && beside_restless_[i] == 0)) continue;
+    if (whole && island_group_[root] == kAwake) island_group_[root] = newGroup();
+    group_[i] = whole ? island_group_[root] : newGroup();
     moving_[i] = 0;
     rest_pose_[i] = bodies[i].pose;
     bodies[i].linear_velocity.setZero();

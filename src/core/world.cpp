@@ -263,6 +263,11 @@ bool World::isSleeping(EntityId id) const {
   return index && islands_.isSleeping(*index);
 }
 
+bool World::isRestless(EntityId id) const {
+  const auto index = indexOf(id);
+  return index && islands_.isRestless(*index);
+}
+
 // The last tick's pair tests point at bodies and its contacts name dense
 // indices: both go stale when entities are added or removed.
 void World::invalidateLastTick() {

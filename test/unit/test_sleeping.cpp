@@ -15,6 +15,7 @@ namespace {
 
 constexpr double kDt = 1.0 / 60.0;
 constexpr int kSettleTicks = 900;  // 15 s: the pile is asleep long before
+constexpr int kBigPile = 1500;     // rocks: one island that a few creeping rocks keep awake
 
 struct Pile {
   std::unique_ptr<World> world;
@@ -315,6 +316,43 @@ TEST(Sleeping, RockPileSettlesSleepsWholeAndThenCostsAlmostNothing) {
   for (std::size_t i = 0; i < poses.size(); ++i) moved = std::max(moved, (world.bodies()[i].pose.position - poses[i].position).norm());
   EXPECT_LT(moved, 0.1);
   EXPECT_GT(settle(world, spec.movers.size(), 600), 0);
+}
+
+TEST(Sleeping, BigPileThatAFewRocksKeepAwakeSleepsAlmostWholeAndStaysPut) {
+  // 1,500 rocks make one island that a few creeping rocks keep awake
+  // (bench_settle's restless count; docs/sleeping.md): the rested part of it
+  // sleeps around them, a body alone, and a creeping rock wakes the sleepers
+  // it reaches, so the count asleep goes up and down by a few per cent.
+  WorldConfig config;
+  config.gravity = sceneGravity(SceneKind::Rockfall);
+  World world(config);
+  SceneParams params;
+  params.entities = kBigPile;
+  const SceneSpec spec = populateScene(world, SceneKind::Rockfall, params);
+  const std::size_t most = spec.movers.size() * 95 / 100;
+  std::size_t asleep = 0;
+  for (int t = 0; t < 1500 && asleep < most; ++t) asleep = world.step(kDt, Budget::unlimited()).sleeping;  // 25 s
+  ASSERT_GE(asleep, most);
+  // It stays put: a second later no rock asleep now has moved (awake or
+  // not: a woken one settles again where it was), the energy has not grown
+  // and nine in ten stayed asleep throughout.
+  std::vector<Vec3> at_sleep;
+  std::vector<bool> was_asleep;
+  for (const EntityId id : spec.movers) {
+    at_sleep.push_back(world.bodies()[indexOf(world, id)].pose.position);
+    was_asleep.push_back(world.isSleeping(id));
+  }
+  const double energy = totalEnergy(world.bodies(), config.gravity, kDt);
+  std::size_t fewest_asleep = asleep;
+  for (int t = 0; t < 60; ++t) fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).sleeping);
+  EXPECT_GE(fewest_asleep, spec.movers.size() * 90 / 100);
+  double moved = 0.0;
+  for (std::size_t k = 0; k < spec.movers.size(); ++k) {
+    if (!was_asleep[k]) continue;
+    moved = std::max(moved, (world.bodies()[indexOf(world, spec.movers[k])].pose.position - at_sleep[k]).norm());
+  }
+  EXPECT_LT(moved, 0.01);
+  EXPECT_LE(totalEnergy(world.bodies(), config.gravity, kDt), energy + 1e-6 * std::abs(energy));
 }
 
 TEST(Sleeping, BadThresholdsAreRejectedNamingTheField) {
