@@ -30,6 +30,9 @@ void validateSleepOptions(const SleepOptions& options) {
 void Islands::add(double reach) {
   rest_test_.add(reach);
   group_.push_back(kAwake);
+  // Groups to wake are distinct and at most one per body: room for that many now keeps
+  // requestWake from allocating mid-tick (lone sleepers make one group per body).
+  if (to_wake_.capacity() < group_.size()) to_wake_.reserve(2 * group_.size());
   held_.push_back(0);
   fresh_.push_back(1);
   moving_.push_back(1);
