@@ -371,16 +371,28 @@ TEST(Contacts, SeparateOrRejectedPairsGiveNoneAndUntestedPairsUseTheRoots) {
 // ---------------------------------------------------------------------------
 // Swept test
 
+// A block of nx x ny x nz full voxels, its tree and bounds (which point into
+// it: not copied or moved).
+struct Block {
+  VoxelShape shape;
+  Vec3 origin;
+  SphereTree tree;
+  ShapeBounds bounds;
+  Block(int nx, int ny, int nz, double voxel, const Vec3& at)
+      : shape(VoxelShape::create(nx, ny, nz, voxel, std::vector<std::uint8_t>(static_cast<std::size_t>(nx * ny * nz), 1))),
+        origin(at),
+        tree(SphereTree::build(shape, origin)),
+        bounds(makeShapeBounds(tree, &shape, origin)) {}
+  Block(const Block&) = delete;
+  Block& operator=(const Block&) = delete;
+};
+
 TEST(Sweep, AFastSmallBodyIsStoppedAtAThinPlateAndSlowOrSlidingOnesAreNot) {
   const double voxel = 0.05;
-  const VoxelShape plate_shape = VoxelShape::create(16, 16, 1, voxel, std::vector<std::uint8_t>(256, 1));
-  const Vec3 plate_origin(0.4, 0.4, 0.025);
-  const SphereTree plate_tree = SphereTree::build(plate_shape, plate_origin);
-  const ShapeBounds plate = makeShapeBounds(plate_tree, &plate_shape, plate_origin);
-  const VoxelShape ball_shape = VoxelShape::create(1, 1, 1, voxel, {1});
-  const Vec3 ball_origin = Vec3::Constant(0.025);
-  const SphereTree ball_tree = SphereTree::build(ball_shape, ball_origin);
-  const ShapeBounds ball = makeShapeBounds(ball_tree, &ball_shape, ball_origin);
+  const Block plate_block(16, 16, 1, voxel, Vec3(0.4, 0.4, 0.025));
+  const Block ball_block(1, 1, 1, voxel, Vec3::Constant(0.025));
+  const ShapeBounds& plate = plate_block.bounds;
+  const ShapeBounds& ball = ball_block.bounds;
 
   std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Constant(voxel))};
   std::vector<Pose> start(2);
@@ -453,14 +465,8 @@ TEST(Sweep, LanesOnWorkersGiveTheOneRunsHitsBitForBit) {
   // pairs, cut into several lanes on 3 threads. Each pair also comes again
   // later in the list (a tie on t in another lane): the first must win.
   const double voxel = 0.05;
-  const VoxelShape plate_shape = VoxelShape::create(8, 8, 1, voxel, std::vector<std::uint8_t>(64, 1));
-  const Vec3 plate_origin(0.2, 0.2, 0.025);
-  const SphereTree plate_tree = SphereTree::build(plate_shape, plate_origin);
-  const ShapeBounds plate = makeShapeBounds(plate_tree, &plate_shape, plate_origin);
-  const VoxelShape cube_shape = VoxelShape::create(2, 2, 2, voxel, std::vector<std::uint8_t>(8, 1));
-  const Vec3 cube_origin = Vec3::Constant(0.05);
-  const SphereTree cube_tree = SphereTree::build(cube_shape, cube_origin);
-  const ShapeBounds cube = makeShapeBounds(cube_tree, &cube_shape, cube_origin);
+  const Block plate(8, 8, 1, voxel, Vec3(0.2, 0.2, 0.025));
+  const Block cube(2, 2, 2, voxel, Vec3::Constant(0.05));
 
   constexpr int kPlates = 20, kCubes = 60;
   std::vector<BodyState> bodies;
@@ -474,7 +480,7 @@ TEST(Sweep, LanesOnWorkersGiveTheOneRunsHitsBitForBit) {
   for (int i = 0; i < kPlates; ++i) {
     bodies.push_back(staticBody(Vec3(0.0, 0.0, 0.1 * i)));
     start.push_back(bodies.back().pose);
-    shapes.push_back(&plate);
+    shapes.push_back(&plate.bounds);
   }
   for (int i = 0; i < kCubes; ++i) {
     BodyState b = boxBody(1.0, Vec3::Constant(2 * voxel));
@@ -484,7 +490,7 @@ TEST(Sweep, LanesOnWorkersGiveTheOneRunsHitsBitForBit) {
     b.pose.orientation = Quat(Eigen::AngleAxisd(uniform(0.0, 3.0), Vec3(1.0, 2.0, 3.0).normalized()));
     bodies.push_back(b);
     start.push_back(p0);
-    shapes.push_back(&cube);
+    shapes.push_back(&cube.bounds);
   }
   std::vector<std::array<std::uint32_t, 2>> pairs;
   for (std::uint32_t c = kPlates; c < kPlates + kCubes; ++c) {
