@@ -27,11 +27,13 @@
 //              it ends earlier once every mover sleeps
 //   --seconds  timed window (default 5)
 //   --every    seconds between lines (default 5)
+//   (the timed window also prints its wall ms per tick by phase)
 //   --sleep-off  WorldConfig::sleeping.enabled = false (what the pile costs awake)
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -267,6 +269,7 @@ int main(int argc, char** argv) {
                 asleep_at >= 0.0 ? std::to_string(asleep_at).c_str() : "never (within --settle)");
 
     std::vector<double> cpu, pairs, tests, contacts;
+    double integrate = 0.0, broad = 0.0, sweep = 0.0, narrow = 0.0, response = 0.0, total = 0.0;  // wall s
     std::size_t asleep_min = spec.movers.size();
     const int timed = static_cast<int>(std::lround(opt.seconds / dt));
     for (int k = 0; k < timed; ++k) {
@@ -277,7 +280,18 @@ int main(int argc, char** argv) {
       tests.push_back(static_cast<double>(r.sphere_tests));
       contacts.push_back(static_cast<double>(r.contacts));
       asleep_min = std::min(asleep_min, r.sleeping);
+      integrate += r.integrate_s;
+      broad += r.broad_s;
+      sweep += r.sweep_s;
+      narrow += r.narrow_s;
+      response += r.response_s;
+      total += r.total_s;
     }
+    const double ms = 1e3 / std::max(timed, 1);
+    std::printf("phases, wall ms per tick: integrate %.3f broad %.3f sweep %.3f narrow %.3f response %.3f"
+                " other %.3f total %.3f\n",
+                integrate * ms, broad * ms, sweep * ms, narrow * ms, response * ms,
+                (total - integrate - broad - sweep - narrow - response) * ms, total * ms);
     std::printf(
         "SETTLED scene=%s bodies=%d asleep_at_s=%.2f asleep_min=%zu ticks=%d cpu_ms p50=%.3f p99=%.3f max=%.3f"
         " pair_tests_mean=%.1f sphere_tests_mean=%.1f contacts_mean=%.1f\n",
