@@ -307,10 +307,11 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
     contact.normal = normals_[r];
     contact.depth = std::max(0.0, rep.overlap);
     contact.separation = separations_[r];
-    // h_a + h_b of the representative's spheres (PairTest::gapBound would
-    // scan all of lastPairs() again for its deepest pair).
-    contact.gap_bound = test.hasLastPair() ? test.bodyA().tree->node(rep.node_a).h + test.bodyB().tree->node(rep.node_b).h
-                                           : test.gapBound();
+    // The pair's bound (its deepest sphere pair's h_a + h_b), the same for
+    // every point: the solver's slop is a fraction of it, and a slop that
+    // differs point by point let position correction lift a rolling link
+    // a little every tick (config/meshes.yaml's link rolled off the floor).
+    contact.gap_bound = test.gapBound();
     contact.level = std::max(0, test.deepestLevel());
     contact.resolved = status == PairStatus::Colliding;
     contact.priority = priority;
