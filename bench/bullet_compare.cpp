@@ -126,14 +126,10 @@ class MotionCheck {
   std::size_t samples_ = 0;
 };
 
-World sceneWorld(const Case& c, SceneSpec& spec) {
-  WorldConfig config;
-  config.gravity = sceneGravity(c.kind);
-  World world(config);
+SceneWorld sceneWorld(const Case& c) {
   SceneParams params;
   params.entities = c.bodies;
-  spec = populateScene(world, c.kind, params);
-  return world;
+  return makeSceneWorld(c.kind, params);
 }
 
 void timeTick(Run& run, double wall0, double cpu0) {
@@ -142,8 +138,9 @@ void timeTick(Run& run, double wall0, double cpu0) {
 }
 
 Run runPackage(const Case& c, int ticks, int settle_ticks) {
-  SceneSpec spec;
-  World world = sceneWorld(c, spec);
+  SceneWorld scene = sceneWorld(c);
+  World& world = scene.world;
+  const SceneSpec& spec = scene.spec;
   for (int t = 0; t < settle_ticks; ++t) world.step(spec.dt, Budget::unlimited());
   std::vector<std::size_t> dense;
   for (EntityId id : spec.movers) dense.push_back(*world.indexOf(id));
@@ -327,8 +324,9 @@ Run runBullet(const Case& c, int ticks, int settle_ticks, BulletShape kind) {
   SceneSpec spec;
   std::unique_ptr<BulletScene> scene;
   {
-    const World world = sceneWorld(c, spec);
-    scene = std::make_unique<BulletScene>(world, spec, kind);
+    SceneWorld built = sceneWorld(c);
+    spec = built.spec;
+    scene = std::make_unique<BulletScene>(built.world, spec, kind);
   }
   for (int t = 0; t < settle_ticks; ++t) scene->step(spec.dt);
   Run run;

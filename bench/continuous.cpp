@@ -28,12 +28,11 @@ double threadCpuSeconds() {
 }
 
 void runScene(SceneKind kind, int count, double seconds) {  // count 0: the scene default
-  WorldConfig config;
-  config.gravity = sceneGravity(kind);
-  World world(config);
   SceneParams params;
   params.entities = count;
-  const SceneSpec spec = populateScene(world, kind, params);
+  SceneWorld scene = makeSceneWorld(kind, params);
+  World& world = scene.world;
+  const SceneSpec& spec = scene.spec;
   const double dt = spec.dt;
   const int steps = static_cast<int>(seconds / dt + 0.5);
   double stored = 0.0, real = 0.0;

@@ -33,12 +33,11 @@ struct Run {
 };
 
 Run simulate(int rocks, double seconds, double strength, bool budgeted) {
-  WorldConfig config;
-  config.gravity = sceneGravity(SceneKind::Rockfall);
-  World world(config);
   SceneParams params;
   params.entities = rocks;
-  const SceneSpec spec = populateScene(world, SceneKind::Rockfall, params);
+  SceneWorld scene = makeSceneWorld(SceneKind::Rockfall, params);
+  World& world = scene.world;
+  const SceneSpec& spec = scene.spec;
   for (BodyState& body : world.bodies()) {
     if (!body.is_static) body.material.strength = strength;
   }

@@ -17,6 +17,7 @@
 //   --settle: simulated time run first, untimed, at one thread (so the
 //   scene is moving and colliding when timing starts).
 // Last lines: SPEEDUP scene=<name> threads=<N> x=<wall ratio>.
+#include "bench_args.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
@@ -64,15 +65,12 @@ struct Run {
   double contacts = 0.0, colours = 0.0;  // sums over the ticks
 };
 
-World makeWorld(const Case& c, int threads, SceneSpec& spec) {
+SceneWorld makeWorld(const Case& c, int threads) {
   WorldConfig config;
-  config.gravity = sceneGravity(c.kind);
   config.threads = threads;
-  World world(config);
   SceneParams params;
   params.entities = c.bodies;
-  spec = populateScene(world, c.kind, params);
-  return world;
+  return makeSceneWorld(c.kind, params, config);
 }
 
 void timedTicks(World& world, double dt, int ticks, Run& run) {
@@ -105,9 +103,11 @@ double serialFraction(double t1, double tn, int n) {
 double amdahl(double s, int n) { return 1.0 / (s + (1.0 - s) / n); }
 
 double runCase(const Case& c, const Options& opt) {
-  SceneSpec spec;
-  World one = makeWorld(c, 1, spec);
-  World many = makeWorld(c, opt.threads, spec);
+  SceneWorld scene_one = makeWorld(c, 1);
+  SceneWorld scene_many = makeWorld(c, opt.threads);
+  World& one = scene_one.world;
+  World& many = scene_many.world;
+  const SceneSpec& spec = scene_one.spec;
   const int settle = static_cast<int>(std::lround(opt.settle / spec.dt));
   for (int t = 0; t < settle; ++t) {
     one.step(spec.dt, Budget::unlimited());
@@ -160,17 +160,21 @@ Case parseCase(const std::string& item) {
   return c;
 }
 
+// The value after `flag`; throws InputError naming the flag when the line ends.
+std::string valueOf(stc_bench::Args& args, const std::string& flag) {
+  const std::string v = args.value();
+  if (v.empty()) throw InputError(flag, "needs a value");
+  return v;
+}
+
 Options parseOptions(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const auto next = [&]() -> std::string {
-      if (i + 1 >= argc) throw InputError(a, "needs a value");
-      return argv[++i];
-    };
+  for (stc_bench::Args args(argc, argv); args.more();) {
+    const std::string a = args.flag();
+    const auto next = [&] { return valueOf(args, a); };
     if (a == "--scenes") {
       o.cases.clear();
-      std::string list = next();
+      const std::string list = next();
       std::size_t start = 0;
       while (start <= list.size()) {
         const std::size_t comma = list.find(',', start);

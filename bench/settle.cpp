@@ -236,12 +236,12 @@ int main(int argc, char** argv) {
   try {
     const Options opt = parse(argc, argv);
     WorldConfig config;
-    config.gravity = sceneGravity(opt.scene);
     config.sleeping.enabled = !opt.sleep_off;
-    World world(config);
     SceneParams params;
     params.entities = opt.bodies;
-    const SceneSpec spec = populateScene(world, opt.scene, params);
+    SceneWorld scene = makeSceneWorld(opt.scene, params, config);
+    World& world = scene.world;
+    const SceneSpec& spec = scene.spec;
     const double dt = spec.dt;
     std::printf("scene=%s bodies=%d dt=%.5f sleeping=%s (linear_speed %.3g m/s for %.3g s)\n",
                 toString(opt.scene), opt.bodies, dt, opt.sleep_off ? "off" : "on", config.sleeping.linear_speed,

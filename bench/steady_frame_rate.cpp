@@ -16,6 +16,7 @@
 // Usage: bench_steady_frame_rate [--scene corner_drift|rockfall|all] [--entities N]
 //          [--tick-budget-ms 16.7] [--seconds 60] [--budget-off] [--wall-clock]
 //          [--markdown FILE]
+#include "bench_args.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
@@ -58,14 +59,13 @@ bool finiteBody(const BodyState& b) {
 
 Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget, bool wall_clock) {
   WorldConfig config;
-  config.gravity = sceneGravity(kind);
   config.scheduler.kind = SchedulerKind::PriorityQueues;
-  World world(config);
-  if (!wall_clock) world.setClock(threadCpuSeconds);
   SceneParams params;
   params.entities = entities;
-  const SceneSpec spec = populateScene(world, kind, params);
-  world.perception().setCamera(spec.camera);
+  SceneWorld scene = makeSceneWorld(kind, params, config);
+  World& world = scene.world;
+  const SceneSpec& spec = scene.spec;
+  if (!wall_clock) world.setClock(threadCpuSeconds);
   GazeParams gp;
   gp.mode = GazeMode::Saccades;
   gp.seed = 3;
@@ -127,27 +127,16 @@ int main(int argc, char** argv) {
   double seconds = 60.0;
   bool budget_off = false, wall_clock = false;
   std::string markdown;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--scene") {
-      scene = next();
-    } else if (a == "--entities") {
-      entities = std::stoi(next());
-    } else if (a == "--tick-budget-ms") {
-      budget_ms = std::stod(next());
-    } else if (a == "--seconds") {
-      seconds = std::stod(next());
-    } else if (a == "--budget-off") {
-      budget_off = true;
-    } else if (a == "--wall-clock") {
-      wall_clock = true;
-    } else if (a == "--markdown") {
-      markdown = next();
-    } else {
-      std::fprintf(stderr, "unknown argument %s\n", a.c_str());
-      return 2;
-    }
+  for (stc_bench::Args args(argc, argv); args.more();) {
+    const std::string& a = args.flag();
+    if (a == "--scene") scene = args.value();
+    else if (a == "--entities") entities = std::stoi(args.value());
+    else if (a == "--tick-budget-ms") budget_ms = std::stod(args.value());
+    else if (a == "--seconds") seconds = std::stod(args.value());
+    else if (a == "--budget-off") budget_off = true;
+    else if (a == "--wall-clock") wall_clock = true;
+    else if (a == "--markdown") markdown = args.value();
+    else return args.unknown();
   }
   struct Case { SceneKind kind; int entities; };
   std::vector<Case> cases;

@@ -5,6 +5,7 @@
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/shape_bounds.hpp"
 #include "sphere_tree_collision/types.hpp"
+#include "sphere_tree_collision/workers.hpp"
 
 #include <array>
 #include <cstdint>
@@ -28,12 +29,21 @@ struct SweepHit {
   Vec3 normal = Vec3::UnitZ(); // face axis the boxes met on, from pairs[pair][0] towards [1]
 };
 
+// One task's run of the pairs: its own node stack and earliest hits, merged
+// after all runs are done.
+struct SweepLane {
+  std::vector<std::pair<std::int32_t, std::int32_t>> stack;  // node pairs of one sweep
+  std::vector<SweepHit> hits;            // per body; t = 1 except at `touched`
+  std::vector<std::uint32_t> touched;    // bodies this lane found a hit for
+  SweepStats stats;
+};
+
 // Kept between ticks so a tick allocates nothing.
 struct SweepScratch {
-  std::vector<std::pair<std::int32_t, std::int32_t>> stack;  // node pairs of one sweep
   std::vector<std::uint8_t> fast;        // per body: moved far enough to be swept
-  std::vector<SweepHit> hits;            // per body
+  std::vector<SweepHit> hits;            // per body: the earliest over all lanes
   std::vector<std::uint32_t> clamped;    // bodies put back this tick
+  std::vector<SweepLane> lanes;          // runs of the pairs, in pair order
 };
 
 // Bodies moved from start[i] to bodies[i].pose this tick. A body is fast when
@@ -60,9 +70,13 @@ std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vect
 // narrow phase gave that pair none). scratch.hits and scratch.clamped say
 // where. Pairs already overlapping at the start are resting contacts, left to
 // the solver.
+// With `workers` the pairs are cut into runs swept in parallel, each into its
+// own hits; a body takes the earliest hit, on a tie the one of the lowest pair
+// index, as the one run in pair order does: the result is the same bit for bit
+// whatever the thread count.
 SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
                            const std::vector<const ShapeBounds*>& shapes,
                            const std::vector<std::array<std::uint32_t, 2>>& pairs, std::size_t pair_count,
-                           double threshold, SweepScratch& scratch);
+                           double threshold, SweepScratch& scratch, const Workers* workers = nullptr);
 
 }  // namespace stc

@@ -96,6 +96,7 @@ class Islands {
   std::uint32_t find(std::uint32_t i);
 
   std::vector<std::uint32_t> group_;  // per body: island it fell asleep with, kAwake while awake
+  std::vector<std::uint8_t> wake_asked_; // per body: its group is in to_wake_
   std::vector<std::uint8_t> held_;    // per body: held as static this tick
   std::vector<std::uint8_t> fresh_;   // per body: added since the last tick
   std::vector<std::uint8_t> moving_;  // per body: not resting at the last endTick, or edited
@@ -106,7 +107,7 @@ class Islands {
   std::vector<double> island_rest_;         // per root: least rest time of its bodies
   std::vector<std::uint8_t> beside_restless_; // per body: touches an awake body not rested yet
   std::vector<std::uint32_t> island_group_; // per root: group it sleeps as (kAwake: none yet)
-  std::vector<std::uint32_t> to_wake_;      // groups to wake
+  std::vector<std::uint32_t> to_wake_;      // groups to wake (repeats allowed)
   std::uint32_t next_group_ = 1;
   std::size_t sleeping_ = 0;
   bool quiet_ = false;

@@ -55,6 +55,17 @@ Vec3 sceneGravity(SceneKind kind);
 // the world may hold the shapes already added, never a partial scene of entities.
 SceneSpec populateScene(World& world, SceneKind kind, const SceneParams& params = SceneParams{});
 
+// A World made for one built-in scene, as tests, benches and users start one.
+struct SceneWorld {
+  World world;
+  SceneSpec spec;
+};
+// `config` with its gravity set to sceneGravity(kind), the scene populated
+// from `params`, and the perception's camera set to the scene's (so a gaze on
+// the image means the same in every World of the scene). Throws as populateScene.
+SceneWorld makeSceneWorld(SceneKind kind, const SceneParams& params = SceneParams{},
+                          WorldConfig config = WorldConfig{});
+
 // ---------------------------------------------------------------------------
 // Gaze
 

@@ -194,10 +194,76 @@ std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vect
   return count;
 }
 
+namespace {
+
+// What every lane of one sweep reads.
+struct SweepInput {
+  const std::vector<BodyState>& bodies;
+  const std::vector<Pose>& start;
+  const std::vector<const ShapeBounds*>& shapes;
+  const std::vector<std::array<std::uint32_t, 2>>& pairs;
+  const std::vector<std::uint8_t>& fast;
+  double threshold;
+};
+
+// Sweeps pairs [begin, end) in order into the lane's hits.
+void sweepPairs(const SweepInput& in, std::size_t begin, std::size_t end, SweepLane& lane) {
+  const std::vector<std::uint8_t>& fast = in.fast;
+  for (std::size_t k = begin; k < end; ++k) {
+    const std::uint32_t a = in.pairs[k][0];
+    const std::uint32_t b = in.pairs[k][1];
+    if (!fast[a] && !fast[b]) continue;
+    const ShapeBounds* sa = in.shapes[a];
+    const ShapeBounds* sb = in.shapes[b];
+    if (sa == nullptr || sa->tree == nullptr || sb == nullptr || sb->tree == nullptr) continue;
+    const Pose& p0 = in.start[a];
+    const Pose& p1 = in.bodies[a].pose;
+    const Pose& q0 = in.start[b];
+    const Pose& q1 = in.bodies[b].pose;
+    // Bodies falling side by side are fast but not towards each other: the
+    // pair is swept only when its relative motion is fast.
+    const double relative = ((p1.position - p0.position) - (q1.position - q0.position)).norm() +
+                            p0.orientation.angularDistance(p1.orientation) * sa->bound_radius +
+                            q0.orientation.angularDistance(q1.orientation) * sb->bound_radius;
+    const double finest = std::min(fast[a] ? sa->min_leaf_radius : sb->min_leaf_radius,
+                                   fast[b] ? sb->min_leaf_radius : sa->min_leaf_radius);
+    if (!(relative > in.threshold * finest)) continue;
+    // Only a hit earlier than a fast body's earliest so far matters.
+    const double latest = std::max(fast[a] ? lane.hits[a].t : 0.0, fast[b] ? lane.hits[b].t : 0.0);
+    Sweeper s{*sa, *sb, p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(),
+              q0.orientation.toRotationMatrix(), q1.orientation.toRotationMatrix(),
+              p0.position, p1.position, q0.position, q1.position, latest, lane.stack};
+    s.anchor_first = fast[a] != 0;
+    ++lane.stats.pairs;
+    const bool found = s.run();
+    lane.stats.leaf_tests += s.leaf_tests;
+    if (!found) continue;
+    for (const std::uint32_t i : {a, b}) {
+      SweepHit& hit = lane.hits[i];
+      if (!fast[i] || !(s.best < hit.t)) continue;
+      if (!(hit.t < 1.0)) lane.touched.push_back(i);
+      hit.t = s.best;
+      hit.pair = static_cast<std::uint32_t>(k);
+      hit.point = s.point;
+      hit.normal = s.normal;  // from a (the sweeper's first body) towards b
+    }
+  }
+}
+
+// Runs of the pairs: one with one thread, a few per thread otherwise (runs
+// differ in how many fast pairs they hold).
+std::size_t laneCount(const Workers* workers, std::size_t pair_count) {
+  if (workers == nullptr || workers->threads() <= 1) return 1;
+  constexpr std::size_t kPairsPerLane = 256;
+  return std::clamp<std::size_t>(pair_count / kPairsPerLane, 1, 4 * static_cast<std::size_t>(workers->threads()));
+}
+
+}  // namespace
+
 SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pose>& start,
                            const std::vector<const ShapeBounds*>& shapes,
                            const std::vector<std::array<std::uint32_t, 2>>& pairs, std::size_t pair_count,
-                           double threshold, SweepScratch& scratch) {
+                           double threshold, SweepScratch& scratch, const Workers* workers) {
   SweepStats stats;
   scratch.hits.assign(bodies.size(), SweepHit{});
   scratch.clamped.clear();
@@ -209,42 +275,33 @@ SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pos
   // the hit holds back whichever of them is fast. Every pair sees the poses
   // of this integration (bodies are put back after all pairs): the result
   // does not depend on the pair order.
-  for (std::size_t k = 0; k < pair_count; ++k) {
-    const std::uint32_t a = pairs[k][0];
-    const std::uint32_t b = pairs[k][1];
-    if (!scratch.fast[a] && !scratch.fast[b]) continue;
-    if (shapes[a] == nullptr || shapes[a]->tree == nullptr || shapes[b] == nullptr || shapes[b]->tree == nullptr) {
-      continue;
-    }
-    const Pose& p0 = start[a];
-    const Pose& p1 = bodies[a].pose;
-    const Pose& q0 = start[b];
-    const Pose& q1 = bodies[b].pose;
-    // Bodies falling side by side are fast but not towards each other: the
-    // pair is swept only when its relative motion is fast.
-    const double relative = ((p1.position - p0.position) - (q1.position - q0.position)).norm() +
-                            p0.orientation.angularDistance(p1.orientation) * shapes[a]->bound_radius +
-                            q0.orientation.angularDistance(q1.orientation) * shapes[b]->bound_radius;
-    const double finest = std::min(scratch.fast[a] ? shapes[a]->min_leaf_radius : shapes[b]->min_leaf_radius,
-                                   scratch.fast[b] ? shapes[b]->min_leaf_radius : shapes[a]->min_leaf_radius);
-    if (!(relative > threshold * finest)) continue;
-    // Only a hit earlier than a fast body's earliest so far matters.
-    const double latest = std::max(scratch.fast[a] ? scratch.hits[a].t : 0.0, scratch.fast[b] ? scratch.hits[b].t : 0.0);
-    Sweeper s{*shapes[a], *shapes[b], p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(),
-              q0.orientation.toRotationMatrix(), q1.orientation.toRotationMatrix(),
-              p0.position, p1.position, q0.position, q1.position, latest, scratch.stack};
-    s.anchor_first = scratch.fast[a] != 0;
-    ++stats.pairs;
-    const bool found = s.run();
-    stats.leaf_tests += s.leaf_tests;
-    if (!found) continue;
-    for (const std::uint32_t i : {a, b}) {
-      SweepHit& hit = scratch.hits[i];
-      if (!scratch.fast[i] || !(s.best < hit.t)) continue;
-      hit.t = s.best;
-      hit.pair = static_cast<std::uint32_t>(k);
-      hit.point = s.point;
-      hit.normal = s.normal;  // from a (the sweeper's first body) towards b
+  const std::size_t lanes = laneCount(workers, pair_count);
+  if (scratch.lanes.size() < lanes) scratch.lanes.resize(lanes);
+  for (std::size_t l = 0; l < lanes; ++l) {
+    SweepLane& lane = scratch.lanes[l];
+    if (lane.hits.size() != bodies.size()) lane.hits.assign(bodies.size(), SweepHit{});
+    lane.touched.clear();
+    lane.touched.reserve(bodies.size());
+    lane.stats = SweepStats{};
+  }
+  const SweepInput in{bodies, start, shapes, pairs, scratch.fast, threshold};
+  const auto run = [&](std::size_t l, std::size_t) {
+    const auto [begin, end] = chunkRange(pair_count, l, lanes);
+    sweepPairs(in, begin, end, scratch.lanes[l]);
+  };
+  if (lanes == 1) {
+    run(0, 1);
+  } else {
+    workers->forChunks(lanes, run);
+  }
+  // Lanes in pair order, a later one taking a body only when strictly earlier.
+  for (std::size_t l = 0; l < lanes; ++l) {
+    SweepLane& lane = scratch.lanes[l];
+    stats.pairs += lane.stats.pairs;
+    stats.leaf_tests += lane.stats.leaf_tests;
+    for (const std::uint32_t i : lane.touched) {
+      if (lane.hits[i].t < scratch.hits[i].t) scratch.hits[i] = lane.hits[i];
+      lane.hits[i] = SweepHit{};
     }
   }
   for (std::size_t i = 0; i < bodies.size(); ++i) {

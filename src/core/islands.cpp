@@ -30,9 +30,10 @@ void validateSleepOptions(const SleepOptions& options) {
 void Islands::add(double reach) {
   rest_test_.add(reach);
   group_.push_back(kAwake);
-  // Groups to wake are distinct and at most one per body: room for that many now keeps
-  // requestWake from allocating mid-tick (lone sleepers make one group per body).
+  // A body asks for its group at most once between wakes: room for one group per body
+  // keeps requestWake from allocating mid-tick (lone sleepers make one group per body).
   if (to_wake_.capacity() < group_.size()) to_wake_.reserve(2 * group_.size());
+  wake_asked_.push_back(0);
   held_.push_back(0);
   fresh_.push_back(1);
   moving_.push_back(1);
@@ -48,12 +49,14 @@ void Islands::remove(std::size_t index, std::size_t last) {
   }
   rest_test_.remove(index, last);
   group_[index] = group_[last];
+  wake_asked_[index] = wake_asked_[last];
   held_[index] = held_[last];
   fresh_[index] = fresh_[last];
   moving_[index] = moving_[last];
   rest_pose_[index] = rest_pose_[last];
   rest_time_[index] = rest_time_[last];
   group_.pop_back();
+  wake_asked_.pop_back();
   held_.pop_back();
   fresh_.pop_back();
   moving_.pop_back();
@@ -63,6 +66,7 @@ void Islands::remove(std::size_t index, std::size_t last) {
 
 void Islands::clear() {
   group_.clear();
+  wake_asked_.clear();
   held_.clear();
   fresh_.clear();
   moving_.clear();
@@ -73,18 +77,23 @@ void Islands::clear() {
   sleeping_ = 0;
 }
 
+// Constant time: a body asks once (a pile's restless rocks touch many sleepers,
+// each overlap asks), and a group asked for by several bodies is listed again.
 void Islands::requestWake(std::size_t body) {
-  const std::uint32_t group = group_[body];
-  if (group == kAwake) return;
-  if (std::find(to_wake_.begin(), to_wake_.end(), group) == to_wake_.end()) to_wake_.push_back(group);
+  if (group_[body] == kAwake || wake_asked_[body] != 0) return;
+  wake_asked_[body] = 1;
+  to_wake_.push_back(group_[body]);
 }
 
-// One pass over the bodies wakes every requested group.
+// One pass over the bodies wakes every requested group (sorted first: with
+// lone sleepers many groups can wake at once, and each body looks its group up).
 void Islands::applyWakes(std::vector<BodyState>* bodies) {
   if (to_wake_.empty()) return;
+  std::sort(to_wake_.begin(), to_wake_.end());
   for (std::size_t i = 0; i < group_.size(); ++i) {
     if (group_[i] == kAwake) continue;
-    if (std::find(to_wake_.begin(), to_wake_.end(), group_[i]) == to_wake_.end()) continue;
+    if (!std::binary_search(to_wake_.begin(), to_wake_.end(), group_[i])) continue;
+    wake_asked_[i] = 0;  // only sleepers ask, and each asking body's group is listed
     group_[i] = kAwake;
     rest_time_[i] = 0.0;
     rest_test_.restart(i);
@@ -104,6 +113,7 @@ void Islands::wake(std::size_t body) {
 
 void Islands::wakeAll() {
   std::fill(group_.begin(), group_.end(), kAwake);
+  std::fill(wake_asked_.begin(), wake_asked_.end(), 0);
   std::fill(rest_time_.begin(), rest_time_.end(), 0.0);
   for (std::size_t i = 0; i < group_.size(); ++i) rest_test_.restart(i);
   to_wake_.clear();

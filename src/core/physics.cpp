@@ -51,7 +51,7 @@ void Physics::sweep(const StepContext& step) {
   sweep_scratch_.clamped.clear();
   if (report_.sweep.fast_bodies == 0 || !options.continuous || !options.enabled) return;
   report_.sweep = sweepFastBodies(*step.bodies, start_, body_bounds_, *step.pair_bodies, step.pair_count,
-                                  options.sweep_threshold, sweep_scratch_);
+                                  options.sweep_threshold, sweep_scratch_, step.workers);
 }
 
 // The contacts of pairs [first, last) appended to `out` in pair order.

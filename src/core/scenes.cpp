@@ -323,4 +323,12 @@ SceneSpec populateScene(World& world, SceneKind kind, const SceneParams& params)
   return spec;
 }
 
+SceneWorld makeSceneWorld(SceneKind kind, const SceneParams& params, WorldConfig config) {
+  config.gravity = sceneGravity(kind);
+  SceneWorld scene{World(config), SceneSpec{}};
+  scene.spec = populateScene(scene.world, kind, params);
+  scene.world.perception().setCamera(scene.spec.camera);
+  return scene;
+}
+
 }  // namespace stc

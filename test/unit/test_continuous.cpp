@@ -76,13 +76,10 @@ TEST(Continuous, StoredSpeedAgreesWithRealMotionOnEveryBuiltInScene) {
   const std::pair<SceneKind, int> scenes[] = {
       {SceneKind::PackedBox, 64}, {SceneKind::BouncingBox, 100}, {SceneKind::Rockfall, 200}, {SceneKind::CornerDrift, 125}};
   for (const auto& [kind, count] : scenes) {
-    WorldConfig config;
-    config.gravity = sceneGravity(kind);
-    World w(config);
     SceneParams params;
     params.entities = count;
-    populateScene(w, kind, params);
-    const SpeedAgreement m = measure(w, static_cast<int>(10.0 / kDt));
+    SceneWorld scene = makeSceneWorld(kind, params);
+    const SpeedAgreement m = measure(scene.world, static_cast<int>(10.0 / kDt));
     SCOPED_TRACE(toString(kind));
     EXPECT_GT(m.stored, 0.0);
     EXPECT_LE(std::abs(m.stored - m.real), 0.1 * m.real + 0.05) << "stored " << m.stored << " real " << m.real;

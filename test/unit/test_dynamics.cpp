@@ -371,16 +371,28 @@ TEST(Contacts, SeparateOrRejectedPairsGiveNoneAndUntestedPairsUseTheRoots) {
 // ---------------------------------------------------------------------------
 // Swept test
 
+// A block of nx x ny x nz full voxels, its tree and bounds (which point into
+// it: not copied or moved).
+struct Block {
+  VoxelShape shape;
+  Vec3 origin;
+  SphereTree tree;
+  ShapeBounds bounds;
+  Block(int nx, int ny, int nz, double voxel, const Vec3& at)
+      : shape(VoxelShape::create(nx, ny, nz, voxel, std::vector<std::uint8_t>(static_cast<std::size_t>(nx * ny * nz), 1))),
+        origin(at),
+        tree(SphereTree::build(shape, origin)),
+        bounds(makeShapeBounds(tree, &shape, origin)) {}
+  Block(const Block&) = delete;
+  Block& operator=(const Block&) = delete;
+};
+
 TEST(Sweep, AFastSmallBodyIsStoppedAtAThinPlateAndSlowOrSlidingOnesAreNot) {
   const double voxel = 0.05;
-  const VoxelShape plate_shape = VoxelShape::create(16, 16, 1, voxel, std::vector<std::uint8_t>(256, 1));
-  const Vec3 plate_origin(0.4, 0.4, 0.025);
-  const SphereTree plate_tree = SphereTree::build(plate_shape, plate_origin);
-  const ShapeBounds plate = makeShapeBounds(plate_tree, &plate_shape, plate_origin);
-  const VoxelShape ball_shape = VoxelShape::create(1, 1, 1, voxel, {1});
-  const Vec3 ball_origin = Vec3::Constant(0.025);
-  const SphereTree ball_tree = SphereTree::build(ball_shape, ball_origin);
-  const ShapeBounds ball = makeShapeBounds(ball_tree, &ball_shape, ball_origin);
+  const Block plate_block(16, 16, 1, voxel, Vec3(0.4, 0.4, 0.025));
+  const Block ball_block(1, 1, 1, voxel, Vec3::Constant(0.025));
+  const ShapeBounds& plate = plate_block.bounds;
+  const ShapeBounds& ball = ball_block.bounds;
 
   std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Constant(voxel))};
   std::vector<Pose> start(2);
@@ -446,6 +458,75 @@ TEST(Sweep, AFastSmallBodyIsStoppedAtAThinPlateAndSlowOrSlidingOnesAreNot) {
   stats = sweepFastBodies(bodies, start, shapes, pairs, pairs.size(), 0.5, scratch);
   EXPECT_EQ(stats.clamped, 1u);
   EXPECT_GT(bodies[1].pose.position.z(), 0.3 - 0.1 * voxel);
+}
+
+TEST(Sweep, LanesOnWorkersGiveTheOneRunsHitsBitForBit) {
+  // 60 small cubes shot through 20 plates from random places: about 1,200
+  // pairs, cut into several lanes on 3 threads. Each pair also comes again
+  // later in the list (a tie on t in another lane): the first must win.
+  const double voxel = 0.05;
+  const Block plate(8, 8, 1, voxel, Vec3(0.2, 0.2, 0.025));
+  const Block cube(2, 2, 2, voxel, Vec3::Constant(0.05));
+
+  constexpr int kPlates = 20, kCubes = 60;
+  std::vector<BodyState> bodies;
+  std::vector<Pose> start;
+  std::vector<const ShapeBounds*> shapes;
+  std::uint32_t seed = 7;
+  const auto uniform = [&seed](double lo, double hi) {  // small LCG: the same draws everywhere
+    seed = seed * 1664525u + 1013904223u;
+    return lo + (hi - lo) * static_cast<double>(seed >> 8) / static_cast<double>(1u << 24);
+  };
+  for (int i = 0; i < kPlates; ++i) {
+    bodies.push_back(staticBody(Vec3(0.0, 0.0, 0.1 * i)));
+    start.push_back(bodies.back().pose);
+    shapes.push_back(&plate.bounds);
+  }
+  for (int i = 0; i < kCubes; ++i) {
+    BodyState b = boxBody(1.0, Vec3::Constant(2 * voxel));
+    Pose p0;
+    p0.position = Vec3(uniform(-0.2, 0.2), uniform(-0.2, 0.2), uniform(1.5, 2.5));
+    b.pose.position = Vec3(uniform(-0.2, 0.2), uniform(-0.2, 0.2), uniform(-0.5, 0.5));
+    b.pose.orientation = Quat(Eigen::AngleAxisd(uniform(0.0, 3.0), Vec3(1.0, 2.0, 3.0).normalized()));
+    bodies.push_back(b);
+    start.push_back(p0);
+    shapes.push_back(&cube.bounds);
+  }
+  std::vector<std::array<std::uint32_t, 2>> pairs;
+  for (std::uint32_t c = kPlates; c < kPlates + kCubes; ++c) {
+    for (std::uint32_t p = 0; p < kPlates; ++p) pairs.push_back({p, c});
+  }
+  const std::size_t once = pairs.size();
+  for (std::size_t k = 0; k < once; ++k) pairs.push_back(pairs[k]);
+
+  const auto sweep = [&](const Workers* workers, std::vector<BodyState>& out, SweepScratch& scratch) {
+    out = bodies;
+    markFastBodies(out, start, shapes, 0.5, scratch.fast);
+    return sweepFastBodies(out, start, shapes, pairs, pairs.size(), 0.5, scratch, workers);
+  };
+  std::vector<BodyState> one_run, in_lanes;
+  SweepScratch one_scratch, lane_scratch;
+  const Workers workers(3);
+  const SweepStats one = sweep(nullptr, one_run, one_scratch);
+  const SweepStats lanes = sweep(&workers, in_lanes, lane_scratch);
+  EXPECT_GT(one.clamped, static_cast<std::size_t>(kCubes / 2));  // most cubes hit a plate
+  EXPECT_EQ(lanes.clamped, one.clamped);
+  ASSERT_EQ(lane_scratch.clamped, one_scratch.clamped);
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const SweepHit& a = one_scratch.hits[i];
+    const SweepHit& b = lane_scratch.hits[i];
+    EXPECT_EQ(a.t, b.t) << i;
+    EXPECT_EQ(a.pair, b.pair) << i;
+    EXPECT_LT(a.pair, once) << i;  // the first of the two equal pairs
+    EXPECT_EQ(a.point, b.point) << i;
+    EXPECT_EQ(a.normal, b.normal) << i;
+    EXPECT_EQ(one_run[i].pose.position, in_lanes[i].pose.position) << i;
+    EXPECT_EQ(one_run[i].pose.orientation.coeffs(), in_lanes[i].pose.orientation.coeffs()) << i;
+  }
+  // Again on the same scratch: the lanes were left clean.
+  const SweepStats again = sweep(&workers, in_lanes, lane_scratch);
+  EXPECT_EQ(again.clamped, one.clamped);
+  for (std::size_t i = 0; i < bodies.size(); ++i) EXPECT_EQ(one_scratch.hits[i].t, lane_scratch.hits[i].t) << i;
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace stc {
@@ -22,16 +23,16 @@ namespace {
 constexpr int kTicks = 300;
 constexpr int kEntities = 100;
 
-World sceneWorld(SceneKind kind, int threads, int entities = kEntities) {
-  WorldConfig config;
-  config.gravity = sceneGravity(kind);
-  config.threads = threads;
-  World w(config);
+World sceneWorld(SceneKind kind, WorldConfig config) {
   SceneParams params;
-  params.entities = entities;
-  const SceneSpec spec = populateScene(w, kind, params);
-  w.perception().setCamera(spec.camera);
-  return w;
+  params.entities = kEntities;
+  return std::move(makeSceneWorld(kind, params, config).world);
+}
+
+World sceneWorld(SceneKind kind, int threads) {
+  WorldConfig config;
+  config.threads = threads;
+  return sceneWorld(kind, config);
 }
 
 // Bit-identical: every double compared with ==, none within a tolerance.
@@ -131,14 +132,9 @@ TEST(ParallelTick, SphereTestBudgetGivesTheSameBitsRunAfterRun) {
 // response is off, so the poses the tests saw are the poses after the tick.
 TEST(ParallelTick, EachChunkRunsTheSchedulerOverItsPairsWithinItsShare) {
   WorldConfig config;
-  config.gravity = sceneGravity(SceneKind::CornerDrift);
   config.threads = 2;
   config.response.enabled = false;
-  World w(config);
-  SceneParams params;
-  params.entities = kEntities;
-  const SceneSpec spec = populateScene(w, SceneKind::CornerDrift, params);
-  w.perception().setCamera(spec.camera);
+  World w = sceneWorld(SceneKind::CornerDrift, config);
   w.perception().setFixation(Vec2(400, 300));
   for (int t = 0; t < 60; ++t) w.step(1.0 / 60.0, Budget::unlimited());  // into the pile
 

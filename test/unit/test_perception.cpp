@@ -1,5 +1,7 @@
 // Perception: pinhole projection, input checks, f(e, g), and the rule for
 // pairs behind the camera or off screen.
+#include "thrown_field.hpp"
+
 #include "sphere_tree_collision/perception.hpp"
 #include "sphere_tree_collision/perception_ray.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
@@ -9,7 +11,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <string>
 
@@ -30,15 +31,6 @@ VoxelShape presetShape(const char* name, int resolution, double voxel_size) {
   params.resolution = resolution;
   params.voxel_size = voxel_size;
   return makePreset(name, params);
-}
-
-std::string fieldOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.field();
-  }
-  return "<no throw>";
 }
 
 TEST(Perception, ProjectsThroughThePinholeWithYDown) {
@@ -80,7 +72,7 @@ TEST(Perception, LookAtPutsTheTargetAtTheImageCentreWithUpUp) {
   // Looking along +x with z up: +z world is up the image (smaller v), -y world is right.
   EXPECT_LT(p.project(Vec3(0, 2, 4))->y(), 360.0);
   EXPECT_GT(p.project(Vec3(0, 1, 3))->x(), 640.0);
-  EXPECT_EQ(fieldOf([] { opticalLookAt(Vec3(1, 1, 1), Vec3(1, 1, 1)); }), "target");
+  EXPECT_EQ(thrownField([] { opticalLookAt(Vec3(1, 1, 1), Vec3(1, 1, 1)); }), "target");
   // Up parallel to the view direction still gives a proper rotation.
   const Pose down = opticalLookAt(Vec3(0, 0, 10), Vec3(0, 0, 0), Vec3::UnitZ());
   EXPECT_NEAR(down.orientation.norm(), 1.0, 1e-12);
@@ -91,7 +83,7 @@ TEST(Perception, ValidateCameraNamesTheBadField) {
   auto with = [](auto edit) {
     Camera c;
     edit(c);
-    return fieldOf([&] { validateCamera(c); });
+    return thrownField([&] { validateCamera(c); });
   };
   EXPECT_EQ(with([](Camera&) {}), "<no throw>");
   EXPECT_EQ(with([](Camera& c) { c.width = 0; }), "width");
@@ -124,12 +116,12 @@ TEST(Perception, FixationMustBeFiniteAndOnScreen) {
   p.setFixation(Vec2(0, 0));
   p.setFixation(Vec2(1280, 720));  // the image edges are on screen
   p.setFixation(Vec2(100, 200));
-  EXPECT_EQ(fieldOf([&] { p.setFixation(Vec2(kNaN, 3)); }), "fixation");
-  EXPECT_EQ(fieldOf([&] { p.setFixation(Vec2(3, std::numeric_limits<double>::infinity())); }),
+  EXPECT_EQ(thrownField([&] { p.setFixation(Vec2(kNaN, 3)); }), "fixation");
+  EXPECT_EQ(thrownField([&] { p.setFixation(Vec2(3, std::numeric_limits<double>::infinity())); }),
             "fixation");
-  EXPECT_EQ(fieldOf([&] { p.setFixation(Vec2(-0.5, 10)); }), "fixation");
-  EXPECT_EQ(fieldOf([&] { p.setFixation(Vec2(10, 720.5)); }), "fixation");
-  EXPECT_EQ(fieldOf([&] { p.setFixation(Vec2(1281, 10)); }), "fixation");
+  EXPECT_EQ(thrownField([&] { p.setFixation(Vec2(-0.5, 10)); }), "fixation");
+  EXPECT_EQ(thrownField([&] { p.setFixation(Vec2(10, 720.5)); }), "fixation");
+  EXPECT_EQ(thrownField([&] { p.setFixation(Vec2(1281, 10)); }), "fixation");
   ASSERT_TRUE(p.hasFixation());  // a rejected fixation keeps the previous one
   EXPECT_EQ(*p.fixation(), Vec2(100, 200));
   p.clearFixation();

@@ -1,26 +1,18 @@
 // Scenes as data and the gaze model: what each scene puts in a World, input
 // checks, determinism, and where the gaze lands over time.
+#include "thrown_field.hpp"
+
 #include "sphere_tree_collision/scenes.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <string>
 
 namespace stc {
 namespace {
-
-std::string fieldOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.field();
-  }
-  return "<no throw>";
-}
 
 WorldConfig configFor(SceneKind kind) {
   WorldConfig c;
@@ -38,11 +30,11 @@ bool inside(const Aabb& box, const Vec3& p) {
 
 TEST(Scenes, NamesRoundTrip) {
   for (SceneKind kind : kAllScenes) EXPECT_EQ(parseScene(toString(kind)), kind);
-  EXPECT_EQ(fieldOf([] { parseScene("ravine"); }), "scene");
+  EXPECT_EQ(thrownField([] { parseScene("ravine"); }), "scene");
   for (GazeMode mode : {GazeMode::Fixed, GazeMode::Saccades, GazeMode::Follow}) {
     EXPECT_EQ(parseGazeMode(toString(mode)), mode);
   }
-  EXPECT_EQ(fieldOf([] { parseGazeMode("stare"); }), "gaze_mode");
+  EXPECT_EQ(thrownField([] { parseGazeMode("stare"); }), "gaze_mode");
 }
 
 TEST(Scenes, EachSceneHasMoversInsideItsBoundsStaticWallsAndACameraOnThem) {
@@ -207,7 +199,7 @@ TEST(Scenes, BadParamsNameTheFieldAndAddNoEntity) {
     World world(config);
     SceneParams p;
     edit(p);
-    const std::string f = fieldOf([&] { populateScene(world, kind, p); });
+    const std::string f = thrownField([&] { populateScene(world, kind, p); });
     EXPECT_EQ(world.entityCount(), 0u) << f;
     return f;
   };
@@ -223,6 +215,34 @@ TEST(Scenes, BadParamsNameTheFieldAndAddNoEntity) {
   WorldConfig small = packed;
   small.max_entities = 100;
   EXPECT_EQ(field(SceneKind::PackedBox, small, [](SceneParams&) {}), "entities");
+}
+
+TEST(Scenes, SceneWorldHasTheScenesGravityAndCameraAndKeepsTheRestOfTheConfig) {
+  WorldConfig config;
+  config.gravity = Vec3(1.0, 2.0, 3.0);  // replaced by the scene's
+  config.threads = 2;
+  config.sleeping.enabled = false;
+  SceneParams params;
+  params.entities = 20;
+  const SceneWorld scene = makeSceneWorld(SceneKind::CornerDrift, params, config);
+  EXPECT_EQ(scene.world.config().gravity, sceneGravity(SceneKind::CornerDrift));
+  EXPECT_EQ(scene.world.config().threads, 2);
+  EXPECT_FALSE(scene.world.config().sleeping.enabled);
+  EXPECT_EQ(scene.spec.movers.size(), 20u);
+  EXPECT_EQ(scene.world.entityCount(), scene.spec.movers.size() + scene.spec.walls.size());
+  const Camera& camera = scene.world.perception().camera();
+  ASSERT_FALSE(scene.spec.camera.camera_to_world.position.isZero());  // not the default camera
+  EXPECT_TRUE(camera.camera_to_world.position.isApprox(scene.spec.camera.camera_to_world.position));
+  EXPECT_EQ(camera.width, scene.spec.camera.width);
+  // The same world as populateScene builds into a World of the scene's gravity.
+  World direct(configFor(SceneKind::CornerDrift));
+  populateScene(direct, SceneKind::CornerDrift, params);
+  ASSERT_EQ(direct.entityCount(), scene.world.entityCount());
+  for (std::size_t i = 0; i < direct.entityCount(); ++i) {
+    EXPECT_EQ(direct.bodies()[i].pose.position, scene.world.bodies()[i].pose.position);
+  }
+  params.entities = -1;
+  EXPECT_EQ(thrownField([&] { makeSceneWorld(SceneKind::PackedBox, params); }), "entities");
 }
 
 // ---------------------------------------------------------------------------
@@ -301,13 +321,13 @@ TEST_F(Gaze, FollowTracksTheEntityAndHoldsWhenItIsBehind) {
 TEST_F(Gaze, BadParamsNameTheField) {
   GazeParams p;
   p.saccade_period_s = 0.0;
-  EXPECT_EQ(fieldOf([&] { GazeModel g(p); }), "saccade_period_s");
+  EXPECT_EQ(thrownField([&] { GazeModel g(p); }), "saccade_period_s");
   p = GazeParams{};
   p.saccade_margin = 0.5;
-  EXPECT_EQ(fieldOf([&] { GazeModel g(p); }), "saccade_margin");
+  EXPECT_EQ(thrownField([&] { GazeModel g(p); }), "saccade_margin");
   p = GazeParams{};
   p.pixel = Vec2(std::nan(""), 1);
-  EXPECT_EQ(fieldOf([&] { GazeModel g(p); }), "pixel");
+  EXPECT_EQ(thrownField([&] { GazeModel g(p); }), "pixel");
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include <numeric>
 #include <random>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 // Counts heap allocations so a test can assert a warm run makes none.
@@ -372,6 +373,19 @@ TEST_F(SchedulerTest, WarmRunsDoNotAllocate) {
   }
 }
 
+// The scene stepped `ticks` full ticks, its poses copied into a World of it
+// with the response off: a snapshot the schedulers step over (dt 0) again
+// and again.
+World snapshotOf(SceneKind kind, const SceneParams& params, int ticks) {
+  auto [sim, spec] = makeSceneWorld(kind, params);
+  for (int i = 0; i < ticks; ++i) sim.step(spec.dt, Budget::unlimited());
+  WorldConfig still;
+  still.response.enabled = false;
+  World eval = std::move(makeSceneWorld(kind, params, still).world);
+  for (std::size_t i = 0; i < sim.entityCount(); ++i) eval.bodies()[i].pose = sim.bodies()[i].pose;
+  return eval;
+}
+
 // The cheaper bookkeeping changes only the order of steps: with no budget
 // every scheduler leaves every pair of a real scene in the same state after
 // the same sphere tests, with the same contacts (round-robin's code is the
@@ -381,18 +395,8 @@ TEST(SchedulerSceneTest, UnlimitedBudgetGivesRoundRobinsResultsOnBothScenes) {
                                               std::tuple{SceneKind::Rockfall, 60, 60}}) {
     SceneParams params;
     params.entities = entities;
-    WorldConfig config;
-    config.gravity = sceneGravity(kind);
-    World sim(config);
-    const SceneSpec spec = populateScene(sim, kind, params);
-    for (int i = 0; i < ticks; ++i) sim.step(spec.dt, Budget::unlimited());
-
-    config.response.enabled = false;
-    World eval(config);
-    populateScene(eval, kind, params);
-    for (std::size_t i = 0; i < sim.entityCount(); ++i) eval.bodies()[i].pose = sim.bodies()[i].pose;
-    eval.perception().setCamera(spec.camera);
-    const auto fixation = eval.perception().project(sim.bodies()[sim.entityCount() / 2].pose.position);
+    World eval = snapshotOf(kind, params, ticks);
+    const auto fixation = eval.perception().project(eval.bodies()[eval.entityCount() / 2].pose.position);
     ASSERT_TRUE(fixation && eval.perception().onScreen(*fixation)) << toString(kind);
     eval.perception().setFixation(*fixation);
 
@@ -433,17 +437,8 @@ TEST(SchedulerSceneTest, UnlimitedBudgetGivesRoundRobinsResultsOnBothScenes) {
 TEST(SchedulerSceneTest, PriorityQueuesBinAlikeByExponentAndByEdges) {
   SceneParams params;
   params.entities = 125;
-  WorldConfig config;
-  config.gravity = sceneGravity(SceneKind::PackedBox);
-  World sim(config);
-  const SceneSpec spec = populateScene(sim, SceneKind::PackedBox, params);
-  for (int i = 0; i < 20; ++i) sim.step(spec.dt, Budget::unlimited());
-  config.response.enabled = false;
-  World eval(config);
-  populateScene(eval, SceneKind::PackedBox, params);
-  for (std::size_t i = 0; i < sim.entityCount(); ++i) eval.bodies()[i].pose = sim.bodies()[i].pose;
-  eval.perception().setCamera(spec.camera);
-  const auto fixation = eval.perception().project(sim.bodies()[sim.entityCount() / 2].pose.position);
+  World eval = snapshotOf(SceneKind::PackedBox, params, 20);
+  const auto fixation = eval.perception().project(eval.bodies()[eval.entityCount() / 2].pose.position);
   ASSERT_TRUE(fixation && eval.perception().onScreen(*fixation));
   eval.perception().setFixation(*fixation);
   const std::int64_t total = eval.step(0.0, Budget::unlimited()).sphere_tests;

@@ -8,7 +8,6 @@
 
 #include <gtest/gtest.h>
 
-#include <memory>
 
 namespace stc {
 namespace {
@@ -17,23 +16,16 @@ constexpr double kDt = 1.0 / 60.0;
 constexpr int kSettleTicks = 900;  // 15 s: the pile is asleep long before
 constexpr int kBigPile = 1500;     // rocks: one island that a few creeping rocks keep awake
 
-struct Pile {
-  std::unique_ptr<World> world;
-  SceneSpec spec;
-};
+using Pile = SceneWorld;
 
 // Cubes falling into a pile in a closed box (scenes.hpp CubeBox).
 Pile cubePile(bool sleeping = true, int count = 27) {
   WorldConfig config;
-  config.gravity = sceneGravity(SceneKind::CubeBox);
   config.sleeping.enabled = sleeping;
-  Pile pile;
-  pile.world = std::make_unique<World>(config);
   SceneParams params;
   params.entities = count;
   params.resolution = 4;
-  pile.spec = populateScene(*pile.world, SceneKind::CubeBox, params);
-  return pile;
+  return makeSceneWorld(SceneKind::CubeBox, params, config);
 }
 
 // Steps until every mover sleeps; returns the ticks it took (-1: never).
@@ -46,7 +38,7 @@ int settle(World& world, std::size_t movers, int max_ticks = kSettleTicks) {
 
 Pile settledPile() {
   Pile pile = cubePile();
-  EXPECT_GT(settle(*pile.world, pile.spec.movers.size()), 0);
+  EXPECT_GT(settle(pile.world, pile.spec.movers.size()), 0);
   return pile;
 }
 
@@ -55,7 +47,7 @@ std::size_t indexOf(const World& world, EntityId id) { return *world.indexOf(id)
 // Top of the pile: the highest mover's centre.
 double highestMover(const Pile& pile) {
   double z = -1e9;
-  for (EntityId id : pile.spec.movers) z = std::max(z, pile.world->bodies()[indexOf(*pile.world, id)].pose.position.z());
+  for (EntityId id : pile.spec.movers) z = std::max(z, pile.world.bodies()[indexOf(pile.world, id)].pose.position.z());
   return z;
 }
 
@@ -63,10 +55,10 @@ TEST(Sleeping, WithoutAResponseNothingSleepsAndEveryPairReportsItsContacts) {
   // Detection alone (the node's ~response false): bodies at rest keep being
   // tested, so overlapping ones report contacts tick after tick.
   Pile pile = cubePile();
-  WorldConfig config = pile.world->config();
+  WorldConfig config = pile.world.config();
   ResponseOptions off = config.response;
   off.enabled = false;
-  World& world = *pile.world;
+  World& world = pile.world;
   for (int t = 0; t < 240; ++t) world.step(kDt, Budget::unlimited());  // under gravity, no response: they fall
   world.setResponse(off);
   for (BodyState& b : world.bodies()) {  // hold them where they are, overlapping the floor or not
@@ -86,7 +78,7 @@ TEST(Sleeping, WithoutAResponseNothingSleepsAndEveryPairReportsItsContacts) {
 
 TEST(Sleeping, TurningTheResponseOffWakesEveryIsland) {
   Pile pile = settledPile();
-  World& world = *pile.world;
+  World& world = pile.world;
   ResponseOptions off = world.config().response;
   off.enabled = false;
   world.setResponse(off);
@@ -96,7 +88,7 @@ TEST(Sleeping, TurningTheResponseOffWakesEveryIsland) {
 
 TEST(Sleeping, PileComesToRestSleepsAndCostsNoSphereTest) {
   Pile pile = settledPile();
-  World& world = *pile.world;
+  World& world = pile.world;
   std::vector<Pose> poses;
   for (const BodyState& b : world.bodies()) poses.push_back(b.pose);
   for (int t = 0; t < 120; ++t) {
@@ -120,24 +112,24 @@ TEST(Sleeping, OffChangesNothingAndOnIsBitIdenticalUntilTheFirstSleep) {
   Pile on = cubePile(true), off = cubePile(false);
   int compared = 0;
   for (int t = 0; t < kSettleTicks; ++t) {
-    const TickReport r_on = on.world->step(kDt, Budget::unlimited());
-    const TickReport r_off = off.world->step(kDt, Budget::unlimited());
+    const TickReport r_on = on.world.step(kDt, Budget::unlimited());
+    const TickReport r_off = off.world.step(kDt, Budget::unlimited());
     EXPECT_EQ(r_off.sleeping, 0u);
     if (r_on.sleeping != 0) break;
     ++compared;
-    for (std::size_t i = 0; i < on.world->bodies().size(); ++i) {
-      ASSERT_EQ(on.world->bodies()[i].pose.position, off.world->bodies()[i].pose.position) << "tick " << t;
-      ASSERT_EQ(on.world->bodies()[i].linear_velocity, off.world->bodies()[i].linear_velocity) << "tick " << t;
+    for (std::size_t i = 0; i < on.world.bodies().size(); ++i) {
+      ASSERT_EQ(on.world.bodies()[i].pose.position, off.world.bodies()[i].pose.position) << "tick " << t;
+      ASSERT_EQ(on.world.bodies()[i].linear_velocity, off.world.bodies()[i].linear_velocity) << "tick " << t;
     }
   }
   EXPECT_GT(compared, 30);  // the pile fell and moved before anything slept
   // Off: the settled pile still tests its pairs every tick.
-  EXPECT_GT(off.world->step(kDt, Budget::unlimited()).sphere_tests, 0);
+  EXPECT_GT(off.world.step(kDt, Budget::unlimited()).sphere_tests, 0);
 }
 
 // A heavy ball 1 m above the pile's last mover, falling at `speed`.
 EntityId dropBall(Pile& pile, double speed) {
-  World& world = *pile.world;
+  World& world = pile.world;
   PresetParams p;
   p.resolution = 4;
   p.voxel_size = 0.1;
@@ -152,7 +144,7 @@ EntityId dropBall(Pile& pile, double speed) {
 
 TEST(Sleeping, BallDroppedOnTheSleepingPileWakesItAndEverythingRestsSupported) {
   Pile pile = settledPile();
-  World& world = *pile.world;
+  World& world = pile.world;
   const EntityId ball_id = dropBall(pile, 3.0);
   std::size_t fewest_asleep = pile.spec.movers.size();
   for (int t = 0; t < 60; ++t) fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).sleeping);
@@ -177,7 +169,7 @@ TEST(Sleeping, BallDroppedOnTheSleepingPileWakesItAndEverythingRestsSupported) {
 
 TEST(Sleeping, FastBallDoesNotTunnelThroughTheSleepingPile) {
   Pile pile = settledPile();
-  World& world = *pile.world;
+  World& world = pile.world;
   const EntityId ball_id = dropBall(pile, 40.0);  // 0.67 m a tick: its swept box reaches the pile
   double lowest = 1e9;
   std::size_t fewest_asleep = pile.spec.movers.size();
@@ -193,7 +185,7 @@ TEST(Sleeping, FastBallDoesNotTunnelThroughTheSleepingPile) {
 // A body spawned just above the pile's last mover, its box overlapping.
 void expectSpawnWakes(bool is_static) {
   Pile pile = settledPile();
-  World& world = *pile.world;
+  World& world = pile.world;
   const std::size_t top = indexOf(world, pile.spec.movers.back());
   EntitySpec spawn;
   spawn.shape = world.bodyShapes()[top];
@@ -210,7 +202,7 @@ TEST(Sleeping, StaticSpawnOverlappingTheSleepingPileWakesIt) { expectSpawnWakes(
 
 TEST(Sleeping, DespawnWakesItsIslandAndWhatItTouched) {
   Pile pile = settledPile();
-  World& world = *pile.world;
+  World& world = pile.world;
   // The lowest mover holds others up.
   EntityId lowest = pile.spec.movers.front();
   for (EntityId id : pile.spec.movers) {
@@ -226,7 +218,7 @@ TEST(Sleeping, DespawnWakesItsIslandAndWhatItTouched) {
 
 TEST(Sleeping, ChangeOfGravityWakesAllAndBadGravityChangesNothing) {
   Pile pile = settledPile();
-  World& world = *pile.world;
+  World& world = pile.world;
   EXPECT_THROW(world.setGravity(Vec3(0.0, 0.0, 1e9)), InputError);
   for (EntityId id : pile.spec.movers) EXPECT_TRUE(world.isSleeping(id));
   world.setGravity(Vec3(2.0, 0.0, -9.81));
@@ -240,7 +232,7 @@ TEST(Sleeping, ChangeOfGravityWakesAllAndBadGravityChangesNothing) {
 
 TEST(Sleeping, EditThroughBodiesAndWakeWakeTheIsland) {
   Pile pile = settledPile();
-  World& world = *pile.world;
+  World& world = pile.world;
   const EntityId id = pile.spec.movers.back();
   world.bodies()[indexOf(world, id)].linear_velocity = Vec3(0.0, 0.0, 2.0);
   world.step(kDt, Budget::unlimited());
@@ -249,9 +241,9 @@ TEST(Sleeping, EditThroughBodiesAndWakeWakeTheIsland) {
 
   Pile other = settledPile();
   const EntityId woken = other.spec.movers.front();
-  EXPECT_TRUE(other.world->wake(woken));
-  EXPECT_FALSE(other.world->isSleeping(woken));
-  EXPECT_FALSE(other.world->wake(kInvalidEntity));
+  EXPECT_TRUE(other.world.wake(woken));
+  EXPECT_FALSE(other.world.isSleeping(woken));
+  EXPECT_FALSE(other.world.wake(kInvalidEntity));
 }
 
 // Work a tick does, counted: pair tests set up, sphere tests run, contacts solved.
@@ -262,12 +254,9 @@ double workOf(const World& world, const TickReport& r) {
 TEST(Sleeping, RockPileSettlesSleepsWholeAndThenCostsAlmostNothing) {
   // 500 rocks down the ravine into one touching pile (issue 9: a settled pile
   // of 5,000 under 2 ms a tick; bench_settle measures that one).
-  WorldConfig config;
-  config.gravity = sceneGravity(SceneKind::Rockfall);
-  World world(config);
   SceneParams params;
   params.entities = 500;
-  const SceneSpec spec = populateScene(world, SceneKind::Rockfall, params);
+  auto [world, spec] = makeSceneWorld(SceneKind::Rockfall, params);
   constexpr int kHalfSecond = 30;
   std::vector<std::vector<Vec3>> recent(kHalfSecond);  // positions of the last half second of ticks
   double awake_work = 0.0;  // of the last tick before the whole pile slept
@@ -310,7 +299,7 @@ TEST(Sleeping, RockPileSettlesSleepsWholeAndThenCostsAlmostNothing) {
   // starts cold, without the impulses that held the pile: it sags a few
   // centimetres, as it did with the rest test by velocity; docs/sleeping.md)
   // and the pile falls asleep again.
-  world.setGravity(config.gravity);
+  world.setGravity(spec.gravity);
   for (int t = 0; t < kHalfSecond; ++t) world.step(kDt, Budget::unlimited());
   moved = 0.0;
   for (std::size_t i = 0; i < poses.size(); ++i) moved = std::max(moved, (world.bodies()[i].pose.position - poses[i].position).norm());
@@ -323,12 +312,9 @@ TEST(Sleeping, BigPileThatAFewRocksKeepAwakeSleepsAlmostWholeAndStaysPut) {
   // (bench_settle's restless count; docs/sleeping.md): the rested part of it
   // sleeps around them, a body alone, and a creeping rock wakes the sleepers
   // it reaches, so the count asleep goes up and down by a few per cent.
-  WorldConfig config;
-  config.gravity = sceneGravity(SceneKind::Rockfall);
-  World world(config);
   SceneParams params;
   params.entities = kBigPile;
-  const SceneSpec spec = populateScene(world, SceneKind::Rockfall, params);
+  auto [world, spec] = makeSceneWorld(SceneKind::Rockfall, params);
   const std::size_t most = spec.movers.size() * 95 / 100;
   std::size_t asleep = 0;
   for (int t = 0; t < 1500 && asleep < most; ++t) asleep = world.step(kDt, Budget::unlimited()).sleeping;  // 25 s
@@ -343,7 +329,7 @@ TEST(Sleeping, BigPileThatAFewRocksKeepAwakeSleepsAlmostWholeAndStaysPut) {
     at_sleep.push_back(world.bodies()[indexOf(world, id)].pose.position);
     was_asleep.push_back(world.isSleeping(id));
   }
-  const double energy = totalEnergy(world.bodies(), config.gravity, kDt);
+  const double energy = totalEnergy(world.bodies(), spec.gravity, kDt);
   std::size_t fewest_asleep = asleep;
   for (int t = 0; t < 60; ++t) fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).sleeping);
   EXPECT_GE(fewest_asleep, spec.movers.size() * 90 / 100);
@@ -357,7 +343,7 @@ TEST(Sleeping, BigPileThatAFewRocksKeepAwakeSleepsAlmostWholeAndStaysPut) {
   }
   EXPECT_LE(slipped, asleep / 100);
   EXPECT_LT(moved, params.entity_size / params.resolution);
-  EXPECT_LE(totalEnergy(world.bodies(), config.gravity, kDt), energy + 1e-6 * std::abs(energy));
+  EXPECT_LE(totalEnergy(world.bodies(), spec.gravity, kDt), energy + 1e-6 * std::abs(energy));
 }
 
 TEST(Sleeping, BadThresholdsAreRejectedNamingTheField) {

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <memory>
+#include <utility>
 
 namespace stc {
 namespace {
@@ -26,17 +27,19 @@ SecondsClock steppingClock(double step) {
   };
 }
 
+// corner_drift with 125 rocks, as built.
+SceneWorld corner125() {
+  SceneParams params;
+  params.entities = 125;
+  return makeSceneWorld(SceneKind::CornerDrift, params);
+}
+
 // corner_drift with 125 rocks after `ticks` full ticks: a pile in the corner.
 World pile(int ticks) {
-  WorldConfig config;
-  config.gravity = sceneGravity(SceneKind::CornerDrift);
-  World w(config);
+  World w = std::move(corner125().world);
   // The reserve the budgeted ticks start from is measured by these ticks: on
   // the real clock it would depend on the machine's load.
   w.setClock(steppingClock(1e-4));
-  SceneParams params;
-  params.entities = 125;
-  populateScene(w, SceneKind::CornerDrift, params);
   for (int i = 0; i < ticks; ++i) w.step(kDt, Budget::unlimited());
   return w;
 }
@@ -212,19 +215,14 @@ TEST(TickBudget, NarrowPhaseGetsWhatTheFixedPhasesAndTheReserveLeave) {
 TEST(TickBudget, SpentTickStillRespondsAndStaysFiniteAndInTheBox) {
   // The tick is over before the narrow phase starts: every pair is accepted
   // unresolved and the solver runs its mandatory pass, tick after tick.
-  WorldConfig config;
-  config.gravity = sceneGravity(SceneKind::CornerDrift);
-  World w(config);
-  SceneParams params;
-  params.entities = 125;
-  const SceneSpec spec = populateScene(w, SceneKind::CornerDrift, params);
+  auto [w, spec] = corner125();
   for (int i = 0; i < 240; ++i) {
     const TickReport r = w.step(kDt, Budget::ofTickSeconds(0.0));
     ASSERT_EQ(r.narrow_budget_s, 0.0);
     ASSERT_EQ(r.sphere_tests, 0);
     if (r.contacts > 0) ASSERT_EQ(r.velocity_passes, 1);
   }
-  const Vec3 margin = Vec3::Constant(0.5 * params.entity_size);
+  const Vec3 margin = Vec3::Constant(0.5 * SceneParams{}.entity_size);
   for (const EntityId id : spec.movers) {
     const BodyState& b = w.bodies()[*w.indexOf(id)];
     ASSERT_TRUE(finite(b));

@@ -1,25 +1,17 @@
 // VoxelShape: validation naming the field, surface voxels, presets, and exact
 // mass properties against closed forms.
+#include "thrown_field.hpp"
+
 #include "sphere_tree_collision/voxel_shape.hpp"
 
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
-#include <functional>
 #include <limits>
 
 namespace stc {
 namespace {
-
-std::string fieldOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.field();
-  }
-  return "<no error>";
-}
 
 std::vector<std::uint8_t> full(int nx, int ny, int nz) {
   return std::vector<std::uint8_t>(static_cast<std::size_t>(nx) * ny * nz, 1);
@@ -50,22 +42,22 @@ std::int64_t componentSize(const VoxelShape& s) {
 }
 
 TEST(VoxelShapeCreate, RejectsBadInputNamingTheField) {
-  EXPECT_EQ(fieldOf([] { VoxelShape::create(0, 2, 2, 0.1, {}); }), "dims");
-  EXPECT_EQ(fieldOf([] { VoxelShape::create(2, -1, 2, 0.1, {}); }), "dims");
-  EXPECT_EQ(fieldOf([] { VoxelShape::create(2, 2, 0, 0.1, {}); }), "dims");
+  EXPECT_EQ(thrownField([] { VoxelShape::create(0, 2, 2, 0.1, {}); }), "dims");
+  EXPECT_EQ(thrownField([] { VoxelShape::create(2, -1, 2, 0.1, {}); }), "dims");
+  EXPECT_EQ(thrownField([] { VoxelShape::create(2, 2, 0, 0.1, {}); }), "dims");
   for (double bad : {0.0, -0.1, std::nan(""), std::numeric_limits<double>::infinity(), 1e-9, 1e6}) {
-    EXPECT_EQ(fieldOf([&] { VoxelShape::create(2, 2, 2, bad, full(2, 2, 2)); }), "voxel_size") << bad;
+    EXPECT_EQ(thrownField([&] { VoxelShape::create(2, 2, 2, bad, full(2, 2, 2)); }), "voxel_size") << bad;
   }
-  EXPECT_EQ(fieldOf([] { VoxelShape::create(2, 2, 2, 0.1, full(2, 2, 1)); }), "occupancy");
-  EXPECT_EQ(fieldOf([] { VoxelShape::create(2, 2, 2, 0.1, std::vector<std::uint8_t>(8, 0)); }), "occupancy");
+  EXPECT_EQ(thrownField([] { VoxelShape::create(2, 2, 2, 0.1, full(2, 2, 1)); }), "occupancy");
+  EXPECT_EQ(thrownField([] { VoxelShape::create(2, 2, 2, 0.1, std::vector<std::uint8_t>(8, 0)); }), "occupancy");
   VoxelLimits small;
   small.max_voxels = 26;
-  EXPECT_EQ(fieldOf([&] { VoxelShape::create(3, 3, 3, 0.1, full(3, 3, 3), small); }), "max_voxels");
+  EXPECT_EQ(thrownField([&] { VoxelShape::create(3, 3, 3, 0.1, full(3, 3, 3), small); }), "max_voxels");
   // A product that overflows 64 bits must still be caught, not wrap around.
-  EXPECT_EQ(fieldOf([] { VoxelShape::create(2000000000, 2000000000, 2000000000, 0.1, {}); }), "max_voxels");
-  EXPECT_EQ(fieldOf([&] { VoxelShape::create(3, 3, 3, 0.1, full(3, 3, 3), small); }), "max_voxels");
+  EXPECT_EQ(thrownField([] { VoxelShape::create(2000000000, 2000000000, 2000000000, 0.1, {}); }), "max_voxels");
+  EXPECT_EQ(thrownField([&] { VoxelShape::create(3, 3, 3, 0.1, full(3, 3, 3), small); }), "max_voxels");
   small.max_voxels = 27;
-  EXPECT_EQ(fieldOf([&] { VoxelShape::create(3, 3, 3, 0.1, full(3, 3, 3), small); }), "<no error>");
+  EXPECT_EQ(thrownField([&] { VoxelShape::create(3, 3, 3, 0.1, full(3, 3, 3), small); }), "<no throw>");
 }
 
 TEST(VoxelShapeCreate, StoresGridAndCountsOccupancy) {
@@ -173,20 +165,20 @@ TEST(Presets, RockIsConnectedAndDeterministicPerSeed) {
 
 TEST(Presets, RejectBadParamsNamingTheField) {
   PresetParams p;
-  EXPECT_EQ(fieldOf([&] { makePreset("teapot", p); }), "preset");
+  EXPECT_EQ(thrownField([&] { makePreset("teapot", p); }), "preset");
   p.resolution = 0;
-  EXPECT_EQ(fieldOf([&] { makePreset("cube", p); }), "resolution");
+  EXPECT_EQ(thrownField([&] { makePreset("cube", p); }), "resolution");
   p.resolution = 257;
-  EXPECT_EQ(fieldOf([&] { makePreset("cube", p); }), "resolution");
+  EXPECT_EQ(thrownField([&] { makePreset("cube", p); }), "resolution");
   p.resolution = 2;
-  EXPECT_EQ(fieldOf([&] { makePreset("ring", p); }), "resolution");
+  EXPECT_EQ(thrownField([&] { makePreset("ring", p); }), "resolution");
   p.resolution = 8;
   p.voxel_size = -1.0;
-  EXPECT_EQ(fieldOf([&] { makePreset("rod", p); }), "voxel_size");
+  EXPECT_EQ(thrownField([&] { makePreset("rod", p); }), "voxel_size");
   p.voxel_size = 0.01;
   VoxelLimits limits;
   limits.max_voxels = 100;
-  EXPECT_EQ(fieldOf([&] { makePreset("cube", p, limits); }), "max_voxels");
+  EXPECT_EQ(thrownField([&] { makePreset("cube", p, limits); }), "max_voxels");
 }
 
 // Solid box of side lengths (x, y, z) and mass m: inertia about its centre.
@@ -267,7 +259,7 @@ TEST(MassProperties, LShapeComposesTwoBoxesByParallelAxis) {
 TEST(MassProperties, RejectsBadDensity) {
   const VoxelShape s = VoxelShape::create(1, 1, 1, 0.1, full(1, 1, 1));
   for (double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
-    EXPECT_EQ(fieldOf([&] { computeMassProperties(s, bad); }), "density") << bad;
+    EXPECT_EQ(thrownField([&] { computeMassProperties(s, bad); }), "density") << bad;
   }
 }
 
