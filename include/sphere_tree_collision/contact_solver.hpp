@@ -61,7 +61,8 @@ struct SolveBudget {
 // bodies out of penetration beyond the slop and are then discarded, so no
 // kinetic energy is added. Contacts' normal_impulse/friction_impulse are
 // filled in. The contacts of one body pair (its manifold: consecutive in the
-// array, as ContactBuilder emits them) are solved together. Warm starting
+// array, as ContactBuilder emits them) are solved together, and the manifolds
+// colour by colour (contact_colouring.hpp: any threads, the same bits). Warm starting
 // keeps each pair's manifold from tick to tick: a point takes the impulse of
 // last tick's point with the same feature id (Contact::node_a/node_b, the
 // leaf sphere pair it was built from), else of the nearest one in body A's
