@@ -27,6 +27,11 @@
 //               a bare NAME picks that scene's cases from the default list)
 //   --variants  Bullet shapes to run: compound,hull (default both; empty: none)
 //   --bullet-only  skip this package's run (to run the engines apart, in parallel)
+// Where the response's time goes (instruction counts, stable on a loaded machine;
+// docs/response.md, "Cost of the response"):
+//   valgrind --tool=callgrind --toggle-collect='stc::Physics::respond*'
+//     bench_bullet_compare --seconds 3 --scenes rockfall:1000 --variants ""
+//   (one command line; callgrind_annotate --inclusive=yes on its output file)
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"

@@ -73,7 +73,10 @@ double deepestOverlap(const std::vector<ContactCandidate>& candidates);
 // represent the pair, the others only join clusters.
 void refineDeepCandidates(std::vector<ContactCandidate>& candidates, double deepest, const PairGeometry& geometry,
                           bool face_normals);
-// 3. Up to `limit` (clamped to 1..16) representatives spread out among the
+// Most representatives a pair can have (ContactBuildOptions::max_contacts_per_pair).
+constexpr int kMaxRepresentatives = 16;
+
+// 3. Up to `limit` (clamped to 1..kMaxRepresentatives) representatives spread out among the
 // refined candidates: first the deepest (within 1e-3 times the smallest reach)
 // farthest from the centroid, then the farthest from it, then the largest
 // triangle, then the farthest from all picked; points closer than 1e-6 times the
@@ -82,14 +85,18 @@ void pickRepresentatives(const std::vector<ContactCandidate>& candidates, double
                          std::vector<int>& reps);
 // 4. Every candidate joins its nearest representative (cluster = position in reps).
 void assignClusters(std::vector<ContactCandidate>& candidates, const std::vector<int>& reps);
-// 5. A cluster's normal: the mean over its refined members with sphere
-// overlap within 10% of its deepest (the pairs straight across the contact);
-// `fallback` (the representative's) when that mean is zero or not finite.
-Vec3 clusterNormal(const std::vector<ContactCandidate>& candidates, int cluster, const Vec3& fallback);
-// ... and its separation along `normal`: the smallest gap of the members whose
-// own normal lies within about 18 degrees of it; `fallback` when none does.
-double clusterSeparation(const std::vector<ContactCandidate>& candidates, int cluster, const Vec3& normal,
-                         const PairGeometry& geometry, double fallback);
+// 5. Each cluster's normal (normals[r] for reps[r]): the mean over its
+// refined members with sphere overlap within 10% of its deepest (the pairs
+// straight across the contact); the representative's when that mean is zero
+// or not finite.
+void clusterNormals(const std::vector<ContactCandidate>& candidates, const std::vector<int>& reps,
+                    std::vector<Vec3>& normals);
+// ... and its separation along its normal: the smallest gap of the members
+// whose own normal lies within about 18 degrees of it; the representative's
+// when none does.
+void clusterSeparations(const std::vector<ContactCandidate>& candidates, const std::vector<int>& reps,
+                        const std::vector<Vec3>& normals, const PairGeometry& geometry,
+                        std::vector<double>& separations);
 
 // Builds the contacts of PairTests. Candidates are the test's lastPairs()
 // (leaf pairs when Colliding, the frontier when accepted Unresolved, the roots
@@ -116,7 +123,7 @@ class ContactBuilder {
   // bounds_a/bounds_b: of the test's trees, or nullptr (surface at the spheres).
   // The steps, in order: gatherCandidates, refineDeepCandidates,
   // pickRepresentatives, assignClusters, then one contact per cluster
-  // (clusterNormal, clusterSeparation).
+  // (clusterNormals, clusterSeparations).
   void append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b, double priority,
               const ShapeBounds* bounds_a, const ShapeBounds* bounds_b,
               const ContactBuildOptions& options, std::vector<Contact>& out);
@@ -124,6 +131,8 @@ class ContactBuilder {
  private:
   std::vector<ContactCandidate> candidates_;  // scratch kept between pairs: no allocation per tick
   std::vector<int> reps_;
+  std::vector<Vec3> normals_;
+  std::vector<double> separations_;
 };
 
 }  // namespace stc

@@ -29,6 +29,7 @@ class ContactColouring {
   // Colours the groups, given in the serial order, of bodies in
   // [0, body_count); no allocation once warm.
   void assign(const std::vector<ColourGroup>& groups, std::size_t body_count);
+  void reserve(std::size_t groups) { colour_.reserve(groups); }  // room for that many groups
   const std::vector<std::uint32_t>& colours() const { return colour_; }  // by group
   std::uint32_t colourCount() const { return colour_count_; }
 

@@ -28,12 +28,14 @@ void tangentBasis(const Vec3& n, Vec3& t1, Vec3& t2);
 struct SolveStats {
   std::size_t contacts = 0;
   std::size_t warm_started = 0;     // contacts that found last tick's impulse
+  std::size_t warm_by_feature = 0;  // ... of those, by the same feature id (leaf sphere pair)
+  std::size_t manifolds = 0;        // body pairs with contacts (rows of one pair are solved together)
   std::size_t bounced = 0;          // contacts that got a restitution impulse
   double max_penetration = 0.0;     // max(-separation) over the contacts, metres
   int velocity_passes = 0;          // velocity iterations run (>= 1 with contacts)
   int position_passes = 0;          // split-impulse iterations run (>= 1 with penetration)
   double refinement_seconds = 0.0;  // spent in the iterations a deadline may cut (set with one)
-  std::uint32_t colours = 0;        // colours of the contacts (contact_colouring.hpp): passes' sync points
+  std::uint32_t colours = 0;        // colours of the manifolds (contact_colouring.hpp): passes' sync points
 };
 
 // What the tick lets the solver spend: the response is refineable (paper 3.5
@@ -58,8 +60,13 @@ struct SolveBudget {
 // Position correction by split impulse: pseudo-velocities that move the
 // bodies out of penetration beyond the slop and are then discarded, so no
 // kinetic energy is added. Contacts' normal_impulse/friction_impulse are
-// filled in. Warm starting matches contacts by entity pair and the contact
-// point in body A's frame (within half the gap bound). Stopped early by the
+// filled in. The contacts of one body pair (its manifold: consecutive in the
+// array, as ContactBuilder emits them) are solved together, and the manifolds
+// colour by colour (contact_colouring.hpp: any threads, the same bits). Warm starting
+// keeps each pair's manifold from tick to tick: a point takes the impulse of
+// last tick's point with the same feature id (Contact::node_a/node_b, the
+// leaf sphere pair it was built from), else of the nearest one in body A's
+// frame within half the gap bound; each old point is used once. Stopped early by the
 // budget, the state is as consistent as after a full solve: normal impulses
 // >= 0, friction clamped to the cone as each pass goes, and velocities what
 // the impulses sum to (shock propagation aside: it holds supports still).
@@ -67,57 +74,94 @@ class ContactSolver {
  public:
   SolveStats solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
                    const ResponseOptions& options, double dt, const SolveBudget& budget = SolveBudget{});
-  void forget() { cache_.clear(); }  // drop warm-start impulses
-  // Threads of the velocity and position iterations (nullptr: the caller's
-  // alone); the result is the same whatever they are (contact_colouring.hpp).
+  void forget() {  // drop warm-start impulses
+    cache_.clear();
+    cache_manifolds_.clear();
+  }
+  // Threads of the velocity, shock and position iterations (nullptr: the
+  // caller's alone); the result is the same whatever they are
+  // (contact_colouring.hpp: a body pair's manifold is one group).
   void setWorkers(const Workers* workers) { workers_ = workers; }
 
- private:
-  // One contact's constraint rows: normal, two tangents.
+  // A body's velocities as the solver sees them: one cache line per body.
+  struct Motion {
+    Vec3 v = Vec3::Zero();
+    Vec3 w = Vec3::Zero();
+  };
+  // What the iterations read and write of one contact point: its normal and
+  // two tangent rows. Everything else about the contact is in RowInfo, so
+  // each pass streams only this.
   struct Row {
     std::uint32_t a = 0, b = 0;
-    std::uint32_t contact = 0;  // index into the contacts array
     Vec3 ra, rb;  // contact point relative to the centres of mass
     Vec3 n, t1, t2;
     // Angular velocity change per unit impulse along n, t1, t2 (I^-1 (r x d)).
     Vec3 ang_a[3], ang_b[3];
     double inv_ma = 0.0, inv_mb = 0.0;
     double mass[3] = {0.0, 0.0, 0.0};  // 1 / effective mass along n, t1, t2
-    double k_a[3] = {0.0, 0.0, 0.0};   // each body's part of the effective inverse mass
-    double k_b[3] = {0.0, 0.0, 0.0};
-    int level = 0;             // contact-graph distance of the lower body from a static one
-    std::uint8_t support = 0;  // 1: a supports b (a is nearer the ground), 2: b supports a, 0: neither
-    double friction = 0.0, restitution = 0.0;
-    double approach = 0.0;     // normal relative velocity before the solve (< 0: closing)
-    double speculative = 0.0;  // closing speed allowed by a gap: max(s, 0) / dt
-    double push = 0.0;         // split impulse: target normal pseudo-velocity
+    double friction = 0.0;
+    double speculative = 0.0;          // closing speed allowed by a gap: max(s, 0) / dt
     double lambda[3] = {0.0, 0.0, 0.0};
+    double bounce_impulse = 0.0;       // of all its restitution waves (before the solve)
+  };
+  // One sequential-impulse step of a row (friction, then non-penetration)
+  // on the velocities of its two bodies: the unit of work of a pass.
+  static void relax(Row& row, Motion& a, Motion& b);
+
+ private:
+  // The rest of a row: the restitution waves, shock propagation and the
+  // position pass read it; the velocity iterations do not.
+  struct RowInfo {
+    std::uint32_t contact = 0;  // index into the contacts array
+    int level = 0;              // contact-graph distance of the lower body from a static one
+    bool move_a = true, move_b = true;   // shock propagation holds the supporting body
+    double shock_mass[3] = {0.0, 0.0, 0.0};  // 1 / effective mass with the support held
+    double restitution = 0.0;
+    double approach = 0.0;     // normal relative velocity before the solve (< 0: closing)
+    double push = 0.0;         // split impulse: target normal pseudo-velocity
     double lambda_main = 0.0;  // normal impulse before restitution (what warm starts)
     double lambda_push = 0.0;
     double bounce_from = 0.0;  // normal velocity its bounce reverses (< 0), in its wave
     double lambda_wave = 0.0;  // impulse of the current restitution wave
-    double bounce_impulse = 0.0;  // of all its restitution waves (before the solve)
     int wave = -1;             // restitution wave it bounced in (-1: none)
     bool bounced = false;      // took a restitution impulse this tick
-    bool static_a = false, static_b = false;  // never moves: its velocity is not written
   };
-  struct Cached {
-    EntityId a = kInvalidEntity, b = kInvalidEntity;
-    Vec3 local_a = Vec3::Zero();  // contact point in body A's frame
+  // Last tick's manifold of a body pair: its points' impulses, by feature id
+  // (the leaf sphere pair a point was built from) and position in A's frame.
+  struct CachedPoint {
+    std::int32_t node_a = 0, node_b = 0;
+    Vec3 local_a = Vec3::Zero();
     double normal = 0.0;
     Vec3 friction = Vec3::Zero();  // world frame
   };
+  struct CachedManifold {
+    std::uint64_t pair = 0;              // entity ids a, b packed: the sort key
+    std::uint32_t first = 0, count = 0;  // its points in cache_
+  };
   void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
                const ResponseOptions& options, double dt, SolveStats& stats);
-  void orderFromTheGround(const std::vector<BodyState>& bodies);
+  void orderFromTheGround(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
+  int levelOf(const Contact& c) const;  // after orderFromTheGround: min of the bodies' depths
+  // After orderFromTheGround: order_ regrouped colour by colour, manifold by
+  // manifold; manifold_start_, manifolds_, the colours' and the shock
+  // levels' runs of manifolds (contact_solver_colours.cpp).
+  void colourManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
+  // manifolds(first, end) over every colour's manifolds in turn, a colour's
+  // manifolds split over the workers.
+  void forEachColour(RangeFn manifolds);
+  // Shock propagation's order: the levels from the ground (unreached rows
+  // aside), and a level's manifolds colour by colour, as forEachColour.
+  std::size_t shockLevels() const { return level_segment_start_.empty() ? 0 : level_segment_start_.size() - 1; }
+  void forEachColourOfLevel(std::size_t level, RangeFn manifolds);
+  void forEachManifoldRun(std::uint32_t first, std::uint32_t end, RangeFn manifolds) const;
+  // step(r, a, b) over the rows r of manifolds [first, end), a and b the
+  // pair's entries of `motion` copied in, then written back (a static body's
+  // never is: colours do not hold it apart).
+  template <typename Step>
+  void overManifolds(std::size_t first, std::size_t end, std::vector<Motion>& motion, Step&& step);
   void warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
                  SolveStats& stats);
-  void commitJacobi(std::vector<Vec3>& v, std::vector<Vec3>& w);
-  static void applyNormal(const Row& row, double impulse, std::vector<Vec3>& v, std::vector<Vec3>& w);
-  // Friction of one row from the velocities now, clamped to the cone of its
-  // normal impulse so far (incl. the bounce); adds to its lambdas and returns
-  // the change along t1, t2.
-  Eigen::Vector2d frictionStep(Row& row, double mass_t1, double mass_t2) const;
+  void commitJacobi(std::vector<Motion>& motion);
   void solveVelocities(const ResponseOptions& options, int passes);
   int affordableIterations(const ResponseOptions& options, int cap, double pass_seconds,
                            double seconds_left) const;
@@ -125,39 +169,33 @@ class ContactSolver {
   void collide(const ResponseOptions& options, SolveStats& stats);
   int solvePositions(const ResponseOptions& options, const Deadline& deadline);
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
-  // After orderFromTheGround: rows_ reordered by colour (contact_solver_colours.cpp).
-  void colourRows(std::size_t body_count);
-  // rows(begin, end) over every colour's rows in turn, a colour's body-pair
-  // groups split over the workers; each range holds whole groups.
-  void forEachColour(RangeFn rows);
-  // Shock propagation's order: the levels from the ground (unreached rows
-  // aside), and a level's rows colour by colour, as forEachColour.
-  std::size_t shockLevels() const { return level_segment_start_.empty() ? 0 : level_segment_start_.size() - 1; }
-  void forEachColourOfLevel(std::size_t level, RangeFn rows);
-  void forEachGroupRun(std::uint32_t first, std::uint32_t end, RangeFn rows) const;  // groups [first, end)
 
-  std::vector<Row> rows_, sorted_rows_;
-  std::vector<std::uint32_t> order_, level_start_;
-  std::vector<Vec3> v_, w_;    // solver velocities, one per body
-  std::vector<Vec3> dv_, dw_;  // Jacobi: impulses of one iteration, applied together
-  std::vector<Vec3> pv_, pw_;  // split-impulse pseudo-velocities
+  std::vector<Row> rows_;
+  std::vector<RowInfo> info_;
+  std::vector<std::uint32_t> manifold_start_;  // rows of one body pair: [start[m], start[m + 1])
+  std::vector<ColourGroup> manifolds_;         // each manifold's movable bodies (kStatic: static)
+  std::vector<std::uint32_t> order_, active_, level_start_, wave_rows_;
+  std::vector<Motion> motion_;  // solver velocities, one per body
+  std::vector<Motion> delta_;   // Jacobi: impulses of one iteration, applied together
+  std::vector<Motion> pseudo_;  // split-impulse pseudo-velocities
   std::vector<int> contact_count_;
   std::vector<int> depth_, adjacency_start_, fill_;  // contact graph, for the row order
   std::vector<std::uint32_t> adjacency_, queue_;
-  std::vector<Cached> cache_, next_cache_;
-  // Colouring (contact_solver_colours.cpp): the body-pair groups of the rows,
-  // their colours, and in colour order where each colour's groups and each
-  // group's rows start.
+  std::vector<CachedPoint> cache_, next_cache_;
+  std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // sorted by pair
+  // Colouring (contact_solver_colours.cpp): the manifolds in the order from
+  // the ground (groups_, each one's first place in order_), their colours,
+  // and in colour order where each colour's manifolds start.
   const Workers* workers_ = nullptr;
   ContactColouring colouring_;
   std::vector<ColourGroup> groups_;
-  std::vector<std::uint32_t> group_of_row_, colour_group_start_, group_row_start_, group_order_;
-  // Per level from the ground: its runs of groups, one per colour
+  std::vector<std::uint32_t> group_first_, group_order_, colour_order_, colour_manifold_start_;
+  // Per level from the ground: its runs of manifolds, one per colour
   // (positions in colour order); the levels' first runs.
-  struct GroupRun {
+  struct ManifoldRun {
     std::uint32_t first = 0, end = 0;
   };
-  std::vector<GroupRun> level_runs_;
+  std::vector<ManifoldRun> level_runs_;
   std::vector<std::uint32_t> level_segment_start_, cursor_;
   std::vector<int> levels_;
 };

@@ -165,7 +165,7 @@ void pickRepresentatives(const std::vector<ContactCandidate>& candidates, double
                          std::vector<int>& reps) {
   reps.clear();
   if (candidates.empty()) return;
-  limit = std::clamp(limit, 1, 16);
+  limit = std::clamp(limit, 1, kMaxRepresentatives);
   Vec3 centroid = Vec3::Zero();
   double scale = std::numeric_limits<double>::infinity();  // smallest reach: the length unit
   for (const ContactCandidate& c : candidates) {
@@ -235,31 +235,48 @@ void assignClusters(std::vector<ContactCandidate>& candidates, const std::vector
   }
 }
 
-Vec3 clusterNormal(const std::vector<ContactCandidate>& candidates, int cluster, const Vec3& fallback) {
+void clusterNormals(const std::vector<ContactCandidate>& candidates, const std::vector<int>& reps,
+                    std::vector<Vec3>& normals) {
   // A voxel resting on one floor voxel also touches the next one edge-on,
   // which says nothing about the direction of this contact.
-  double cluster_deepest = -std::numeric_limits<double>::infinity();
-  for (const ContactCandidate& c : candidates) {
-    if (c.cluster == cluster) cluster_deepest = std::max(cluster_deepest, c.overlap);
+  const std::size_t count = reps.size();
+  normals.resize(count);
+  if (count == 0) return;
+  double deepest[kMaxRepresentatives];
+  Vec3 sum[kMaxRepresentatives];
+  for (std::size_t r = 0; r < count; ++r) {
+    deepest[r] = -std::numeric_limits<double>::infinity();
+    sum[r].setZero();
   }
-  const double deep = cluster_deepest - kDeepBand * std::abs(cluster_deepest);
-  Vec3 sum = Vec3::Zero();
   for (const ContactCandidate& c : candidates) {
-    if (c.cluster != cluster || c.overlap < deep || !c.refined) continue;
-    sum += c.normal;
+    double& d = deepest[static_cast<std::size_t>(c.cluster)];
+    d = std::max(d, c.overlap);
   }
-  const double sum_norm = sum.norm();
-  return sum_norm > 0.0 && std::isfinite(sum_norm) ? Vec3(sum / sum_norm) : fallback;
+  for (const ContactCandidate& c : candidates) {
+    const std::size_t r = static_cast<std::size_t>(c.cluster);
+    if (!c.refined || c.overlap < deepest[r] - kDeepBand * std::abs(deepest[r])) continue;
+    sum[r] += c.normal;
+  }
+  for (std::size_t r = 0; r < count; ++r) {
+    const double sum_norm = sum[r].norm();
+    normals[r] = sum_norm > 0.0 && std::isfinite(sum_norm) ? Vec3(sum[r] / sum_norm)
+                                                            : candidates[static_cast<std::size_t>(reps[r])].normal;
+  }
 }
 
-double clusterSeparation(const std::vector<ContactCandidate>& candidates, int cluster, const Vec3& normal,
-                         const PairGeometry& geometry, double fallback) {
-  double separation = std::numeric_limits<double>::infinity();
+void clusterSeparations(const std::vector<ContactCandidate>& candidates, const std::vector<int>& reps,
+                        const std::vector<Vec3>& normals, const PairGeometry& geometry,
+                        std::vector<double>& separations) {
+  const std::size_t count = reps.size();
+  separations.assign(count, std::numeric_limits<double>::infinity());
   for (const ContactCandidate& c : candidates) {
-    if (c.cluster != cluster || c.normal.dot(normal) < kAlignedCosine) continue;
-    separation = std::min(separation, geometry.gapAlong(c, normal));
+    const std::size_t r = static_cast<std::size_t>(c.cluster);
+    if (c.normal.dot(normals[r]) < kAlignedCosine) continue;
+    separations[r] = std::min(separations[r], geometry.gapAlong(c, normals[r]));
   }
-  return std::isfinite(separation) ? separation : fallback;
+  for (std::size_t r = 0; r < count; ++r) {
+    if (!std::isfinite(separations[r])) separations[r] = candidates[static_cast<std::size_t>(reps[r])].separation;
+  }
 }
 
 void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b,
@@ -277,19 +294,23 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
   pickRepresentatives(candidates_, deepest, options.max_contacts_per_pair, reps_);
   assignClusters(candidates_, reps_);
 
+  clusterNormals(candidates_, reps_, normals_);
+  clusterSeparations(candidates_, reps_, normals_, geometry, separations_);
   for (std::size_t r = 0; r < reps_.size(); ++r) {
     const ContactCandidate& rep = candidates_[reps_[r]];
-    const int cluster = static_cast<int>(r);
-    const Vec3 normal = clusterNormal(candidates_, cluster, rep.normal);
     Contact contact;
     contact.a = test.bodyA().id;
     contact.b = test.bodyB().id;
     contact.index_a = index_a;
     contact.index_b = index_b;
     contact.point = rep.point;
-    contact.normal = normal;
+    contact.normal = normals_[r];
     contact.depth = std::max(0.0, rep.overlap);
-    contact.separation = clusterSeparation(candidates_, cluster, normal, geometry, rep.separation);
+    contact.separation = separations_[r];
+    // The pair's bound (its deepest sphere pair's h_a + h_b), the same for
+    // every point: the solver's slop is a fraction of it, and a slop that
+    // differs point by point let position correction lift a rolling link
+    // a little every tick (config/meshes.yaml's link rolled off the floor).
     contact.gap_bound = test.gapBound();
     contact.level = std::max(0, test.deepestLevel());
     contact.resolved = status == PairStatus::Colliding;

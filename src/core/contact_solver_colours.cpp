@@ -1,5 +1,6 @@
-// The solver's rows in colour order (contact_colouring.hpp) and the loop that
-// runs a pass over them colour by colour, each colour's groups in parallel.
+// The solver's manifolds in colour order (contact_colouring.hpp) and the loop
+// that runs a pass over them colour by colour, each colour's manifolds in
+// parallel.
 #include "sphere_tree_collision/contact_solver.hpp"
 
 #include <limits>
@@ -7,85 +8,105 @@
 namespace stc {
 namespace {
 
-// Body-pair groups a task of a colour takes at least (a row is ~50 ns a pass):
-// a smaller colour is solved on the calling thread.
-constexpr std::size_t kGroupsPerTask = 128;
+// Manifolds a task of a colour takes at least (a row is ~50 ns a pass, a
+// manifold 1 to 4 rows): a smaller colour is solved on the calling thread.
+constexpr std::size_t kManifoldsPerTask = 128;
 
 }  // namespace
 
-void ContactSolver::colourRows(std::size_t body_count) {
-  // Groups: runs of rows of one body pair (a pair's contacts are adjacent,
-  // and stay so in the order from the ground, which is stable).
+void ContactSolver::colourManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts) {
+  // Groups: the manifolds, runs of one body pair in order_ (a pair's contacts
+  // are adjacent, as ContactBuilder emits them, and stay so in the order from
+  // the ground, which is stable).
   groups_.clear();
-  group_of_row_.clear();  // here: each group's first row, in the order from the ground
-  levels_.clear();        // the levels met, in that order
-  for (std::size_t r = 0; r < rows_.size(); ++r) {
-    const Row& row = rows_[r];
-    if (levels_.empty() || levels_.back() != row.level) levels_.push_back(row.level);
-    if (r > 0 && row.a == rows_[r - 1].a && row.b == rows_[r - 1].b) continue;
+  group_first_.clear();
+  levels_.clear();  // the levels met, in that order
+  // Sized by the contacts, in the tick they grow (no allocation in a later
+  // tick with more manifolds or levels and no more contacts).
+  // (Colours are at most the manifolds, manifolds at most the contacts.)
+  for (std::vector<std::uint32_t>* v : {&group_first_, &group_order_, &colour_order_, &manifold_start_,
+                                        &colour_manifold_start_, &cursor_}) {
+    v->reserve(order_.size() + 1);
+  }
+  colouring_.reserve(order_.size());
+  groups_.reserve(order_.size());
+  manifolds_.reserve(order_.size());
+  levels_.reserve(order_.size());
+  level_runs_.reserve(order_.size());
+  level_segment_start_.reserve(order_.size() + 1);
+  for (std::size_t p = 0; p < order_.size(); ++p) {
+    const Contact& c = contacts[order_[p]];
+    const int level = levelOf(c);
+    if (levels_.empty() || levels_.back() != level) levels_.push_back(level);
+    if (p > 0) {
+      const Contact& previous = contacts[order_[p - 1]];
+      if (c.index_a == previous.index_a && c.index_b == previous.index_b) continue;
+    }
     ColourGroup group;
-    group.a = row.static_a ? ColourGroup::kStatic : row.a;
-    group.b = row.static_b ? ColourGroup::kStatic : row.b;
+    group.a = bodies[c.index_a].is_static ? ColourGroup::kStatic : c.index_a;
+    group.b = bodies[c.index_b].is_static ? ColourGroup::kStatic : c.index_b;
     groups_.push_back(group);
-    group_of_row_.push_back(static_cast<std::uint32_t>(r));
+    group_first_.push_back(static_cast<std::uint32_t>(p));
   }
-  group_of_row_.push_back(static_cast<std::uint32_t>(rows_.size()));
-  colouring_.assign(groups_, body_count);
+  group_first_.push_back(static_cast<std::uint32_t>(order_.size()));
+  colouring_.assign(groups_, bodies.size());
 
-  // Groups by colour, stable (counting sort), then their rows in that order.
+  // Manifolds by colour, stable (counting sort), then their contacts in that order.
   const std::vector<std::uint32_t>& colour = colouring_.colours();
-  colour_group_start_.assign(colouring_.colourCount() + 1, 0);
-  for (std::size_t g = 0; g < groups_.size(); ++g) ++colour_group_start_[colour[g] + 1];
-  for (std::size_t c = 1; c < colour_group_start_.size(); ++c) colour_group_start_[c] += colour_group_start_[c - 1];
-  group_order_.resize(groups_.size());
-  group_row_start_.assign(colour_group_start_.begin(), colour_group_start_.end() - 1);  // fill positions
-  for (std::uint32_t g = 0; g < groups_.size(); ++g) group_order_[group_row_start_[colour[g]]++] = g;
-  group_row_start_.resize(groups_.size() + 1);
-  sorted_rows_.clear();
-  for (std::size_t pos = 0; pos < group_order_.size(); ++pos) {
-    const std::uint32_t g = group_order_[pos];
-    group_row_start_[pos] = static_cast<std::uint32_t>(sorted_rows_.size());
-    for (std::uint32_t r = group_of_row_[g]; r < group_of_row_[g + 1]; ++r) sorted_rows_.push_back(rows_[r]);
+  colour_manifold_start_.assign(colouring_.colourCount() + 1, 0);
+  for (std::size_t g = 0; g < groups_.size(); ++g) ++colour_manifold_start_[colour[g] + 1];
+  for (std::size_t c = 1; c < colour_manifold_start_.size(); ++c) {
+    colour_manifold_start_[c] += colour_manifold_start_[c - 1];
   }
-  group_row_start_[groups_.size()] = static_cast<std::uint32_t>(sorted_rows_.size());
-  rows_.swap(sorted_rows_);
+  cursor_.assign(colour_manifold_start_.begin(), colour_manifold_start_.end() - 1);  // fill positions
+  group_order_.resize(groups_.size());
+  for (std::uint32_t g = 0; g < groups_.size(); ++g) group_order_[cursor_[colour[g]]++] = g;
+  colour_order_.clear();
+  manifold_start_.clear();
+  manifolds_.clear();
+  for (const std::uint32_t g : group_order_) {
+    manifold_start_.push_back(static_cast<std::uint32_t>(colour_order_.size()));
+    manifolds_.push_back(groups_[g]);
+    for (std::uint32_t p = group_first_[g]; p < group_first_[g + 1]; ++p) colour_order_.push_back(order_[p]);
+  }
+  manifold_start_.push_back(static_cast<std::uint32_t>(colour_order_.size()));
+  order_.swap(colour_order_);
 
-  // Shock propagation's runs: within a colour the groups are in the order
+  // Shock propagation's runs: within a colour the manifolds are in the order
   // from the ground, so each level takes the next run of every colour.
   // Restricted to one level, colour order still meets each body's rows in
   // the serial order: a level colour by colour gives the serial bits too.
   constexpr int kUnreached = std::numeric_limits<int>::max();
   level_runs_.clear();
   level_segment_start_.clear();
-  cursor_.assign(colour_group_start_.begin(), colour_group_start_.end() - 1);
+  cursor_.assign(colour_manifold_start_.begin(), colour_manifold_start_.end() - 1);
   for (const int level : levels_) {
     if (level == kUnreached) break;  // nothing static below: no shock to pass on
     level_segment_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
     for (std::size_t c = 0; c < cursor_.size(); ++c) {
       std::uint32_t end = cursor_[c];
-      while (end < colour_group_start_[c + 1] && rows_[group_row_start_[end]].level == level) ++end;
-      if (end > cursor_[c]) level_runs_.push_back(GroupRun{cursor_[c], end});
+      while (end < colour_manifold_start_[c + 1] && levelOf(contacts[order_[manifold_start_[end]]]) == level) ++end;
+      if (end > cursor_[c]) level_runs_.push_back(ManifoldRun{cursor_[c], end});
       cursor_[c] = end;
     }
   }
   if (!level_segment_start_.empty()) level_segment_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
 }
 
-void ContactSolver::forEachGroupRun(std::uint32_t first, std::uint32_t end, RangeFn rows) const {
-  forEachIndex(workers_, end - first, kGroupsPerTask, [&](std::size_t begin, std::size_t stop) {
-    rows(group_row_start_[first + begin], group_row_start_[first + stop]);
-  });
+void ContactSolver::forEachManifoldRun(std::uint32_t first, std::uint32_t end, RangeFn manifolds) const {
+  forEachIndex(workers_, end - first, kManifoldsPerTask,
+               [&](std::size_t begin, std::size_t stop) { manifolds(first + begin, first + stop); });
 }
 
-void ContactSolver::forEachColour(RangeFn rows) {
-  for (std::size_t c = 0; c + 1 < colour_group_start_.size(); ++c) {
-    forEachGroupRun(colour_group_start_[c], colour_group_start_[c + 1], rows);
+void ContactSolver::forEachColour(RangeFn manifolds) {
+  for (std::size_t c = 0; c + 1 < colour_manifold_start_.size(); ++c) {
+    forEachManifoldRun(colour_manifold_start_[c], colour_manifold_start_[c + 1], manifolds);
   }
 }
 
-void ContactSolver::forEachColourOfLevel(std::size_t level, RangeFn rows) {
+void ContactSolver::forEachColourOfLevel(std::size_t level, RangeFn manifolds) {
   for (std::uint32_t k = level_segment_start_[level]; k < level_segment_start_[level + 1]; ++k) {
-    forEachGroupRun(level_runs_[k].first, level_runs_[k].end, rows);
+    forEachManifoldRun(level_runs_[k].first, level_runs_[k].end, manifolds);
   }
 }
 

@@ -217,23 +217,35 @@ TEST(ContactSteps, ClusterNormalAveragesTheDeepestMembersOnly) {
                                            at(Vec3(0.0, 0.1, 0.0), 0.0095, Vec3::UnitX()),
                                            at(Vec3(0.0, 0.2, 0.0), 0.005, tilted),  // edge-on neighbour
                                            at(Vec3(0.0, 0.3, 0.0), 0.010, -Vec3::UnitX())};
-  cluster[3].cluster = 1;  // another cluster: never counted
-  EXPECT_EQ(clusterNormal(cluster, 0, Vec3::UnitZ()), Vec3::UnitX());
+  cluster[3].cluster = 1;  // another cluster: never counted in the first
+  const std::vector<int> reps = {0, 3};
+  std::vector<Vec3> normals;
+  clusterNormals(cluster, reps, normals);
+  ASSERT_EQ(normals.size(), 2u);
+  EXPECT_EQ(normals[0], Vec3::UnitX());
+  EXPECT_EQ(normals[1], -Vec3::UnitX());
 
   // The tilted member within the deep band: the mean of the two directions.
   cluster[2].overlap = 0.0095;
-  const Vec3 mean = clusterNormal(cluster, 0, Vec3::UnitZ());
+  clusterNormals(cluster, reps, normals);
+  const Vec3 mean = normals[0];
   EXPECT_NEAR(mean.norm(), 1.0, 1e-12);
   EXPECT_GT(mean.y(), 0.0);
   EXPECT_LT(mean.y(), tilted.y());
 
-  // Opposite normals cancel, unrefined members do not count: the fallback.
+  // Opposite normals cancel, unrefined members do not count: the
+  // representative's own normal.
   std::vector<ContactCandidate> opposed = {at(Vec3::Zero(), 0.01, Vec3::UnitX()),
-                                           at(Vec3::Zero(), 0.01, -Vec3::UnitX())};
-  EXPECT_EQ(clusterNormal(opposed, 0, Vec3::UnitZ()), Vec3::UnitZ());
-  opposed.pop_back();
+                                           at(Vec3::Zero(), 0.01, -Vec3::UnitX()),
+                                           at(Vec3::Zero(), 0.01, Vec3::UnitZ())};
+  opposed[2].refined = false;
+  clusterNormals(opposed, {2}, normals);
+  EXPECT_EQ(normals[0], Vec3::UnitZ());
   opposed[0].refined = false;
-  EXPECT_EQ(clusterNormal(opposed, 0, Vec3::UnitY()), Vec3::UnitY());
+  opposed[1].normal = Vec3::UnitY();
+  opposed[1].refined = false;
+  clusterNormals(opposed, {1}, normals);
+  EXPECT_EQ(normals[0], Vec3::UnitY());
 }
 
 TEST(ContactSteps, ClusterSeparationIsTheClosestAlignedMembersGap) {
@@ -243,8 +255,16 @@ TEST(ContactSteps, ClusterSeparationIsTheClosestAlignedMembersGap) {
   gatherCandidates(cubes.test, geometry, candidates);
   refineDeepCandidates(candidates, deepestOverlap(candidates), geometry, true);
   for (ContactCandidate& c : candidates) c.cluster = 0;
-  EXPECT_NEAR(clusterSeparation(candidates, 0, Vec3::UnitX(), geometry, 1.0), -0.01, 1e-12);
-  // No member's normal within about 18 degrees of the normal asked for: the fallback.
-  EXPECT_EQ(clusterSeparation(candidates, 0, Vec3::UnitZ(), geometry, 0.5), 0.5);
-  EXPECT_EQ(clusterSeparation(candidates, 1, Vec3::UnitX(), geometry, 0.25), 0.25);
+  candidates[0].separation = 0.5;
+  candidates[1].separation = 0.25;
+  const std::vector<int> reps = {0, 1};
+  std::vector<double> separations;
+  clusterSeparations(candidates, reps, {Vec3::UnitX(), Vec3::UnitX()}, geometry, separations);
+  ASSERT_EQ(separations.size(), 2u);
+  EXPECT_NEAR(separations[0], -0.01, 1e-12);
+  // A cluster without members: its representative's separation.
+  EXPECT_EQ(separations[1], 0.25);
+  // No member's normal within about 18 degrees of the normal asked for: the same.
+  clusterSeparations(candidates, reps, {Vec3::UnitZ(), Vec3::UnitX()}, geometry, separations);
+  EXPECT_EQ(separations[0], 0.5);
 }

@@ -134,7 +134,9 @@ TEST(Stability, NewtonsCradleKeepsItsEnergyAndMomentum) {
 TEST(Stability, ZeroDetectionBudgetStaysFiniteAndBounded) {
   WorldConfig probe;
   ASSERT_EQ(probe.unresolved_policy, UnresolvedPolicy::Accept);
-  Scene scene = cornerPile(125, 4, 4.0, Budget::ofSphereTests(0));
+  // 5 s: the pile has come to rest (at 4 s a rock may still be sliding down
+  // its side: 0.59 m/s with the manifold solver, 0.47 with the one before it).
+  Scene scene = cornerPile(125, 4, 5.0, Budget::ofSphereTests(0));
   const Metrics m = run(scene);
   // Root spheres stand in for the shapes: contacts repel at the roots' boxes,
 
