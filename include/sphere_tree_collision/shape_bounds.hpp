@@ -25,6 +25,7 @@ struct ShapeBounds {
   std::vector<Vec3> box_offset;  // per node: box centre minus sphere centre (body frame)
   std::vector<Vec3> box_half;    // per node: box half extents
   std::vector<double> reach;     // per node: max over its leaves of |c_leaf - c_node| + r_leaf
+  std::vector<double> thinnest;  // per node: least half extent of its leaves' boxes (sweeps)
   double min_leaf_radius = 0.0;
   double bound_radius = 0.0;     // max over leaves of |c_leaf| + r_leaf (about the body origin)
 

@@ -25,6 +25,11 @@ double firstTouch(const Vec3& d0, const Vec3& v, double reach, double t_max) {
   return t <= t_max ? t : -1.0;
 }
 
+// A node pair whose leaves close on each other by less than this share of the
+// thinnest box half extent below them holds no hit (Sweeper::run). Below the
+// exact 3/4, so rounding never drops a hit leafEntry would take.
+constexpr double kNoHitShare = 0.74;
+
 struct Sweeper {
   const ShapeBounds& first;   // the pair's bodies
   const ShapeBounds& second;
@@ -33,6 +38,8 @@ struct Sweeper {
   double best;            // earliest hit so far, fraction of the tick
   std::vector<std::pair<std::int32_t, std::int32_t>>& stack;
   bool anchor_first = true;  // the contact point is taken below the first body's leaf (else the second's)
+  double turn_first = 0.0;   // angle each body turns through this tick (rad)
+  double turn_second = 0.0;
   Mat3 relative_abs = (ro1.transpose() * r1).cwiseAbs();  // |cosines| between the end axes
   Vec3 normal = Vec3::UnitZ();  // of the earliest hit, from the first body towards the second
   Vec3 point = Vec3::Zero();
@@ -139,6 +146,17 @@ struct Sweeper {
       const Vec3 a1 = r1 * f.centre + x1;
       const Vec3 b0 = ro0 * o.centre + xo0;
       const Vec3 b1 = ro1 * o.centre + xo1;
+      const std::size_t fi = static_cast<std::size_t>(nf), oi = static_cast<std::size_t>(no);
+      // No leaf pair below moves far enough against the other to be a hit:
+      // leafEntry refuses a pair less than a quarter of the thinner box deep
+      // at the start, and takes one only deeper than the thinner box's half
+      // extent, so its box centres must close by more than 3/4 of it. A box
+      // centre moves at most its node's centre's motion plus turn x reach.
+      // (A pile's resting neighbours: their node pairs overlap from the
+      // start and would otherwise be opened down to every touching leaf.)
+      const double closing = ((a1 - a0) - (b1 - b0)).norm() + turn_first * first.reach[fi] +
+                             turn_second * second.reach[oi];
+      if (closing < kNoHitShare * std::min(first.thinnest[fi], second.thinnest[oi])) continue;
       const bool f_leaf = f.child_count == 0;
       const bool o_leaf = o.child_count == 0;
       if (f_leaf && o_leaf) {
@@ -153,11 +171,10 @@ struct Sweeper {
         }
         continue;
       }
-      const double bound = first.reach[static_cast<std::size_t>(nf)] + second.reach[static_cast<std::size_t>(no)];
+      const double bound = first.reach[fi] + second.reach[oi];
       if (firstTouch(a0 - b0, (a1 - b1) - (a0 - b0), bound, best) < 0.0) continue;
       // Open the node with the larger reach (a leaf cannot be opened).
-      const bool open_first = !f_leaf && (o_leaf || first.reach[static_cast<std::size_t>(nf)] >=
-                                                       second.reach[static_cast<std::size_t>(no)]);
+      const bool open_first = !f_leaf && (o_leaf || first.reach[fi] >= second.reach[oi]);
       if (open_first) {
         for (std::int32_t c = f.first_child; c < f.first_child + f.child_count; ++c) stack.emplace_back(c, no);
       } else {
@@ -222,9 +239,10 @@ void sweepPairs(const SweepInput& in, std::size_t begin, std::size_t end, SweepL
     const Pose& q1 = in.bodies[b].pose;
     // Bodies falling side by side are fast but not towards each other: the
     // pair is swept only when its relative motion is fast.
+    const double turn_a = p0.orientation.angularDistance(p1.orientation);
+    const double turn_b = q0.orientation.angularDistance(q1.orientation);
     const double relative = ((p1.position - p0.position) - (q1.position - q0.position)).norm() +
-                            p0.orientation.angularDistance(p1.orientation) * sa->bound_radius +
-                            q0.orientation.angularDistance(q1.orientation) * sb->bound_radius;
+                            turn_a * sa->bound_radius + turn_b * sb->bound_radius;
     const double finest = std::min(fast[a] ? sa->min_leaf_radius : sb->min_leaf_radius,
                                    fast[b] ? sb->min_leaf_radius : sa->min_leaf_radius);
     if (!(relative > in.threshold * finest)) continue;
@@ -234,6 +252,8 @@ void sweepPairs(const SweepInput& in, std::size_t begin, std::size_t end, SweepL
               q0.orientation.toRotationMatrix(), q1.orientation.toRotationMatrix(),
               p0.position, p1.position, q0.position, q1.position, latest, lane.stack};
     s.anchor_first = fast[a] != 0;
+    s.turn_first = turn_a;
+    s.turn_second = turn_b;
     ++lane.stats.pairs;
     const bool found = s.run();
     lane.stats.leaf_tests += s.leaf_tests;

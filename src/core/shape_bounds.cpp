@@ -15,6 +15,7 @@ ShapeBounds makeShapeBounds(const SphereTree& tree, const VoxelShape* voxels, co
   bounds.box_offset.assign(count, Vec3::Zero());
   bounds.box_half.resize(count);
   bounds.reach.assign(count, 0.0);
+  bounds.thinnest.assign(count, 0.0);
   bounds.min_leaf_radius = std::numeric_limits<double>::infinity();
 
   for (std::size_t n = 0; n < count; ++n) {
@@ -56,14 +57,18 @@ ShapeBounds makeShapeBounds(const SphereTree& tree, const VoxelShape* voxels, co
       bounds.reach[i] = std::max(n.radius, bounds.box_offset[i].norm() + bounds.box_half[i].norm());
       bounds.min_leaf_radius = std::min(bounds.min_leaf_radius, n.radius);
       bounds.bound_radius = std::max(bounds.bound_radius, n.centre.norm() + bounds.reach[i]);
+      bounds.thinnest[i] = bounds.box_half[i].minCoeff();
       continue;
     }
     double reach = 0.0;
+    double thinnest = std::numeric_limits<double>::infinity();
     for (std::int32_t c = n.first_child; c < n.first_child + n.child_count; ++c) {
       const std::size_t ci = static_cast<std::size_t>(c);
       reach = std::max(reach, (nodes[ci].centre - n.centre).norm() + bounds.reach[ci]);
+      thinnest = std::min(thinnest, bounds.thinnest[ci]);
     }
     bounds.reach[i] = reach;
+    bounds.thinnest[i] = thinnest;
   }
   if (!std::isfinite(bounds.min_leaf_radius)) bounds.min_leaf_radius = 0.0;
   return bounds;
