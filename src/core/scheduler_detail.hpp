@@ -118,7 +118,17 @@ class PriorityQueueScheduler final : public Scheduler {
               const Perception& perception);
   double perCost(double f, int cost) const;
   int binOf(double priority) const;
-  int binAfterStep(const PairTest& test, float scale) const;
+  // How a stepped pair is binned (scheduler_priority_queues.cpp): by the
+  // exponent (the defaults), by the edges (other options), not at all (queue 0).
+  struct ExponentBin;
+  struct EdgeBin;
+  struct StayBin;
+  template <typename BinAfterStep>
+  void serveQueues(PairTest* tests, BudgetTracker& budget, ScheduleStats& stats, SampledClock& requeue,
+                   BinAfterStep binAfterStep);
+  template <typename BinAfterStep>
+  bool servePass(int q, PairTest* tests, BudgetTracker& budget, ScheduleStats& stats,
+                 BinAfterStep binAfterStep);
 
   // A queued pair and its weight x pixels per metre: with the gap estimate and
   // next-step cost the PairTest keeps, all a re-measure needs.

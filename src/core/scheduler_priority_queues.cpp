@@ -53,10 +53,6 @@ namespace {
 // A queue holds pairs in no memory order, so the hardware does not see the
 // next PairTest coming: ask for it a few steps ahead (a step reads most of it).
 constexpr std::size_t kPrefetchAhead = 4;
-inline void prefetch(const PairTest& test) {
-  const char* p = reinterpret_cast<const char*>(&test);
-  for (std::size_t offset = 0; offset < sizeof(PairTest); offset += 64) __builtin_prefetch(p + offset);
-}
 
 }  // namespace
 
@@ -106,24 +102,40 @@ inline int PriorityQueueScheduler::binOf(double priority) const {
   return q;
 }
 
-// The bin of a stepped pair: g x weight x pixels per metre, per cost. With
-// bins a factor 2 apart and the priority per sphere test (the defaults) this
-// is floor(log2(y / c)) of y = g x scale / fmax, found without dividing: the
-// exponents' difference, less one when y's mantissa is below c's.
-inline int PriorityQueueScheduler::binAfterStep(const PairTest& test, float scale) const {
-  const double y = test.frontierGap() * scale;
-  const int cost = test.nextStepTests();
-  if (!binary_bins_ || cost_exponent_ != 1.0) return binOf(perCost(y, cost));
-  const double x = y * inverse_reference_;
-  if (!(x > 0.0)) return 0;
-  const double c = static_cast<double>(cost);
-  std::uint64_t xb, cb;
-  std::memcpy(&xb, &x, sizeof xb);
-  std::memcpy(&cb, &c, sizeof cb);
-  constexpr std::uint64_t kMantissa = (std::uint64_t{1} << 52) - 1;
-  const int exponent = static_cast<int>(xb >> 52) - static_cast<int>(cb >> 52) - ((xb & kMantissa) < (cb & kMantissa));
-  return std::clamp(queue_count_ + exponent, 0, queue_count_ - 1);
-}
+// The bin of a stepped pair with bins a factor 2 apart and the priority per
+// sphere test (the defaults): floor(log2(y / c)) of y = g x scale / fmax,
+// found without dividing: the exponents' difference, less one when y's
+// mantissa is below c's. Its constants are copied in, so they stay in
+// registers across the steps (a step could write to the scheduler, for all
+// the compiler knows).
+struct PriorityQueueScheduler::ExponentBin {
+  double inverse_reference;
+  int queue_count;
+  int operator()(const PairTest& test, float scale) const {
+    const double x = test.frontierGap() * scale * inverse_reference;
+    if (!(x > 0.0)) return 0;
+    const double c = static_cast<double>(test.nextStepTests());
+    std::uint64_t xb, cb;
+    std::memcpy(&xb, &x, sizeof xb);
+    std::memcpy(&cb, &c, sizeof cb);
+    constexpr std::uint64_t kMantissa = (std::uint64_t{1} << 52) - 1;
+    const int exponent = static_cast<int>(xb >> 52) - static_cast<int>(cb >> 52) - ((xb & kMantissa) < (cb & kMantissa));
+    return std::clamp(queue_count + exponent, 0, queue_count - 1);
+  }
+};
+
+// Any other ratio or cost exponent: the priority, then its bin.
+struct PriorityQueueScheduler::EdgeBin {
+  const PriorityQueueScheduler* scheduler;
+  int operator()(const PairTest& test, float scale) const {
+    return scheduler->binOf(scheduler->perCost(test.frontierGap() * scale, test.nextStepTests()));
+  }
+};
+
+// Queue 0 is not re-measured.
+struct PriorityQueueScheduler::StayBin {
+  int operator()(const PairTest& /*test*/, float /*scale*/) const { return 0; }
+};
 
 void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
                                     const PairBodies& bodies, const Perception& perception) {
@@ -138,6 +150,7 @@ void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
   for (std::size_t i = 0; i < count; ++i) {
     priorities_[i] = -1.0;  // resolved: not queued
     if (tests[i].resolved()) continue;
+    tests[i].trackFrontierGap();  // its steps keep g for the re-measure
     const BodyGaze& a = gazeOf(bodies.of_pair[i][0], tests[i].bodyA(), perception);
     const BodyGaze& b = gazeOf(bodies.of_pair[i][1], tests[i].bodyB(), perception);
     const double weight = a.root_weight * b.root_weight;
@@ -190,48 +203,73 @@ ScheduleStats PriorityQueueScheduler::run(PairTest* tests, std::size_t count,
   }
   overhead.stop();
 
+  if (!stats.used_perception) {  // every pair in queue 0
+    serveQueues(tests, budget, stats, requeue, StayBin{});
+  } else if (binary_bins_ && cost_exponent_ == 1.0) {
+    serveQueues(tests, budget, stats, requeue, ExponentBin{inverse_reference_, queue_count_});
+  } else {
+    serveQueues(tests, budget, stats, requeue, EdgeBin{this});
+  }
+  stats.overhead_seconds = overhead.seconds() + requeue.seconds();
+  return stats;
+}
+
+// The highest non-empty queue, one pass over it, until all are empty or the
+// budget ends.
+template <typename BinAfterStep>
+void PriorityQueueScheduler::serveQueues(PairTest* tests, BudgetTracker& budget, ScheduleStats& stats,
+                                         SampledClock& requeue, BinAfterStep binAfterStep) {
   requeue.start();  // choosing the next queue is decision work too
   for (;;) {
     int q = queue_count_ - 1;
     while (q >= 0 && sizes_[static_cast<std::size_t>(q)] == 0) --q;
     requeue.stop();
-    if (q < 0) break;  // everything resolved
-    Queued* queue = slots_.data() + static_cast<std::size_t>(q) * stride_;
-    // One round-robin pass. A pair still unresolved is re-measured as soon as
-    // it is stepped (its gap estimate and next cost are in cache then): it
-    // stays, in order, compacted in place, or goes to the back of its new
-    // queue, which is not served before this pass ends. Queue 0 is not
-    // re-measured. No branch on the outcome (it is a coin toss to predict):
-    // the entry is written both at the compaction point and at the end of
-    // its new queue, and only one of the two counts. Writing past this
-    // queue's end is what the spare slot is for, and the compaction point is
-    // never ahead of the pass.
-    const bool remeasure = stats.used_perception && q > 0;
-    const std::size_t size = sizes_[static_cast<std::size_t>(q)];
-    std::size_t kept = 0;
-    for (std::size_t r = 0; r < size; ++r) {
-      if (r + kPrefetchAhead < size) prefetch(tests[queue[r + kPrefetchAhead].pair]);
-      const Queued entry = queue[r];
-      PairTest& test = tests[entry.pair];
-      if (remeasure) test.trackFrontierGap();  // its next step keeps g for the re-measure
-      if (!budgetedStep(test, budget, stats)) {
-        stats.interrupted = true;
-        break;
-      }
-      if (test.resolved()) continue;
-      const int moved = remeasure ? binAfterStep(test, entry.scale) : q;
-      const bool stays = moved == q;
-      queue[kept] = entry;
-      kept += stays;
-      slotEnd(moved) = entry;
-      sizes_[static_cast<std::size_t>(moved)] += !stays;
+    if (q < 0) return;  // everything resolved
+    const bool finished = q > 0 ? servePass(q, tests, budget, stats, binAfterStep)
+                                : servePass(q, tests, budget, stats, StayBin{});
+    if (!finished) {
+      stats.interrupted = true;
+      return;
     }
-    if (stats.interrupted) break;
-    sizes_[static_cast<std::size_t>(q)] = kept;
     requeue.start();
   }
-  stats.overhead_seconds = overhead.seconds() + requeue.seconds();
-  return stats;
+}
+
+// One round-robin pass over queue q; false when the budget ended it. A pair
+// still unresolved is re-measured as soon as it is stepped (its gap estimate
+// and next cost are in cache then): it stays, in order, compacted in place,
+// or goes to the back of its new queue, which is not served before this pass
+// ends. No branch on the outcome (it is a coin toss to predict): the entry is
+// written both at the compaction point and at the end of its new queue, and
+// only one of the two counts. Writing past this queue's end is what the spare
+// slot is for, and the compaction point is never ahead of the pass. The
+// queues' storage is held in locals: a step could write to the scheduler, for
+// all the compiler knows, so members would be read again after each.
+template <typename BinAfterStep>
+bool PriorityQueueScheduler::servePass(int q, PairTest* tests, BudgetTracker& budget, ScheduleStats& stats,
+                                       BinAfterStep binAfterStep) {
+  Queued* const slots = slots_.data();
+  std::size_t* const sizes = sizes_.data();
+  const std::size_t stride = stride_;
+  const auto qi = static_cast<std::size_t>(q);
+  Queued* const queue = slots + qi * stride;
+  const std::size_t size = sizes[qi];
+  std::size_t kept = 0;
+  for (std::size_t r = 0; r < size; ++r) {
+    if (r + kPrefetchAhead < size) tests[queue[r + kPrefetchAhead].pair].prefetchForStep();
+    const Queued entry = queue[r];
+    PairTest& test = tests[entry.pair];
+    if (!budgetedStep(test, budget, stats)) return false;
+    if (test.resolved()) continue;
+    const auto moved = static_cast<std::size_t>(binAfterStep(test, entry.scale));
+    const bool stays = moved == qi;
+    queue[kept] = entry;
+    kept += stays;
+    slots[moved * stride + sizes[moved]] = entry;
+    sizes[moved] += !stays;
+  }
+  sizes[qi] = kept;
+  return true;
 }
 
 }  // namespace stc::detail
