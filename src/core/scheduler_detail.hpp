@@ -137,6 +137,7 @@ class PriorityQueueScheduler final : public Scheduler {
     float scale = 0.0f;
   };
 
+  static constexpr std::size_t kMaxQueues = 64;  // validateSchedulerOptions
   int queue_count_;
   double log_ratio_;
   double cost_exponent_;

@@ -44,6 +44,7 @@
 #include "scheduler_detail.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -112,8 +113,8 @@ struct PriorityQueueScheduler::ExponentBin {
   double inverse_reference;
   int queue_count;
   int operator()(const PairTest& test, float scale) const {
+    // g >= 0: x = 0 has exponent bits 0 and lands in queue 0 by the clamp.
     const double x = test.frontierGap() * scale * inverse_reference;
-    if (!(x > 0.0)) return 0;
     const double c = static_cast<double>(test.nextStepTests());
     std::uint64_t xb, cb;
     std::memcpy(&xb, &x, sizeof xb);
@@ -243,33 +244,40 @@ void PriorityQueueScheduler::serveQueues(PairTest* tests, BudgetTracker& budget,
 // written both at the compaction point and at the end of its new queue, and
 // only one of the two counts. Writing past this queue's end is what the spare
 // slot is for, and the compaction point is never ahead of the pass. The
-// queues' storage is held in locals: a step could write to the scheduler, for
+// queues' ends are held in locals: a step could write to the scheduler, for
 // all the compiler knows, so members would be read again after each.
 template <typename BinAfterStep>
 bool PriorityQueueScheduler::servePass(int q, PairTest* tests, BudgetTracker& budget, ScheduleStats& stats,
                                        BinAfterStep binAfterStep) {
-  Queued* const slots = slots_.data();
-  std::size_t* const sizes = sizes_.data();
-  const std::size_t stride = stride_;
+  // Each queue's end, as a pointer: a mover is one store and one add.
+  std::array<Queued*, kMaxQueues> ends;
+  for (std::size_t k = 0; k < sizes_.size(); ++k) ends[k] = slots_.data() + k * stride_ + sizes_[k];
   const auto qi = static_cast<std::size_t>(q);
-  Queued* const queue = slots + qi * stride;
-  const std::size_t size = sizes[qi];
+  Queued* const queue = slots_.data() + qi * stride_;
+  const std::size_t size = sizes_[qi];
   std::size_t kept = 0;
+  bool finished = true;
   for (std::size_t r = 0; r < size; ++r) {
     if (r + kPrefetchAhead < size) tests[queue[r + kPrefetchAhead].pair].prefetchForStep();
     const Queued entry = queue[r];
     PairTest& test = tests[entry.pair];
-    if (!budgetedStep(test, budget, stats)) return false;
+    if (!budgetedStep(test, budget, stats)) {
+      finished = false;
+      break;
+    }
     if (test.resolved()) continue;
     const auto moved = static_cast<std::size_t>(binAfterStep(test, entry.scale));
     const bool stays = moved == qi;
     queue[kept] = entry;
     kept += stays;
-    slots[moved * stride + sizes[moved]] = entry;
-    sizes[moved] += !stays;
+    *ends[moved] = entry;
+    ends[moved] += !stays;
   }
-  sizes[qi] = kept;
-  return true;
+  for (std::size_t k = 0; k < sizes_.size(); ++k) {
+    sizes_[k] = static_cast<std::size_t>(ends[k] - (slots_.data() + k * stride_));
+  }
+  sizes_[qi] = kept;
+  return finished;
 }
 
 }  // namespace stc::detail
