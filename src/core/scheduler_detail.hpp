@@ -146,6 +146,11 @@ class PriorityQueueScheduler final : public Scheduler {
   std::vector<Queued> slots_;
   std::vector<std::size_t> sizes_;
   std::size_t stride_ = 0;
+  // Each queue's end as a pointer, for a loop that appends (held in a local,
+  // it stays in registers); setEnds() turns them back into sizes.
+  using QueueEnds = std::array<Queued*, kMaxQueues>;
+  QueueEnds queueEnds();
+  void setEnds(const QueueEnds& ends);
   Queued& slotEnd(int q) {
     const auto qi = static_cast<std::size_t>(q);
     return slots_[qi * stride_ + sizes_[qi]];

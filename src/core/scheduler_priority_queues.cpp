@@ -138,6 +138,18 @@ struct PriorityQueueScheduler::StayBin {
   int operator()(const PairTest& /*test*/, float /*scale*/) const { return 0; }
 };
 
+PriorityQueueScheduler::QueueEnds PriorityQueueScheduler::queueEnds() {
+  QueueEnds ends{};
+  for (std::size_t k = 0; k < sizes_.size(); ++k) ends[k] = slots_.data() + k * stride_ + sizes_[k];
+  return ends;
+}
+
+void PriorityQueueScheduler::setEnds(const QueueEnds& ends) {
+  for (std::size_t k = 0; k < sizes_.size(); ++k) {
+    sizes_[k] = static_cast<std::size_t>(ends[k] - (slots_.data() + k * stride_));
+  }
+}
+
 void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
                                     const PairBodies& bodies, const Perception& perception) {
   if (gaze_.size() < bodies.body_count) gaze_.resize(bodies.body_count);
@@ -147,18 +159,23 @@ void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
   }
   priorities_.resize(count);
   scale_.resize(count);
+  // Storage in locals: the projection of a body is an opaque call, after
+  // which members would be read again.
+  double* const priority = priorities_.data();
+  float* const scale = scale_.data();
   double reference = 0.0;
   for (std::size_t i = 0; i < count; ++i) {
-    priorities_[i] = -1.0;  // resolved: not queued
+    priority[i] = -1.0;  // resolved: not queued
     if (tests[i].resolved()) continue;
     tests[i].trackFrontierGap();  // its steps keep g for the re-measure
     const BodyGaze& a = gazeOf(bodies.of_pair[i][0], tests[i].bodyA(), perception);
     const BodyGaze& b = gazeOf(bodies.of_pair[i][1], tests[i].bodyB(), perception);
     const double weight = a.root_weight * b.root_weight;
-    scale_[i] = static_cast<float>(a.root_scale * b.root_scale);
+    scale[i] = static_cast<float>(a.root_scale * b.root_scale);
     // Before any step: g = the projected distance of the entity origins, c = 1.
-    priorities_[i] = weight == 0.0 ? 0.0 : weight * (a.pixel - b.pixel).norm();
-    reference = std::max(reference, priorities_[i]);
+    const double f = weight == 0.0 ? 0.0 : weight * (a.pixel - b.pixel).norm();
+    priority[i] = f;
+    reference = std::max(reference, f);
   }
   // Queue q >= 1 holds f >= fmax / r^(K - q).
   inverse_reference_ = reference > 0.0 ? 1.0 / reference : 0.0;
@@ -166,16 +183,17 @@ void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
   for (int q = 1; q < queue_count_; ++q) {
     lower_edge_[static_cast<std::size_t>(q)] = reference * std::exp(-(queue_count_ - q) * log_ratio_);
   }
+  QueueEnds ends = queueEnds();
   for (std::size_t i = 0; i < count; ++i) {
-    if (priorities_[i] < 0.0) continue;
+    if (priority[i] < 0.0) continue;
     // Field by field: a Queued built on the stack and copied whole stalls on
     // store forwarding (two 4-byte writes read back as one 8-byte load).
-    const int q = binOf(priorities_[i]);
-    Queued& entry = slotEnd(q);
-    entry.pair = static_cast<std::uint32_t>(i);
-    entry.scale = scale_[i];
-    ++sizes_[static_cast<std::size_t>(q)];
+    Queued*& end = ends[static_cast<std::size_t>(binOf(priority[i]))];
+    end->pair = static_cast<std::uint32_t>(i);
+    end->scale = scale[i];
+    ++end;
   }
+  setEnds(ends);
 }
 
 ScheduleStats PriorityQueueScheduler::run(PairTest* tests, std::size_t count,
@@ -249,9 +267,7 @@ void PriorityQueueScheduler::serveQueues(PairTest* tests, BudgetTracker& budget,
 template <typename BinAfterStep>
 bool PriorityQueueScheduler::servePass(int q, PairTest* tests, BudgetTracker& budget, ScheduleStats& stats,
                                        BinAfterStep binAfterStep) {
-  // Each queue's end, as a pointer: a mover is one store and one add.
-  std::array<Queued*, kMaxQueues> ends;
-  for (std::size_t k = 0; k < sizes_.size(); ++k) ends[k] = slots_.data() + k * stride_ + sizes_[k];
+  QueueEnds ends = queueEnds();  // a mover is one store and one add
   const auto qi = static_cast<std::size_t>(q);
   Queued* const queue = slots_.data() + qi * stride_;
   const std::size_t size = sizes_[qi];
@@ -273,9 +289,7 @@ bool PriorityQueueScheduler::servePass(int q, PairTest* tests, BudgetTracker& bu
     *ends[moved] = entry;
     ends[moved] += !stays;
   }
-  for (std::size_t k = 0; k < sizes_.size(); ++k) {
-    sizes_[k] = static_cast<std::size_t>(ends[k] - (slots_.data() + k * stride_));
-  }
+  setEnds(ends);
   sizes_[qi] = kept;
   return finished;
 }
