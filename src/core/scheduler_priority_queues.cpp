@@ -24,10 +24,12 @@
 //   an intersecting sphere pair (the frontier's first), times the pair's
 //   pixels per metre (queued beside its index), and c the exact tests of the
 //   next step: both kept by the PairTest as it steps. The re-measure
-//   is done right after the step, while the PairTest is in cache: a
-//   multiply, a divide and the bin, which for the default ratio 2 is the
-//   exponent of f / fmax (O(1); other ratios: K - 1 branch-free comparisons
-//   with the bin edges). No projection after the start.
+//   is done right after the step, while the PairTest is in cache: two
+//   multiplies and the bin, which for the defaults is read off the exponents
+//   of g x scale / fmax and of c, with no divide (O(1); other options: the
+//   priority, then K - 1 branch-free comparisons with the bin edges). No
+//   projection after the start. A pass is compiled per bin rule, so nothing
+//   is decided per step but the bin.
 //   (Measured against the reach r_a + r_b of that pair, which this used
 //   before: the centre distance also tells a deep overlap, likely a real
 //   contact whose gap is 0, from a shallow one, and left 5-15 % less true P
