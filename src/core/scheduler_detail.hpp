@@ -118,7 +118,17 @@ class PriorityQueueScheduler final : public Scheduler {
               const Perception& perception);
   double perCost(double f, int cost) const;
   int binOf(double priority) const;
-  int binAfterStep(const PairTest& test, float scale) const;
+  // How a stepped pair is binned (scheduler_priority_queues.cpp): by the
+  // exponent (the defaults), by the edges (other options), not at all (queue 0).
+  struct ExponentBin;
+  struct EdgeBin;
+  struct StayBin;
+  template <typename BinAfterStep>
+  void serveQueues(PairTest* tests, BudgetTracker& budget, ScheduleStats& stats, SampledClock& requeue,
+                   BinAfterStep binAfterStep);
+  template <typename BinAfterStep>
+  bool servePass(int q, PairTest* tests, BudgetTracker& budget, ScheduleStats& stats,
+                 BinAfterStep binAfterStep);
 
   // A queued pair and its weight x pixels per metre: with the gap estimate and
   // next-step cost the PairTest keeps, all a re-measure needs.
@@ -127,6 +137,7 @@ class PriorityQueueScheduler final : public Scheduler {
     float scale = 0.0f;
   };
 
+  static constexpr std::size_t kMaxQueues = 64;  // validateSchedulerOptions
   int queue_count_;
   double log_ratio_;
   double cost_exponent_;
@@ -135,6 +146,11 @@ class PriorityQueueScheduler final : public Scheduler {
   std::vector<Queued> slots_;
   std::vector<std::size_t> sizes_;
   std::size_t stride_ = 0;
+  // Each queue's end as a pointer, for a loop that appends (held in a local,
+  // it stays in registers); setEnds() turns them back into sizes.
+  using QueueEnds = std::array<Queued*, kMaxQueues>;
+  QueueEnds queueEnds();
+  void setEnds(const QueueEnds& ends);
   Queued& slotEnd(int q) {
     const auto qi = static_cast<std::size_t>(q);
     return slots_[qi * stride_ + sizes_[qi]];

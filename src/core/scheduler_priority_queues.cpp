@@ -24,10 +24,12 @@
 //   an intersecting sphere pair (the frontier's first), times the pair's
 //   pixels per metre (queued beside its index), and c the exact tests of the
 //   next step: both kept by the PairTest as it steps. The re-measure
-//   is done right after the step, while the PairTest is in cache: a
-//   multiply, a divide and the bin, which for the default ratio 2 is the
-//   exponent of f / fmax (O(1); other ratios: K - 1 branch-free comparisons
-//   with the bin edges). No projection after the start.
+//   is done right after the step, while the PairTest is in cache: two
+//   multiplies and the bin, which for the defaults is read off the exponents
+//   of g x scale / fmax and of c, with no divide (O(1); other options: the
+//   priority, then K - 1 branch-free comparisons with the bin edges). No
+//   projection after the start. A pass is compiled per bin rule, so nothing
+//   is decided per step but the bin.
 //   (Measured against the reach r_a + r_b of that pair, which this used
 //   before: the centre distance also tells a deep overlap, likely a real
 //   contact whose gap is 0, from a shallow one, and left 5-15 % less true P
@@ -44,6 +46,7 @@
 #include "scheduler_detail.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -53,10 +56,6 @@ namespace {
 // A queue holds pairs in no memory order, so the hardware does not see the
 // next PairTest coming: ask for it a few steps ahead (a step reads most of it).
 constexpr std::size_t kPrefetchAhead = 4;
-inline void prefetch(const PairTest& test) {
-  const char* p = reinterpret_cast<const char*>(&test);
-  for (std::size_t offset = 0; offset < sizeof(PairTest); offset += 64) __builtin_prefetch(p + offset);
-}
 
 }  // namespace
 
@@ -106,23 +105,51 @@ inline int PriorityQueueScheduler::binOf(double priority) const {
   return q;
 }
 
-// The bin of a stepped pair: g x weight x pixels per metre, per cost. With
-// bins a factor 2 apart and the priority per sphere test (the defaults) this
-// is floor(log2(y / c)) of y = g x scale / fmax, found without dividing: the
-// exponents' difference, less one when y's mantissa is below c's.
-inline int PriorityQueueScheduler::binAfterStep(const PairTest& test, float scale) const {
-  const double y = test.frontierGap() * scale;
-  const int cost = test.nextStepTests();
-  if (!binary_bins_ || cost_exponent_ != 1.0) return binOf(perCost(y, cost));
-  const double x = y * inverse_reference_;
-  if (!(x > 0.0)) return 0;
-  const double c = static_cast<double>(cost);
-  std::uint64_t xb, cb;
-  std::memcpy(&xb, &x, sizeof xb);
-  std::memcpy(&cb, &c, sizeof cb);
-  constexpr std::uint64_t kMantissa = (std::uint64_t{1} << 52) - 1;
-  const int exponent = static_cast<int>(xb >> 52) - static_cast<int>(cb >> 52) - ((xb & kMantissa) < (cb & kMantissa));
-  return std::clamp(queue_count_ + exponent, 0, queue_count_ - 1);
+// The bin of a stepped pair with bins a factor 2 apart and the priority per
+// sphere test (the defaults): floor(log2(y / c)) of y = g x scale / fmax,
+// found without dividing: the exponents' difference, less one when y's
+// mantissa is below c's. Its constants are copied in, so they stay in
+// registers across the steps (a step could write to the scheduler, for all
+// the compiler knows).
+struct PriorityQueueScheduler::ExponentBin {
+  double inverse_reference;
+  int queue_count;
+  int operator()(const PairTest& test, float scale) const {
+    // g >= 0: x = 0 has exponent bits 0 and lands in queue 0 by the clamp.
+    const double x = test.frontierGap() * scale * inverse_reference;
+    const double c = static_cast<double>(test.nextStepTests());
+    std::uint64_t xb, cb;
+    std::memcpy(&xb, &x, sizeof xb);
+    std::memcpy(&cb, &c, sizeof cb);
+    constexpr std::uint64_t kMantissa = (std::uint64_t{1} << 52) - 1;
+    const int exponent = static_cast<int>(xb >> 52) - static_cast<int>(cb >> 52) - ((xb & kMantissa) < (cb & kMantissa));
+    return std::clamp(queue_count + exponent, 0, queue_count - 1);
+  }
+};
+
+// Any other ratio or cost exponent: the priority, then its bin.
+struct PriorityQueueScheduler::EdgeBin {
+  const PriorityQueueScheduler* scheduler;
+  int operator()(const PairTest& test, float scale) const {
+    return scheduler->binOf(scheduler->perCost(test.frontierGap() * scale, test.nextStepTests()));
+  }
+};
+
+// Queue 0 is not re-measured.
+struct PriorityQueueScheduler::StayBin {
+  int operator()(const PairTest& /*test*/, float /*scale*/) const { return 0; }
+};
+
+PriorityQueueScheduler::QueueEnds PriorityQueueScheduler::queueEnds() {
+  QueueEnds ends{};
+  for (std::size_t k = 0; k < sizes_.size(); ++k) ends[k] = slots_.data() + k * stride_ + sizes_[k];
+  return ends;
+}
+
+void PriorityQueueScheduler::setEnds(const QueueEnds& ends) {
+  for (std::size_t k = 0; k < sizes_.size(); ++k) {
+    sizes_[k] = static_cast<std::size_t>(ends[k] - (slots_.data() + k * stride_));
+  }
 }
 
 void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
@@ -134,17 +161,23 @@ void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
   }
   priorities_.resize(count);
   scale_.resize(count);
+  // Storage in locals: the projection of a body is an opaque call, after
+  // which members would be read again.
+  double* const priority = priorities_.data();
+  float* const scale = scale_.data();
   double reference = 0.0;
   for (std::size_t i = 0; i < count; ++i) {
-    priorities_[i] = -1.0;  // resolved: not queued
+    priority[i] = -1.0;  // resolved: not queued
     if (tests[i].resolved()) continue;
+    tests[i].trackFrontierGap();  // its steps keep g for the re-measure
     const BodyGaze& a = gazeOf(bodies.of_pair[i][0], tests[i].bodyA(), perception);
     const BodyGaze& b = gazeOf(bodies.of_pair[i][1], tests[i].bodyB(), perception);
     const double weight = a.root_weight * b.root_weight;
-    scale_[i] = static_cast<float>(a.root_scale * b.root_scale);
+    scale[i] = static_cast<float>(a.root_scale * b.root_scale);
     // Before any step: g = the projected distance of the entity origins, c = 1.
-    priorities_[i] = weight == 0.0 ? 0.0 : weight * (a.pixel - b.pixel).norm();
-    reference = std::max(reference, priorities_[i]);
+    const double f = weight == 0.0 ? 0.0 : weight * (a.pixel - b.pixel).norm();
+    priority[i] = f;
+    reference = std::max(reference, f);
   }
   // Queue q >= 1 holds f >= fmax / r^(K - q).
   inverse_reference_ = reference > 0.0 ? 1.0 / reference : 0.0;
@@ -152,16 +185,17 @@ void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
   for (int q = 1; q < queue_count_; ++q) {
     lower_edge_[static_cast<std::size_t>(q)] = reference * std::exp(-(queue_count_ - q) * log_ratio_);
   }
+  QueueEnds ends = queueEnds();
   for (std::size_t i = 0; i < count; ++i) {
-    if (priorities_[i] < 0.0) continue;
+    if (priority[i] < 0.0) continue;
     // Field by field: a Queued built on the stack and copied whole stalls on
     // store forwarding (two 4-byte writes read back as one 8-byte load).
-    const int q = binOf(priorities_[i]);
-    Queued& entry = slotEnd(q);
-    entry.pair = static_cast<std::uint32_t>(i);
-    entry.scale = scale_[i];
-    ++sizes_[static_cast<std::size_t>(q)];
+    Queued*& end = ends[static_cast<std::size_t>(binOf(priority[i]))];
+    end->pair = static_cast<std::uint32_t>(i);
+    end->scale = scale[i];
+    ++end;
   }
+  setEnds(ends);
 }
 
 ScheduleStats PriorityQueueScheduler::run(PairTest* tests, std::size_t count,
@@ -190,48 +224,76 @@ ScheduleStats PriorityQueueScheduler::run(PairTest* tests, std::size_t count,
   }
   overhead.stop();
 
+  if (!stats.used_perception) {  // every pair in queue 0
+    serveQueues(tests, budget, stats, requeue, StayBin{});
+  } else if (binary_bins_ && cost_exponent_ == 1.0) {
+    serveQueues(tests, budget, stats, requeue, ExponentBin{inverse_reference_, queue_count_});
+  } else {
+    serveQueues(tests, budget, stats, requeue, EdgeBin{this});
+  }
+  stats.overhead_seconds = overhead.seconds() + requeue.seconds();
+  return stats;
+}
+
+// The highest non-empty queue, one pass over it, until all are empty or the
+// budget ends.
+template <typename BinAfterStep>
+void PriorityQueueScheduler::serveQueues(PairTest* tests, BudgetTracker& budget, ScheduleStats& stats,
+                                         SampledClock& requeue, BinAfterStep binAfterStep) {
   requeue.start();  // choosing the next queue is decision work too
   for (;;) {
     int q = queue_count_ - 1;
     while (q >= 0 && sizes_[static_cast<std::size_t>(q)] == 0) --q;
     requeue.stop();
-    if (q < 0) break;  // everything resolved
-    Queued* queue = slots_.data() + static_cast<std::size_t>(q) * stride_;
-    // One round-robin pass. A pair still unresolved is re-measured as soon as
-    // it is stepped (its gap estimate and next cost are in cache then): it
-    // stays, in order, compacted in place, or goes to the back of its new
-    // queue, which is not served before this pass ends. Queue 0 is not
-    // re-measured. No branch on the outcome (it is a coin toss to predict):
-    // the entry is written both at the compaction point and at the end of
-    // its new queue, and only one of the two counts. Writing past this
-    // queue's end is what the spare slot is for, and the compaction point is
-    // never ahead of the pass.
-    const bool remeasure = stats.used_perception && q > 0;
-    const std::size_t size = sizes_[static_cast<std::size_t>(q)];
-    std::size_t kept = 0;
-    for (std::size_t r = 0; r < size; ++r) {
-      if (r + kPrefetchAhead < size) prefetch(tests[queue[r + kPrefetchAhead].pair]);
-      const Queued entry = queue[r];
-      PairTest& test = tests[entry.pair];
-      if (remeasure) test.trackFrontierGap();  // its next step keeps g for the re-measure
-      if (!budgetedStep(test, budget, stats)) {
-        stats.interrupted = true;
-        break;
-      }
-      if (test.resolved()) continue;
-      const int moved = remeasure ? binAfterStep(test, entry.scale) : q;
-      const bool stays = moved == q;
-      queue[kept] = entry;
-      kept += stays;
-      slotEnd(moved) = entry;
-      sizes_[static_cast<std::size_t>(moved)] += !stays;
+    if (q < 0) return;  // everything resolved
+    const bool finished = q > 0 ? servePass(q, tests, budget, stats, binAfterStep)
+                                : servePass(q, tests, budget, stats, StayBin{});
+    if (!finished) {
+      stats.interrupted = true;
+      return;
     }
-    if (stats.interrupted) break;
-    sizes_[static_cast<std::size_t>(q)] = kept;
     requeue.start();
   }
-  stats.overhead_seconds = overhead.seconds() + requeue.seconds();
-  return stats;
+}
+
+// One round-robin pass over queue q; false when the budget ended it. A pair
+// still unresolved is re-measured as soon as it is stepped (its gap estimate
+// and next cost are in cache then): it stays, in order, compacted in place,
+// or goes to the back of its new queue, which is not served before this pass
+// ends. No branch on the outcome (it is a coin toss to predict): the entry is
+// written both at the compaction point and at the end of its new queue, and
+// only one of the two counts. Writing past this queue's end is what the spare
+// slot is for, and the compaction point is never ahead of the pass. The
+// queues' ends are held in locals: a step could write to the scheduler, for
+// all the compiler knows, so members would be read again after each.
+template <typename BinAfterStep>
+bool PriorityQueueScheduler::servePass(int q, PairTest* tests, BudgetTracker& budget, ScheduleStats& stats,
+                                       BinAfterStep binAfterStep) {
+  QueueEnds ends = queueEnds();  // a mover is one store and one add
+  const auto qi = static_cast<std::size_t>(q);
+  Queued* const queue = slots_.data() + qi * stride_;
+  const std::size_t size = sizes_[qi];
+  std::size_t kept = 0;
+  bool finished = true;
+  for (std::size_t r = 0; r < size; ++r) {
+    if (r + kPrefetchAhead < size) tests[queue[r + kPrefetchAhead].pair].prefetchForStep();
+    const Queued entry = queue[r];
+    PairTest& test = tests[entry.pair];
+    if (!budgetedStep(test, budget, stats)) {
+      finished = false;
+      break;
+    }
+    if (test.resolved()) continue;
+    const auto moved = static_cast<std::size_t>(binAfterStep(test, entry.scale));
+    const bool stays = moved == qi;
+    queue[kept] = entry;
+    kept += stays;
+    *ends[moved] = entry;
+    ends[moved] += !stays;
+  }
+  setEnds(ends);
+  sizes_[qi] = kept;
+  return finished;
 }
 
 }  // namespace stc::detail
