@@ -14,6 +14,7 @@
 #include "sphere_tree_collision/types.hpp"
 #include "sphere_tree_collision/workers.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -80,8 +81,13 @@ class ContactSolver {
   }
   // Threads of the velocity, shock and position iterations (nullptr: the
   // caller's alone); the result is the same whatever they are
-  // (contact_colouring.hpp: a body pair's manifold is one group).
-  void setWorkers(const Workers* workers) { workers_ = workers; }
+  // (contact_colouring.hpp: a body pair's manifold is one group). A colour
+  // of fewer than `task_manifolds` manifolds is solved on the calling thread
+  // (ResponseOptions::solver_task_manifolds).
+  void setWorkers(const Workers* workers, std::size_t task_manifolds) {
+    workers_ = workers;
+    task_manifolds_ = std::max<std::size_t>(1, task_manifolds);
+  }
 
   // A body's velocities as the solver sees them: one cache line per body.
   struct Motion {
@@ -187,6 +193,7 @@ class ContactSolver {
   // the ground (groups_, each one's first place in order_), their colours,
   // and in colour order where each colour's manifolds start.
   const Workers* workers_ = nullptr;
+  std::size_t task_manifolds_ = 1;  // read only with workers_
   ContactColouring colouring_;
   std::vector<ColourGroup> groups_;
   std::vector<std::uint32_t> group_first_, group_order_, colour_order_, colour_manifold_start_;

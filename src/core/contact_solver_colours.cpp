@@ -6,13 +6,6 @@
 #include <limits>
 
 namespace stc {
-namespace {
-
-// Manifolds a task of a colour takes at least (a row is ~50 ns a pass, a
-// manifold 1 to 4 rows): a smaller colour is solved on the calling thread.
-constexpr std::size_t kManifoldsPerTask = 128;
-
-}  // namespace
 
 void ContactSolver::colourManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts) {
   // Groups: the manifolds, runs of one body pair in order_ (a pair's contacts
@@ -94,7 +87,7 @@ void ContactSolver::colourManifolds(const std::vector<BodyState>& bodies, const 
 }
 
 void ContactSolver::forEachManifoldRun(std::uint32_t first, std::uint32_t end, RangeFn manifolds) const {
-  forEachIndex(workers_, end - first, kManifoldsPerTask,
+  forEachIndex(workers_, end - first, task_manifolds_,
                [&](std::size_t begin, std::size_t stop) { manifolds(first + begin, first + stop); });
 }
 

@@ -127,7 +127,7 @@ void Physics::respond(const StepContext& step) {
   if (!options.enabled) return;
   ResponseOptions solve = options;
   solve.restitution_threshold = std::max(options.restitution_threshold, kRestingFallTicks * gravity_speed_);
-  solver_.setWorkers(step.workers);
+  solver_.setWorkers(step.workers, static_cast<std::size_t>(options.solver_task_manifolds));
   report_.solve = solver_.solve(*step.bodies, contacts, solve, step.dt, step.budget);
 }
 

@@ -33,6 +33,9 @@ void validateResponseOptions(const ResponseOptions& o) {
   if (o.max_contacts_per_pair < 1 || o.max_contacts_per_pair > 16) {
     throw InputError("response.max_contacts_per_pair", "must be in [1, 16]");
   }
+  if (o.solver_task_manifolds < 1) {
+    throw InputError("response.solver_task_manifolds", "must be >= 1");
+  }
   if (!(o.sweep_threshold > 0.0 && std::isfinite(o.sweep_threshold))) {
     throw InputError("response.sweep_threshold", "must be finite and > 0");
   }

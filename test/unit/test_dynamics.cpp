@@ -1,5 +1,7 @@
 // Integration, contact building, impulse solver and swept test, each on flat
 // arrays of BodyState / Contact without a World.
+#include "thrown_field.hpp"
+
 #include "sphere_tree_collision/dynamics.hpp"
 #include "sphere_tree_collision/response.hpp"
 
@@ -250,6 +252,9 @@ TEST(Response, OptionsAndSolverNamesAreValidatedByField) {
   o = ResponseOptions{};
   o.position_correction = 1.5;
   EXPECT_THROW(validateResponseOptions(o), InputError);
+  o = ResponseOptions{};
+  o.solver_task_manifolds = 0;
+  EXPECT_EQ(thrownField([&] { validateResponseOptions(o); }), "response.solver_task_manifolds");
   Vec3 t1, t2;
   for (const Vec3& n : {Vec3(Vec3::UnitX()), Vec3(Vec3::UnitZ()), Vec3(Vec3(1, 2, 3).normalized())}) {
     tangentBasis(n, t1, t2);

@@ -32,6 +32,9 @@ World sceneWorld(SceneKind kind, WorldConfig config) {
 World sceneWorld(SceneKind kind, int threads) {
   WorldConfig config;
   config.threads = threads;
+  // Solver colours split into tasks from a few manifolds up: at 100 bodies
+  // the default (512) would leave every colour on the calling thread.
+  config.response.solver_task_manifolds = 4;
   return sceneWorld(kind, config);
 }
 
