@@ -7,24 +7,12 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
-#include <memory>
-
 namespace stc_bench {
 
-struct SceneSim {
-  std::unique_ptr<stc::World> world;
-  stc::SceneSpec spec;
-};
-
-inline SceneSim makeSceneSim(stc::SceneKind kind, const stc::SceneParams& params = stc::SceneParams{}) {
+inline stc::SceneWorld makeSceneSim(stc::SceneKind kind, const stc::SceneParams& params = stc::SceneParams{}) {
   stc::WorldConfig config;
-  config.gravity = stc::sceneGravity(kind);
   config.scheduler.kind = stc::SchedulerKind::RoundRobin;
-  SceneSim sim;
-  sim.world = std::make_unique<stc::World>(config);
-  sim.spec = stc::populateScene(*sim.world, kind, params);
-  sim.world->perception().setCamera(sim.spec.camera);
-  return sim;
+  return stc::makeSceneWorld(kind, params, config);
 }
 
 }  // namespace stc_bench

@@ -74,8 +74,8 @@ int main(int argc, char** argv) {
     else return args.unknown();
   }
   const SceneKind kind = parseScene(scene);
-  stc_bench::SceneSim scene_sim = stc_bench::makeSceneSim(kind);
-  World& sim = *scene_sim.world;
+  SceneWorld scene_sim = stc_bench::makeSceneSim(kind);
+  World& sim = scene_sim.world;
   const SceneSpec& spec = scene_sim.spec;
   const WorldConfig config = sim.config();
   const int warmup = kind == SceneKind::Rockfall ? 80 : 36;
