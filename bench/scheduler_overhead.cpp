@@ -20,7 +20,7 @@
 // it; run() less step() is the scheduler's own work.
 //
 // Usage: bench_scheduler_overhead [--scene packed_box|rockfall] [--scheduler NAME|all] [--ticks N]
-//          [--no-retry]
+//          [--no-retry] [--queues K --ratio R --cost-exponent A]
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
@@ -64,6 +64,7 @@ __attribute__((noinline)) TickTimes measureTicks(World& world, int ticks, double
 int main(int argc, char** argv) {
   std::string scene = "packed_box", only = "all";
   int ticks = 60;
+  SchedulerOptions queues;  // priority queues' options (defaults)
   double retry_s = 20e-6;
   for (stc_bench::Args args(argc, argv); args.more();) {
     const std::string& a = args.flag();
@@ -71,6 +72,9 @@ int main(int argc, char** argv) {
     else if (a == "--scheduler") only = args.value();
     else if (a == "--ticks") ticks = std::stoi(args.value());
     else if (a == "--no-retry") retry_s = 1e9;
+    else if (a == "--queues") queues.queue_count = std::stoi(args.value());
+    else if (a == "--ratio") queues.queue_ratio = std::stod(args.value());
+    else if (a == "--cost-exponent") queues.cost_exponent = std::stod(args.value());
     else return args.unknown();
   }
   const SceneKind kind = parseScene(scene);
@@ -94,6 +98,7 @@ int main(int argc, char** argv) {
     WorldConfig eval_config = config;
     eval_config.response.enabled = false;
     eval_config.unresolved_policy = UnresolvedPolicy::Accept;
+    eval_config.scheduler = queues;
     eval_config.scheduler.kind = parseScheduler(name);
     World eval(eval_config);
     populateScene(eval, kind);
