@@ -93,13 +93,10 @@ class PairTest {
   std::int64_t sphereTests() const { return sphere_tests_; }
   // What the next step() will cost, known from the last one: its sphere
   // tests (1 after reset; 0 once resolved). And, once asked for with
-  // trackFrontierGap() (until the next reset), the paper's gap estimate g
-  // (the distance of the centres) of the sphere pair the last step descended
-  // from: the roots after the first step, else the frontier's first pair as
-  // it was before the step (0 before any step). The step has that pair's
-  // target centre in the other body's frame already, so g costs no rotation;
-  // it is one level coarser than the frontier's own, which ranks pairs as
-  // well (docs/error_vs_runtime.md). A scheduler's priority needs no more.
+  // trackFrontierGap() (until the next reset), the distance of the centres of
+  // the frontier's first sphere pair, the paper's gap estimate g for it, made
+  // by each step while its spheres are in cache (0 before). A scheduler's
+  // priority needs no more.
   int nextStepTests() const { return next_tests_; }
   void trackFrontierGap() { track_gap_ = true; }
   double frontierGap() const { return frontier_gap_; }
@@ -140,8 +137,6 @@ class PairTest {
  private:
   const PairArena& arena() const { return shared_arena_ ? *shared_arena_ : own_arena_; }
   PairArena& arena() { return shared_arena_ ? *shared_arena_ : own_arena_; }
-  template <bool kTrackGap>
-  int descend();  // step(), keeping the frontier gap or not
 
   // What step() and a scheduler read come first, in as few cache lines as
   // they fit (prefetchForStep() asks for them); the rest after best_last_.

@@ -98,15 +98,7 @@ void PairTest::reset(const PairBody& a, const PairBody& b, PairArena* arena) {
   sphere_tests_ = 0;
 }
 
-int PairTest::step() { return track_gap_ ? descend<true>() : descend<false>(); }
-
-// kTrackGap: the frontier gap. A step already takes the target centre of each
-// hit into the other body's frame; the first hit's target and the parent of
-// its test list are the frontier's first pair before the step, so their
-// distance costs a subtraction and a norm, no rotation (the frontier the
-// step makes would need one of its own).
-template <bool kTrackGap>
-int PairTest::descend() {
+int PairTest::step() {
   if (resolved()) return 0;
 
   // Distances do not change under a rigid motion, so each target centre is
@@ -138,9 +130,8 @@ int PairTest::descend() {
   std::size_t hit_count = 0, leaf_pairs = 0;
   int tests = 0;
 
-  // Tests hit h and returns its target's centre in the other body's frame.
-  // Inlined at both calls: it is the whole of a step's work.
-  auto testHit = [&](std::size_t h) __attribute__((always_inline)) {
+  for (std::size_t h = hits_begin_; h < hits_begin_ + hits_count_; ++h) {
+    if (first_contact_only_ && leaf_pairs > 0) break;  // the answer is known
     const SphereHit& hit = hits[h];
     tests += hit.test_count;
     const int ts = hit.target_side;
@@ -160,22 +151,6 @@ int PairTest::descend() {
       case 4: testList<1, true>(hit, target, centre, members, hit_out, pair_out, hit_count, leaf_pairs); break;
       default: testList<1, true, true>(hit, target, centre, members, hit_out, pair_out, hit_count, leaf_pairs); break;
     }
-    return centre;
-  };
-
-  std::size_t h = hits_begin_;  // an unresolved test has at least one hit
-  const std::size_t hits_end = hits_begin_ + hits_count_;
-  double gap_sq = 0.0;
-  if constexpr (kTrackGap) {
-    const SphereHit& first = hits[h];
-    const Vec3 centre = testHit(h++);
-    const SphereNode* members = nodes[1 - first.target_side];
-    const std::int32_t parent = members[first.test_first].parent;  // -1: the roots' step
-    gap_sq = (members[parent >= 0 ? parent : first.test_first].centre - centre).squaredNorm();
-  }
-  for (; h < hits_end; ++h) {
-    if (first_contact_only_ && leaf_pairs > 0) break;  // the answer is known
-    testHit(h);
   }
 
   ++steps_;
@@ -198,7 +173,10 @@ int PairTest::descend() {
       next_tests += next.test_count;
     }
     next_tests_ = next_tests;
-    if constexpr (kTrackGap) frontier_gap_ = std::sqrt(gap_sq);
+    if (track_gap_) {  // centres compared in B's body frame, as the step tested them
+      frontier_gap_ = (rot_to_other_[0] * nodes[0][pair_out[0].a].centre + pos_to_other_[0] -
+                       nodes[1][pair_out[0].b].centre).norm();
+    }
     pair_count = hit_count;
     store.hits_used = new_hits_begin + hit_count;
     hits_begin_ = new_hits_begin;

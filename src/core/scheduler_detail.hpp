@@ -108,10 +108,12 @@ class PriorityQueueScheduler final : public Scheduler {
  private:
   // A body's projection, made once per run however many pairs share the body.
   struct BodyGaze {
-    Vec2 pixel = Vec2::Zero();
-    double root_weight = 0.0;  // exp(-e / 200): a pair's weight is the product of its two bodies'
-    double root_scale = 0.0;   // root_weight * sqrt(pixels per metre)
-    std::uint32_t run = 0;     // the run that made it
+    Vec3 root_centre = Vec3::Zero();  // its tree's root sphere's centre, world frame
+    // exp(-e / 200) * sqrt(pixels per metre), e the eccentricity of its
+    // origin: a pair's weight x pixels per metre is the product of its two
+    // bodies' (0 behind the camera).
+    double root_scale = 0.0;
+    std::uint32_t run = 0;  // the run that made it
   };
   // Measures every unresolved pair, sets the bins from the largest priority, queues them.
   void binAll(PairTest* tests, std::size_t count, const PairBodies& bodies,
@@ -129,18 +131,17 @@ class PriorityQueueScheduler final : public Scheduler {
   bool servePass(int q, BudgetTracker& budget, BinAfterStep binAfterStep);
 
   // A queued pair (its PairTest's address: no index arithmetic per step) and
-  // its weight x pixels per metre over the run's largest priority: times the
-  // gap estimate over the next step's cost (both kept by the PairTest), its
-  // priority as a share of the largest. All a re-measure needs.
+  // its priority over the run's largest at a cost of one sphere test:
+  // divided by the cost of its next step (kept by the PairTest), its
+  // priority as a share of the largest. All a re-bin needs.
   struct Queued {
     PairTest* test = nullptr;
-    double scale = 0.0;
+    double share = 0.0;
   };
   // A measured pair before the bins are known.
   struct Measured {
     std::uint32_t pair = 0;
     double priority = 0.0;
-    double scale = 0.0;  // weight x pixels per metre
   };
 
   static constexpr std::size_t kMaxQueues = 64;  // validateSchedulerOptions
@@ -162,7 +163,7 @@ class PriorityQueueScheduler final : public Scheduler {
   // A body to project this run.
   struct Unseen {
     std::uint32_t body = 0;
-    const Pose* pose = nullptr;
+    const PairBody* of = nullptr;
   };
   // Capacity reused: per body, its projection; per unresolved pair, its
   // measure; the bodies to project.

@@ -1,8 +1,8 @@
 // Priority-queue scheduling (paper 3.4.3). The perceptual model only picks
 // one of K queues; inside a queue pairs go round-robin; the highest non-empty
-// queue is always served next. A pair stepped by a pass over a queue is
-// re-measured and moves to the back of another queue when its priority
-// crossed a bin edge; that queue is served once the pass is over.
+// queue is always served next. A pair stepped by a pass over a queue moves to
+// the back of another queue when its priority crossed a bin edge; that queue
+// is served once the pass is over.
 //
 // Priority: f(e, g) / c^a, c the sphere tests of the pair's next step (see
 // SchedulerOptions::cost_exponent; a = 0 is the paper's f). Bins are
@@ -12,33 +12,29 @@
 // the rest, including f = 0 (behind the camera). A pass over a queue is
 // finished before a higher queue that filled meanwhile is served.
 //
-// The bookkeeping is kept to a few operations per step (issue 11,
-// docs/error_vs_runtime.md):
+// f(e, g) is measured once per run, and the queue changes with the cost
+// alone (issue 11, docs/error_vs_runtime.md):
+// - g is the paper's estimate for the roots, the distance of the root
+//   spheres' centres, in pixels. Re-measured after each step for the
+//   frontier (as this did before), g cost a third of the bookkeeping and
+//   left no less true P at equal sphere tests (measured: as much or less, on
+//   both scenes); c is what changes a pair's worth per sphere test as it
+//   descends (a level multiplies it by up to 8 per intersecting pair).
 // - Each body is projected once per run, not each pair (a body is in five or
 //   more pairs in a pile), in a loop of its own with no library call (exp by
 //   a polynomial). A pair's weight exp(-e/100) takes e as the mean of its
 //   bodies' eccentricities (the midpoint's is at most that), so it is the
 //   product of two per-body factors exp(-e_body/200); its pixels per metre
-//   the geometric mean of its bodies'. g before any step is the paper's
-//   estimate, the projected distance of the entity origins.
-// - After a step, g is the paper's estimate for the sphere pair the step
-//   descended from (PairTest::frontierGap(): no rotation, the step has that
-//   centre in the other frame already; one level coarser than the new
-//   frontier's, it ranks pairs as well, measured), times the pair's weight x
-//   pixels per metre over fmax (queued beside the pair), over c, the exact
-//   tests of the next step. The re-measure is done right after the step,
-//   while the PairTest is in cache: a multiply, a divide and the bin, which
-//   for the defaults is a table look-up by the exponent (O(1); other options:
-//   K - 1 branch-free comparisons with the bin edges). No projection after
-//   the start. A pass is compiled per bin rule, so nothing is decided per
-//   step but the bin.
-//   (Measured against the reach r_a + r_b of that pair, which this used
-//   before: the centre distance also tells a deep overlap, likely a real
-//   contact whose gap is 0, from a shallow one, and left 5-15 % less true P
-//   at equal sphere tests; docs/error_vs_runtime.md.)
+//   the geometric mean of its bodies'.
+// - A queued pair carries its f / fmax; after a step its bin is that over c,
+//   the exact tests of the next step, which the PairTest keeps: a divide and
+//   a table look-up by the exponent for the defaults (other options: K - 1
+//   branch-free comparisons with the bin edges). No projection after the
+//   start, nothing for the PairTest to keep, and a pass is compiled per bin
+//   rule, so nothing is decided per step but the bin.
 // - Queue 0 is the end of the line: its pairs (the rest, and weight 0 when a
-//   body is behind the camera) go round-robin and are not re-measured (a
-//   step rarely raises a priority: the spheres shrink and the cost grows).
+//   body is behind the camera) go round-robin and are not re-binned (the
+//   cost only grows).
 // - Queues are flat storage reused across runs, their ends kept as pointers:
 //   appending is one store and one add, a pass compacts the pairs that stay
 //   in place, and nothing is sorted. A queue entry holds the PairTest's
@@ -125,28 +121,28 @@ inline int PriorityQueueScheduler::binOf(double share) const {
 }
 
 // The bin of a stepped pair with bins a factor 2 apart and the priority per
-// sphere test (the defaults): the exponent of g x scale / c, looked up. The
+// sphere test (the defaults): the exponent of share / c, looked up. The
 // table's address is copied in, so it stays in a register across the steps
 // (a step could write to the scheduler, for all the compiler knows).
 struct PriorityQueueScheduler::ExponentBin {
   const std::uint8_t* bin_of_exponent;
-  int operator()(const PairTest& test, double scale) const {
-    // g >= 0: x = 0 has exponent 0 and lands in queue 0.
-    return bin_of_exponent[biasedExponent(test.frontierGap() * scale / test.nextStepTests())];
+  int operator()(const PairTest& test, double share) const {
+    // share >= 0: 0 has exponent 0 and lands in queue 0.
+    return bin_of_exponent[biasedExponent(share / test.nextStepTests())];
   }
 };
 
 // Any other ratio or cost exponent: the priority, then its bin.
 struct PriorityQueueScheduler::EdgeBin {
   const PriorityQueueScheduler* scheduler;
-  int operator()(const PairTest& test, double scale) const {
-    return scheduler->binOf(scheduler->perCost(test.frontierGap() * scale, test.nextStepTests()));
+  int operator()(const PairTest& test, double share) const {
+    return scheduler->binOf(scheduler->perCost(share, test.nextStepTests()));
   }
 };
 
-// Queue 0 is not re-measured.
+// Queue 0 is not re-binned.
 struct PriorityQueueScheduler::StayBin {
-  int operator()(const PairTest& /*test*/, double /*scale*/) const { return 0; }
+  int operator()(const PairTest& /*test*/, double /*share*/) const { return 0; }
 };
 
 void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
@@ -170,15 +166,14 @@ void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
   for (std::size_t i = 0; i < count; ++i) {
     PairTest& test = tests[i];
     if (test.resolved()) continue;
-    test.trackFrontierGap();  // its steps keep g for the re-measure
     const std::uint32_t a = of_pair[i][0], b = of_pair[i][1];
     if (gaze[a].run != run) {
       gaze[a].run = run;
-      unseen[fresh++] = Unseen{a, test.bodyA().pose};
+      unseen[fresh++] = Unseen{a, &test.bodyA()};
     }
     if (gaze[b].run != run) {
       gaze[b].run = run;
-      unseen[fresh++] = Unseen{b, test.bodyB().pose};
+      unseen[fresh++] = Unseen{b, &test.bodyB()};
     }
     measured[n++].pair = static_cast<std::uint32_t>(i);
   }
@@ -188,22 +183,24 @@ void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
   const Vec2 fixation = *perception.fixation();
   constexpr double kPerPixel = -1.0 / (200.0 * 0.69314718055994531);
   for (std::size_t k = 0; k < fresh; ++k) {
-    const Perception::GazeWeight gw = perception.pixelAndScale(unseen[k].pose->position);
+    const PairBody& body = *unseen[k].of;
+    const Perception::GazeWeight gw = perception.pixelAndScale(body.pose->position);
     BodyGaze& g = gaze[unseen[k].body];
-    g.pixel = gw.pixel;
-    g.root_weight = gw.px_per_metre > 0.0 ? exp2NonPositive(kPerPixel * (gw.pixel - fixation).norm()) : 0.0;
-    g.root_scale = g.root_weight * std::sqrt(gw.px_per_metre);
+    g.root_centre = body.pose->apply(body.tree->root().centre);
+    const double root_weight =
+        gw.px_per_metre > 0.0 ? exp2NonPositive(kPerPixel * (gw.pixel - fixation).norm()) : 0.0;
+    g.root_scale = root_weight * std::sqrt(gw.px_per_metre);
   }
-  // Each pair's priority before any step: g = the projected distance of the
-  // entity origins, c = 1.
+  // Each pair's priority at a cost of one sphere test, for the whole run:
+  // g = the distance of the root spheres' centres (the paper's estimate for
+  // the roots) in pixels.
   double reference = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     const std::uint32_t i = measured[k].pair;
     const BodyGaze& a = gaze[of_pair[i][0]];
     const BodyGaze& b = gaze[of_pair[i][1]];
-    const double f = a.root_weight * b.root_weight * (a.pixel - b.pixel).norm();
+    const double f = a.root_scale * b.root_scale * (a.root_centre - b.root_centre).norm();
     measured[k].priority = f;
-    measured[k].scale = a.root_scale * b.root_scale;
     reference = std::max(reference, f);
   }
   // Priorities from here on are shares of the largest.
@@ -212,7 +209,7 @@ void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
   for (std::size_t k = 0; k < n; ++k) {
     Queued*& end = ends[binOf(measured[k].priority * inverse_reference)];
     end->test = tests + measured[k].pair;
-    end->scale = measured[k].scale * inverse_reference;
+    end->share = measured[k].priority * inverse_reference;
     ++end;
   }
 }
@@ -238,7 +235,7 @@ ScheduleStats PriorityQueueScheduler::run(PairTest* tests, std::size_t count,
     for (std::size_t i = 0; i < count; ++i) {
       if (tests[i].resolved()) continue;
       end->test = &tests[i];
-      end->scale = 0.0;
+      end->share = 0.0;
       ++end;
     }
     ends_[0] = end;
@@ -277,8 +274,8 @@ bool PriorityQueueScheduler::serveQueues(BudgetTracker& budget, SampledClock& re
 }
 
 // One round-robin pass over queue q; false when the budget ended it. A pair
-// still unresolved is re-measured as soon as it is stepped (its gap estimate
-// and next cost are in cache then): it stays, in order, compacted in place,
+// still unresolved is re-binned as soon as it is stepped (its next cost is
+// in cache then): it stays, in order, compacted in place,
 // or goes to the back of its new queue, which is not served before this pass
 // ends. No branch on the outcome (it is a coin toss to predict): the entry is
 // written both at the compaction point and at the end of its new queue, and
@@ -301,7 +298,7 @@ bool PriorityQueueScheduler::servePass(int q, BudgetTracker& budget, BinAfterSte
     budget.charge(test.step());
     if (test.resolved()) continue;
     const Queued entry = *read;
-    const auto moved = static_cast<std::size_t>(binAfterStep(test, entry.scale));
+    const auto moved = static_cast<std::size_t>(binAfterStep(test, entry.share));
     const bool stays = moved == qi;
     *kept = entry;
     kept += stays;
