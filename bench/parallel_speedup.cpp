@@ -13,7 +13,6 @@
 //
 // Usage: bench_parallel_speedup [--scenes corner_drift:500,rockfall:1000,packed_box:500,cube_box:10000]
 //          [--threads 2] [--seconds 6] [--cube-seconds 1.5] [--settle 1]
-//          [--solver-task-manifolds N] (ResponseOptions::solver_task_manifolds)
 //   --seconds: simulated time timed per scene (cube_box: --cube-seconds);
 //   --settle: simulated time run first, untimed, at one thread (so the
 //   scene is moving and colliding when timing starts).
@@ -58,7 +57,6 @@ struct Options {
   double seconds = 6.0;
   double cube_seconds = 1.5;
   double settle = 1.0;
-  int solver_task_manifolds = ResponseOptions{}.solver_task_manifolds;
 };
 
 // Per-tick samples of one run, seconds.
@@ -67,10 +65,9 @@ struct Run {
   double contacts = 0.0, colours = 0.0;  // sums over the ticks
 };
 
-SceneWorld makeWorld(const Case& c, int threads, int solver_task_manifolds) {
+SceneWorld makeWorld(const Case& c, int threads) {
   WorldConfig config;
   config.threads = threads;
-  config.response.solver_task_manifolds = solver_task_manifolds;
   SceneParams params;
   params.entities = c.bodies;
   return makeSceneWorld(c.kind, params, config);
@@ -106,8 +103,8 @@ double serialFraction(double t1, double tn, int n) {
 double amdahl(double s, int n) { return 1.0 / (s + (1.0 - s) / n); }
 
 double runCase(const Case& c, const Options& opt) {
-  SceneWorld scene_one = makeWorld(c, 1, opt.solver_task_manifolds);
-  SceneWorld scene_many = makeWorld(c, opt.threads, opt.solver_task_manifolds);
+  SceneWorld scene_one = makeWorld(c, 1);
+  SceneWorld scene_many = makeWorld(c, opt.threads);
   World& one = scene_one.world;
   World& many = scene_many.world;
   const SceneSpec& spec = scene_one.spec;
@@ -185,8 +182,6 @@ Options parseOptions(int argc, char** argv) {
         if (comma == std::string::npos) break;
         start = comma + 1;
       }
-    } else if (a == "--solver-task-manifolds") {
-      o.solver_task_manifolds = std::stoi(next());
     } else if (a == "--threads") {
       o.threads = std::stoi(next());
       validateThreads(o.threads);

@@ -82,8 +82,8 @@ class ContactSolver {
   // Threads of the velocity, shock and position iterations (nullptr: the
   // caller's alone); the result is the same whatever they are
   // (contact_colouring.hpp: a body pair's manifold is one group). A colour
-  // of fewer than `task_manifolds` manifolds is solved by one thread, in
-  // turn with its small neighbours (ResponseOptions::solver_task_manifolds).
+  // of fewer than `task_manifolds` manifolds is solved on the calling thread
+  // (ResponseOptions::solver_task_manifolds).
   void setWorkers(const Workers* workers, std::size_t task_manifolds) {
     workers_ = workers;
     task_manifolds_ = std::max<std::size_t>(1, task_manifolds);
@@ -144,9 +144,6 @@ class ContactSolver {
     std::uint64_t pair = 0;              // entity ids a, b packed: the sort key
     std::uint32_t first = 0, count = 0;  // its points in cache_
   };
-  // solve() inside the workers' session.
-  SolveStats solveNow(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, const ResponseOptions& options,
-                      double dt, const SolveBudget& budget);
   void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
                const ResponseOptions& options, double dt, SolveStats& stats);
   void orderFromTheGround(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
@@ -155,31 +152,14 @@ class ContactSolver {
   // manifold; manifold_start_, manifolds_, the colours' and the shock
   // levels' runs of manifolds (contact_solver_colours.cpp).
   void colourManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
-  // A run of manifolds, positions in colour order: [first, end).
-  struct ManifoldRun {
-    std::uint32_t first = 0, end = 0;
-  };
-  // One stage of a pass (contact_solver_colours.cpp): runs [first_run,
-  // end_run) of a run list, after the stage before. With blocks > 1 it is
-  // one run of one colour, cut into that many blocks that may run at once;
-  // with 1, consecutive small runs one thread takes in turn.
-  struct PassStage {
-    std::uint32_t first_run = 0, end_run = 0, blocks = 1;
-  };
-  // Appends to `plan` the stages of runs [first, end) of `runs`.
-  void planStages(const std::vector<ManifoldRun>& runs, std::size_t first, std::size_t end,
-                  std::vector<PassStage>& plan) const;
-  // manifolds(first, end) over the stages of `plan` (on `runs`), the whole
-  // plan `repeats` times; before each repeat after the first,
-  // go_on(repeat) may stop it. Returns the repeats run.
-  int runPlan(const std::vector<ManifoldRun>& runs, const std::vector<PassStage>& plan, int repeats,
-              RangeFn manifolds, FunctionRef<bool(int)> go_on);
-  int runPlan(const std::vector<ManifoldRun>& runs, const std::vector<PassStage>& plan, int repeats,
-              RangeFn manifolds) {
-    return runPlan(runs, plan, repeats, manifolds, [](int) { return true; });
-  }
-  // Shock propagation's levels from the ground (unreached rows aside).
+  // manifolds(first, end) over every colour's manifolds in turn, a colour's
+  // manifolds split over the workers.
+  void forEachColour(RangeFn manifolds);
+  // Shock propagation's order: the levels from the ground (unreached rows
+  // aside), and a level's manifolds colour by colour, as forEachColour.
   std::size_t shockLevels() const { return level_segment_start_.empty() ? 0 : level_segment_start_.size() - 1; }
+  void forEachColourOfLevel(std::size_t level, RangeFn manifolds);
+  void forEachManifoldRun(std::uint32_t first, std::uint32_t end, RangeFn manifolds) const;
   // step(r, a, b) over the rows r of manifolds [first, end), a and b the
   // pair's entries of `motion` copied in, then written back (a static body's
   // never is: colours do not hold it apart).
@@ -217,15 +197,13 @@ class ContactSolver {
   ContactColouring colouring_;
   std::vector<ColourGroup> groups_;
   std::vector<std::uint32_t> group_first_, group_order_, colour_order_, colour_manifold_start_;
-  // The colours as runs, and a pass over them colour by colour.
-  std::vector<ManifoldRun> colour_runs_;
-  std::vector<PassStage> colour_plan_;
   // Per level from the ground: its runs of manifolds, one per colour
-  // (positions in colour order); the levels' first runs; shock
-  // propagation's plan (each level's stages, once per pass).
+  // (positions in colour order); the levels' first runs.
+  struct ManifoldRun {
+    std::uint32_t first = 0, end = 0;
+  };
   std::vector<ManifoldRun> level_runs_;
   std::vector<std::uint32_t> level_segment_start_, cursor_;
-  std::vector<PassStage> shock_plan_;
   std::vector<int> levels_;
 };
 

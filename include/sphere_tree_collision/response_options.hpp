@@ -40,11 +40,10 @@ struct ResponseOptions {
   // than this fraction of its smallest leaf radius in one tick.
   double sweep_threshold = 0.5;
   bool gyroscopic = true;               // implicit-midpoint w x Iw (see dynamics.hpp)
-  // With threads > 1: a solver colour of at least this many manifolds is
-  // split into blocks over the threads; smaller ones are solved by one
-  // thread, in turn with their small neighbours (docs/architecture.md,
-  // "Stages"). >= 1.
-  int solver_task_manifolds = 32;
+  // With threads > 1: a solver colour of fewer manifolds than this is solved
+  // on the calling thread, a bigger one split in tasks of at least this many
+  // (each hand-off wakes a worker, 40+ times a tick; docs/architecture.md). >= 1.
+  int solver_task_manifolds = 512;
 };
 // Throws InputError naming the field ("response.iterations", ...).
 void validateResponseOptions(const ResponseOptions& options);

@@ -279,15 +279,14 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
     applyNormal(row, normal - row.lambda[0], a, b);
     row.lambda[0] = normal;
   };
-  // Level by level, each level `passes` times; a level's manifolds colour by colour.
-  shock_plan_.clear();
+  // Level by level; a level's manifolds colour by colour.
   for (std::size_t level = 0; level < shockLevels(); ++level) {
     for (int pass = 0; pass < passes; ++pass) {
-      planStages(level_runs_, level_segment_start_[level], level_segment_start_[level + 1], shock_plan_);
+      forEachColourOfLevel(level, [&](std::size_t first, std::size_t end) {
+        overManifolds(first, end, motion_, shockStep);
+      });
     }
   }
-  runPlan(level_runs_, shock_plan_, 1,
-          [&](std::size_t first, std::size_t end) { overManifolds(first, end, motion_, shockStep); });
 }
 
 // Each manifold looks up last tick's manifold of its entity pair once; each
@@ -376,8 +375,7 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
       row.lambda[0] = normal;
     };
     for (int it = 0; it < passes; ++it) {
-      runPlan(colour_runs_, colour_plan_, 1,
-              [&](std::size_t first, std::size_t end) { overManifolds(first, end, delta_, jacobiStep); });
+      forEachColour([&](std::size_t first, std::size_t end) { overManifolds(first, end, delta_, jacobiStep); });
       commitJacobi(motion_);
     }
     return;
@@ -385,8 +383,9 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
   // Sequential: the rows of one body pair in a row, on local copies of the
   // two bodies' velocities.
   const auto relaxStep = [&](std::size_t r, Motion& a, Motion& b) { relaxRow(rows_[r], a, b); };
-  runPlan(colour_runs_, colour_plan_, passes,
-          [&](std::size_t first, std::size_t end) { overManifolds(first, end, motion_, relaxStep); });
+  for (int it = 0; it < passes; ++it) {
+    forEachColour([&](std::size_t first, std::size_t end) { overManifolds(first, end, motion_, relaxStep); });
+  }
 }
 
 // Restitution before the solve, as collisions (Guendelman et al. 2003): wave
@@ -478,16 +477,12 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
     info.lambda_push = normal;
     applyNormal(row, delta, out_a, out_b);
   };
-  // Colour by colour, as the velocity passes.
-  const auto pass = [&](std::size_t first, std::size_t end) { overManifolds(first, end, out, positionStep); };
-  if (!jacobi) {
-    return runPlan(colour_runs_, colour_plan_, options.iterations, pass, [&](int) { return !deadline.passed(); });
-  }
   int passes = 0;
   for (int it = 0; it < options.iterations; ++it, ++passes) {
     if (it > 0 && deadline.passed()) break;
-    runPlan(colour_runs_, colour_plan_, 1, pass);
-    commitJacobi(pseudo_);
+    // Colour by colour, as the velocity passes.
+    forEachColour([&](std::size_t first, std::size_t end) { overManifolds(first, end, out, positionStep); });
+    if (jacobi) commitJacobi(pseudo_);
   }
   return passes;
 }
@@ -562,16 +557,6 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
 
 SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
                                 const ResponseOptions& options, double dt, const SolveBudget& budget) {
-  if (workers_ == nullptr || workers_->threads() == 1) return solveNow(bodies, contacts, options, dt, budget);
-  // One session for every pass of the tick: the workers wake once, while
-  // the rows are prepared, not at each pass loop.
-  SolveStats stats;
-  workers_->session([&] { stats = solveNow(bodies, contacts, options, dt, budget); });
-  return stats;
-}
-
-SolveStats ContactSolver::solveNow(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
-                                   const ResponseOptions& options, double dt, const SolveBudget& budget) {
   SolveStats stats;
   if (!(dt > 0.0) || bodies.empty()) return stats;
   for (Contact& c : contacts) {

@@ -1,10 +1,8 @@
-// The solver's manifolds in colour order (contact_colouring.hpp) and the
-// passes over them colour by colour: a large colour's manifolds in blocks on
-// every thread, runs of small colours on one thread in turn, all as stages
-// of one Workers::runStages call per pass loop.
+// The solver's manifolds in colour order (contact_colouring.hpp) and the loop
+// that runs a pass over them colour by colour, each colour's manifolds in
+// parallel.
 #include "sphere_tree_collision/contact_solver.hpp"
 
-#include <algorithm>
 #include <limits>
 
 namespace stc {
@@ -23,8 +21,6 @@ void ContactSolver::colourManifolds(const std::vector<BodyState>& bodies, const 
                                         &colour_manifold_start_, &cursor_}) {
     v->reserve(order_.size() + 1);
   }
-  colour_runs_.reserve(order_.size());
-  colour_plan_.reserve(order_.size());
   colouring_.reserve(order_.size());
   groups_.reserve(order_.size());
   manifolds_.reserve(order_.size());
@@ -68,12 +64,6 @@ void ContactSolver::colourManifolds(const std::vector<BodyState>& bodies, const 
   }
   manifold_start_.push_back(static_cast<std::uint32_t>(colour_order_.size()));
   order_.swap(colour_order_);
-  colour_runs_.clear();
-  for (std::size_t c = 0; c + 1 < colour_manifold_start_.size(); ++c) {
-    colour_runs_.push_back(ManifoldRun{colour_manifold_start_[c], colour_manifold_start_[c + 1]});
-  }
-  colour_plan_.clear();
-  planStages(colour_runs_, 0, colour_runs_.size(), colour_plan_);
 
   // Shock propagation's runs: within a colour the manifolds are in the order
   // from the ground, so each level takes the next run of every colour.
@@ -96,47 +86,21 @@ void ContactSolver::colourManifolds(const std::vector<BodyState>& bodies, const 
   if (!level_segment_start_.empty()) level_segment_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
 }
 
-void ContactSolver::planStages(const std::vector<ManifoldRun>& runs, std::size_t first, std::size_t end,
-                               std::vector<PassStage>& plan) const {
-  // A block of fewer manifolds than this costs more to hand over than it saves.
-  constexpr std::size_t kMinBlockManifolds = 8;
-  constexpr std::size_t kBlocksPerThread = 4;  // claimed as threads come free: uneven blocks even out
-  const std::size_t threads = workers_ != nullptr ? static_cast<std::size_t>(workers_->threads()) : 1;
-  for (std::size_t r = first; r < end; ++r) {
-    const std::size_t size = runs[r].end - runs[r].first;
-    if (threads > 1 && size >= task_manifolds_ && size >= 2) {
-      const std::size_t blocks = std::min({threads * kBlocksPerThread, size, kMaxStageBlocks,
-                                           std::max<std::size_t>(2, size / kMinBlockManifolds)});
-      plan.push_back(PassStage{static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(r + 1),
-                               static_cast<std::uint32_t>(blocks)});
-    } else if (!plan.empty() && plan.back().blocks == 1 && plan.back().end_run == r) {
-      ++plan.back().end_run;  // joins the small runs before it
-    } else {
-      plan.push_back(PassStage{static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(r + 1), 1});
-    }
+void ContactSolver::forEachManifoldRun(std::uint32_t first, std::uint32_t end, RangeFn manifolds) const {
+  forEachIndex(workers_, end - first, task_manifolds_,
+               [&](std::size_t begin, std::size_t stop) { manifolds(first + begin, first + stop); });
+}
+
+void ContactSolver::forEachColour(RangeFn manifolds) {
+  for (std::size_t c = 0; c + 1 < colour_manifold_start_.size(); ++c) {
+    forEachManifoldRun(colour_manifold_start_[c], colour_manifold_start_[c + 1], manifolds);
   }
 }
 
-int ContactSolver::runPlan(const std::vector<ManifoldRun>& runs, const std::vector<PassStage>& plan, int repeats,
-                           RangeFn manifolds, FunctionRef<bool(int)> go_on) {
-  const std::size_t n = plan.size();
-  if (n == 0 || repeats <= 0) return 0;
-  const bool parallel = std::any_of(plan.begin(), plan.end(), [](const PassStage& s) { return s.blocks > 1; });
-  const auto blocks = [&](std::size_t s) -> std::size_t { return plan[s % n].blocks; };
-  const auto run_block = [&](std::size_t s, std::size_t k) {
-    const PassStage& stage = plan[s % n];
-    if (stage.blocks == 1) {
-      for (std::uint32_t r = stage.first_run; r < stage.end_run; ++r) manifolds(runs[r].first, runs[r].end);
-      return;
-    }
-    const ManifoldRun& run = runs[stage.first_run];
-    const auto [begin, stop] = chunkRange(run.end - run.first, k, stage.blocks);
-    manifolds(run.first + begin, run.first + stop);
-  };
-  const auto next = [&](std::size_t s) { return s == 0 || s % n != 0 || go_on(static_cast<int>(s / n)); };
-  const StageFns fns{blocks, run_block, next};  // (references: the lambdas outlive the call)
-  const std::size_t stages = runStages(parallel ? workers_ : nullptr, n * static_cast<std::size_t>(repeats), fns);
-  return static_cast<int>((stages + n - 1) / n);
+void ContactSolver::forEachColourOfLevel(std::size_t level, RangeFn manifolds) {
+  for (std::uint32_t k = level_segment_start_[level]; k < level_segment_start_[level + 1]; ++k) {
+    forEachManifoldRun(level_runs_[k].first, level_runs_[k].end, manifolds);
+  }
 }
 
 }  // namespace stc

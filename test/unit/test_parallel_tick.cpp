@@ -5,7 +5,6 @@
 // deadline stops every worker. No timing is asserted: budgets are counts, and
 // the deadline runs on a fake clock.
 #include "sphere_tree_collision/scenes.hpp"
-#include "sphere_tree_collision/workers.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <gtest/gtest.h>
@@ -67,45 +66,6 @@ World sceneWorld(SceneKind kind, int threads) {
 }
 
 const SceneKind kScenes[] = {SceneKind::CornerDrift, SceneKind::Rockfall, SceneKind::PackedBox};
-
-// Workers::runStages, the solver's passes: every block of a stage runs
-// exactly once, after every block of the stage before has finished, and
-// go_on stops the run before a stage. With 4 threads on a machine with fewer
-// cores some helpers start only at the end: nothing may wait for them.
-TEST(ParallelTick, StagesRunEachBlockOnceAfterTheStageBefore) {
-  constexpr std::size_t kStages = 400;
-  constexpr std::size_t kStopAt = 300;
-  const auto blocksOf = [](std::size_t s) { return s % 9 == 0 ? kMaxStageBlocks : 1 + s % 7; };
-  for (const int threads : {1, 2, 4}) {
-    const Workers workers(threads);
-    std::atomic<std::uint64_t> clock{0};
-    // Per stage and block: times run, first tick of its start, tick of its end.
-    std::vector<std::array<std::atomic<std::uint64_t>, kMaxStageBlocks>> runs(kStages), starts(kStages), ends(kStages);
-    const auto blocks = [&](std::size_t s) { return blocksOf(s); };
-    const auto run = [&](std::size_t s, std::size_t k) {
-      starts[s][k] = ++clock;
-      ++runs[s][k];
-      for (volatile int work = 0; work < 2000; work = work + 1) {
-      }  // long enough for another thread to start a block meanwhile
-      ends[s][k] = ++clock;
-    };
-    const auto go_on = [&](std::size_t s) { return s < kStopAt; };
-    const std::size_t ran = runStages(threads > 1 ? &workers : nullptr, kStages, StageFns{blocks, run, go_on});
-    EXPECT_EQ(ran, kStopAt) << threads << " threads";
-    for (std::size_t s = 0; s < kStages; ++s) {
-      std::uint64_t first_start = ~std::uint64_t{0};
-      for (std::size_t k = 0; k < kMaxStageBlocks; ++k) {
-        const bool expected = s < kStopAt && k < blocksOf(s);
-        ASSERT_EQ(runs[s][k].load(), expected ? 1u : 0u) << "stage " << s << " block " << k << ", " << threads << " threads";
-        if (expected) first_start = std::min<std::uint64_t>(first_start, starts[s][k]);
-      }
-      if (s == 0 || s >= kStopAt) continue;
-      for (std::size_t k = 0; k < blocksOf(s - 1); ++k) {
-        ASSERT_LT(ends[s - 1][k].load(), first_start) << "stage " << s << " began before stage " << s - 1 << " ended";
-      }
-    }
-  }
-}
 
 TEST(ParallelTick, ThreadsAreValidatedAndResolved) {
   for (const int bad : {-1, kMaxThreads + 1, 1 << 30}) {
