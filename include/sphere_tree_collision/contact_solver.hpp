@@ -89,6 +89,17 @@ class ContactSolver {
     task_manifolds_ = std::max<std::size_t>(1, task_manifolds);
   }
 
+  // Bodies held out of the solve because they sleep (by dense index, non-zero:
+  // held) and the bodies' entity ids: a manifold of last tick's cache that
+  // this tick did not solve is kept while both its bodies are out of the
+  // solve and one of them sleeps, so a woken pile starts from the impulses
+  // it fell asleep with, not cold (nullptr: none kept). Valid for the
+  // following solve calls.
+  void keepWhileHeld(const std::vector<EntityId>* ids, const std::vector<std::uint8_t>* held) {
+    held_ids_ = ids;
+    held_ = held;
+  }
+
   // A body's velocities as the solver sees them: one cache line per body.
   struct Motion {
     Vec3 v = Vec3::Zero();
@@ -143,7 +154,11 @@ class ContactSolver {
   struct CachedManifold {
     std::uint64_t pair = 0;              // entity ids a, b packed: the sort key
     std::uint32_t first = 0, count = 0;  // its points in cache_
+    std::uint32_t index_a = 0, index_b = 0;  // the bodies' dense indices when it was solved
   };
+  // Into the next cache (after the solved manifolds): last tick's manifolds
+  // of sleeping pairs (keepWhileHeld), then the caches swapped.
+  void keepHeldManifolds(const std::vector<BodyState>& bodies);
   void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
                const ResponseOptions& options, double dt, SolveStats& stats);
   void orderFromTheGround(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
@@ -192,6 +207,8 @@ class ContactSolver {
   // Colouring (contact_solver_colours.cpp): the manifolds in the order from
   // the ground (groups_, each one's first place in order_), their colours,
   // and in colour order where each colour's manifolds start.
+  const std::vector<EntityId>* held_ids_ = nullptr;
+  const std::vector<std::uint8_t>* held_ = nullptr;
   const Workers* workers_ = nullptr;
   std::size_t task_manifolds_ = 1;  // read only with workers_
   ContactColouring colouring_;

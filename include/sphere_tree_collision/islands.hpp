@@ -56,6 +56,9 @@ class Islands {
   void clear();
 
   bool isSleeping(std::size_t body) const { return group_[body] != kAwake; }
+  // Per body, non-zero: held as static this tick because it sleeps (from
+  // beginTick, less what releaseWoken releases, to endTick).
+  const std::vector<std::uint8_t>& held() const { return held_; }
   std::size_t sleepingCount() const { return sleeping_; }
   // Awake and not resting at the last endTick (or edited, or new).
   bool isRestless(std::size_t body) const { return group_[body] == kAwake && moving_[body] != 0; }

@@ -40,6 +40,10 @@ struct StepContext {
   SolveBudget budget;             // what the solver may spend (respond)
   std::vector<Contact>* contacts = nullptr;  // respond's output
   const Workers* workers = nullptr;  // threads of the parallel loops (nullptr: the caller's alone)
+  // Entity ids by dense index, and the bodies held asleep this tick: the
+  // solver keeps sleeping pairs' warm-start impulses (respond; nullptr: not).
+  const std::vector<EntityId>* ids = nullptr;
+  const std::vector<std::uint8_t>* held_asleep = nullptr;
 };
 
 struct PhysicsReport {

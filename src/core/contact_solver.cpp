@@ -535,7 +535,11 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
       Contact& c = contacts[info_[r].contact];
       c.normal_impulse = row.lambda[0] + row.bounce_impulse;
       c.friction_impulse = row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
-      if (r == manifold_start_[m]) manifold.pair = pairKey(c.a, c.b);
+      if (r == manifold_start_[m]) {
+        manifold.pair = pairKey(c.a, c.b);
+        manifold.index_a = row.a;
+        manifold.index_b = row.b;
+      }
       if (r - manifold_start_[m] >= 32) continue;  // warmStart's bit set
       CachedPoint point;
       point.node_a = c.node_a;
@@ -551,6 +555,35 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
   }
   std::sort(next_manifolds_.begin(), next_manifolds_.end(),
             [](const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; });
+  keepHeldManifolds(bodies);
+}
+
+void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
+  const std::size_t solved = next_manifolds_.size();
+  if (held_ids_ != nullptr && held_ != nullptr) {
+    for (const CachedManifold& old : cache_manifolds_) {
+      if (std::binary_search(next_manifolds_.begin(), next_manifolds_.begin() + solved, old,
+                             [](const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; })) {
+        continue;  // solved this tick: its new impulses are kept
+      }
+      // Both bodies still there (a despawn moves indices: the ids must
+      // match) and out of the solve, one of them asleep.
+      const std::uint32_t ia = old.index_a, ib = old.index_b;
+      if (ia >= bodies.size() || ib >= bodies.size() || (*held_ids_)[ia] != static_cast<EntityId>(old.pair >> 32) ||
+          (*held_ids_)[ib] != static_cast<EntityId>(old.pair & 0xffffffffu) || !bodies[ia].is_static ||
+          !bodies[ib].is_static || ((*held_)[ia] == 0 && (*held_)[ib] == 0)) {
+        continue;
+      }
+      CachedManifold kept = old;
+      kept.first = static_cast<std::uint32_t>(next_cache_.size());
+      next_cache_.insert(next_cache_.end(), cache_.begin() + old.first, cache_.begin() + old.first + old.count);
+      next_manifolds_.push_back(kept);
+    }
+    if (next_manifolds_.size() > solved) {
+      std::sort(next_manifolds_.begin(), next_manifolds_.end(),
+                [](const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; });
+    }
+  }
   cache_.swap(next_cache_);
   cache_manifolds_.swap(next_manifolds_);
 }
@@ -565,7 +598,9 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
   }
   prepare(bodies, contacts, options, dt, stats);
   if (rows_.empty()) {
-    forget();
+    next_cache_.clear();
+    next_manifolds_.clear();
+    keepHeldManifolds(bodies);  // only the sleepers' manifolds stay
     return stats;
   }
   collide(options, stats);

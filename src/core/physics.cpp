@@ -128,6 +128,7 @@ void Physics::respond(const StepContext& step) {
   ResponseOptions solve = options;
   solve.restitution_threshold = std::max(options.restitution_threshold, kRestingFallTicks * gravity_speed_);
   solver_.setWorkers(step.workers, static_cast<std::size_t>(options.solver_task_manifolds));
+  solver_.keepWhileHeld(step.ids, step.held_asleep);
   report_.solve = solver_.solve(*step.bodies, contacts, solve, step.dt, step.budget);
 }
 

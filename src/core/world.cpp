@@ -336,6 +336,8 @@ StepContext World::physicsStep() {
   step.accept_unresolved = config_.unresolved_policy == UnresolvedPolicy::Accept;
   step.contacts = &contacts_;
   step.workers = &workers_;
+  step.ids = &ids_;
+  step.held_asleep = &islands_.held();
   return step;
 }
 
