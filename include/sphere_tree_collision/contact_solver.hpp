@@ -156,6 +156,7 @@ class ContactSolver {
     std::uint32_t first = 0, count = 0;  // its points in cache_
     std::uint32_t index_a = 0, index_b = 0;  // the bodies' dense indices when it was solved
   };
+  static bool byPair(const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; }
   // Into the next cache (after the solved manifolds): last tick's manifolds
   // of sleeping pairs (keepWhileHeld), then the caches swapped.
   void keepHeldManifolds(const std::vector<BodyState>& bodies);

@@ -553,8 +553,7 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
     manifold.count = static_cast<std::uint32_t>(next_cache_.size()) - manifold.first;
     next_manifolds_.push_back(manifold);
   }
-  std::sort(next_manifolds_.begin(), next_manifolds_.end(),
-            [](const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; });
+  std::sort(next_manifolds_.begin(), next_manifolds_.end(), byPair);
   keepHeldManifolds(bodies);
 }
 
@@ -562,8 +561,7 @@ void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
   const std::size_t solved = next_manifolds_.size();
   if (held_ids_ != nullptr && held_ != nullptr) {
     for (const CachedManifold& old : cache_manifolds_) {
-      if (std::binary_search(next_manifolds_.begin(), next_manifolds_.begin() + solved, old,
-                             [](const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; })) {
+      if (std::binary_search(next_manifolds_.begin(), next_manifolds_.begin() + solved, old, byPair)) {
         continue;  // solved this tick: its new impulses are kept
       }
       // Both bodies still there (a despawn moves indices: the ids must
@@ -580,8 +578,7 @@ void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
       next_manifolds_.push_back(kept);
     }
     if (next_manifolds_.size() > solved) {
-      std::sort(next_manifolds_.begin(), next_manifolds_.end(),
-                [](const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; });
+      std::sort(next_manifolds_.begin(), next_manifolds_.end(), byPair);
     }
   }
   cache_.swap(next_cache_);
