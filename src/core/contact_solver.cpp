@@ -561,16 +561,18 @@ void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
   const std::size_t solved = next_manifolds_.size();
   if (held_ids_ != nullptr && held_ != nullptr) {
     for (const CachedManifold& old : cache_manifolds_) {
+      // Both bodies still there (a despawn moves indices: the ids must
+      // match) and out of the solve, one of them asleep; tested first, so
+      // an awake world pays two look-ups a manifold, no search.
+      const std::uint32_t ia = old.index_a, ib = old.index_b;
+      if (ia >= bodies.size() || ib >= bodies.size() || ((*held_)[ia] == 0 && (*held_)[ib] == 0) ||
+          !bodies[ia].is_static || !bodies[ib].is_static ||
+          (*held_ids_)[ia] != static_cast<EntityId>(old.pair >> 32) ||
+          (*held_ids_)[ib] != static_cast<EntityId>(old.pair & 0xffffffffu)) {
+        continue;
+      }
       if (std::binary_search(next_manifolds_.begin(), next_manifolds_.begin() + solved, old, byPair)) {
         continue;  // solved this tick: its new impulses are kept
-      }
-      // Both bodies still there (a despawn moves indices: the ids must
-      // match) and out of the solve, one of them asleep.
-      const std::uint32_t ia = old.index_a, ib = old.index_b;
-      if (ia >= bodies.size() || ib >= bodies.size() || (*held_ids_)[ia] != static_cast<EntityId>(old.pair >> 32) ||
-          (*held_ids_)[ib] != static_cast<EntityId>(old.pair & 0xffffffffu) || !bodies[ia].is_static ||
-          !bodies[ib].is_static || ((*held_)[ia] == 0 && (*held_)[ib] == 0)) {
-        continue;
       }
       CachedManifold kept = old;
       kept.first = static_cast<std::uint32_t>(next_cache_.size());
