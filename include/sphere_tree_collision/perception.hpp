@@ -95,6 +95,16 @@ class Perception {
     Vec2 pixel = Vec2::Zero();
   };
   GazeWeight gazeWeight(const Vec3& world) const;
+  // gazeWeight without the weight (left 0): the pixel and the pixels per
+  // metre. Inline and with no library call, for a loop over many points.
+  GazeWeight pixelAndScale(const Vec3& world) const {
+    GazeWeight out;
+    const Vec3 c = world_to_camera_rotation_ * (world - camera_position_);
+    if (!(c.z() > kNearDepth) || !fixation_) return out;
+    out.px_per_metre = focal_px_ / c.z();
+    out.pixel = Vec2(0.5 * camera_.width + out.px_per_metre * c.x(), 0.5 * camera_.height + out.px_per_metre * c.y());
+    return out;
+  }
   // The paper's on-screen gap estimate alone: |proj(cA) - proj(cB)| of the
   // last intersecting centres; when either is behind the camera, the 3D gap
   // estimate times `px_per_metre`. What a scheduler re-measures after a step.

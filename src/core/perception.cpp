@@ -132,13 +132,8 @@ Ray Perception::rayThrough(const Vec2& pixel) const {
 }
 
 Perception::GazeWeight Perception::gazeWeight(const Vec3& world) const {
-  GazeWeight out;
-  const Vec3 c = world_to_camera_rotation_ * (world - camera_position_);
-  if (!(c.z() > kNearDepth) || !fixation_) return out;
-  out.px_per_metre = focal_px_ / c.z();
-  out.pixel = Vec2(0.5 * camera_.width + out.px_per_metre * c.x(),
-                   0.5 * camera_.height + out.px_per_metre * c.y());
-  out.weight = std::exp(-(out.pixel - *fixation_).norm() / 100.0);
+  GazeWeight out = pixelAndScale(world);
+  if (out.px_per_metre > 0.0) out.weight = std::exp(-(out.pixel - *fixation_).norm() / 100.0);
   return out;
 }
 

@@ -4,6 +4,7 @@
 
 #include "sphere_tree_collision/scheduler.hpp"
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <utility>
@@ -107,63 +108,69 @@ class PriorityQueueScheduler final : public Scheduler {
  private:
   // A body's projection, made once per run however many pairs share the body.
   struct BodyGaze {
-    Vec2 pixel = Vec2::Zero();
-    double root_weight = 0.0;  // exp(-e / 200): a pair's weight is the product of its two bodies'
-    double root_scale = 0.0;   // root_weight * sqrt(pixels per metre)
-    std::uint32_t run = 0;     // the run that made it
+    Vec3 root_centre = Vec3::Zero();  // its tree's root sphere's centre, world frame
+    // exp(-e / 200) * sqrt(pixels per metre), e the eccentricity of its
+    // origin: a pair's weight x pixels per metre is the product of its two
+    // bodies' (0 behind the camera).
+    double root_scale = 0.0;
+    std::uint32_t run = 0;  // the run that made it
   };
-  const BodyGaze& gazeOf(std::uint32_t body, const PairBody& pair_body, const Perception& perception);
-  // Measures every unresolved pair, sets the bin edges from the largest priority, bins.
+  // Measures every unresolved pair, sets the bins from the largest priority, queues them.
   void binAll(PairTest* tests, std::size_t count, const PairBodies& bodies,
               const Perception& perception);
-  double perCost(double f, int cost) const;
-  int binOf(double priority) const;
+  double perCost(double x, int cost) const;
+  int binOf(double share) const;
   // How a stepped pair is binned (scheduler_priority_queues.cpp): by the
   // exponent (the defaults), by the edges (other options), not at all (queue 0).
   struct ExponentBin;
   struct EdgeBin;
   struct StayBin;
   template <typename BinAfterStep>
-  void serveQueues(PairTest* tests, BudgetTracker& budget, ScheduleStats& stats, SampledClock& requeue,
-                   BinAfterStep binAfterStep);
+  bool serveQueues(BudgetTracker& budget, SampledClock& requeue, BinAfterStep binAfterStep);
   template <typename BinAfterStep>
-  bool servePass(int q, PairTest* tests, BudgetTracker& budget, ScheduleStats& stats,
-                 BinAfterStep binAfterStep);
+  bool servePass(int q, BudgetTracker& budget, BinAfterStep binAfterStep);
 
-  // A queued pair and its weight x pixels per metre: with the gap estimate and
-  // next-step cost the PairTest keeps, all a re-measure needs.
+  // A queued pair (its PairTest's address: no index arithmetic per step) and
+  // its priority over the run's largest at a cost of one sphere test:
+  // divided by the cost of its next step (kept by the PairTest), its
+  // priority as a share of the largest. All a re-bin needs.
   struct Queued {
+    PairTest* test = nullptr;
+    double share = 0.0;
+  };
+  // A measured pair before the bins are known.
+  struct Measured {
     std::uint32_t pair = 0;
-    float scale = 0.0f;
+    double priority = 0.0;
   };
 
   static constexpr std::size_t kMaxQueues = 64;  // validateSchedulerOptions
   int queue_count_;
-  double log_ratio_;
   double cost_exponent_;
-  // Queue q ([0] lowest .. [K-1] highest) is slots_[q * stride_, + sizes_[q]);
-  // stride_ = pairs + 1. Storage reused across runs.
+  bool binary_bins_;  // queue_ratio 2: a share's bin is read off its exponent
+  // Queue q ([0] lowest .. [K-1] highest) is slots_[q * stride_, ends_[q]);
+  // stride_ = pairs + 1. The ends are kept as pointers from run to run of a
+  // pass (a mover is one store and one add). Storage reused across runs.
   std::vector<Queued> slots_;
-  std::vector<std::size_t> sizes_;
   std::size_t stride_ = 0;
-  // Each queue's end as a pointer, for a loop that appends (held in a local,
-  // it stays in registers); setEnds() turns them back into sizes.
-  using QueueEnds = std::array<Queued*, kMaxQueues>;
-  QueueEnds queueEnds();
-  void setEnds(const QueueEnds& ends);
-  Queued& slotEnd(int q) {
-    const auto qi = static_cast<std::size_t>(q);
-    return slots_[qi * stride_ + sizes_[qi]];
-  }
-  std::vector<double> lower_edge_;           // f at the bottom of each queue, this run
-  double inverse_reference_ = 0.0;           // 1 / fmax, this run
-  bool binary_bins_;                         // queue_ratio 2: the bin is f / fmax's exponent
-  // Capacity reused: per body, its projection; per pair, this run's initial
-  // priority and weight x pixels per metre.
+  std::array<Queued*, kMaxQueues> ends_{};
+  Queued* queueBegin(int q) { return slots_.data() + static_cast<std::size_t>(q) * stride_; }
+  // Bins a factor 2 apart: the queue of a share x of the largest priority by
+  // x's biased IEEE exponent (clamped to the queues). Other ratios: the
+  // share at the bottom of each queue.
+  std::array<std::uint8_t, 2048> bin_of_exponent_{};
+  std::vector<double> lower_share_;
+  // A body to project this run.
+  struct Unseen {
+    std::uint32_t body = 0;
+    const PairBody* of = nullptr;
+  };
+  // Capacity reused: per body, its projection; per unresolved pair, its
+  // measure; the bodies to project.
   std::vector<BodyGaze> gaze_;
   std::uint32_t run_ = 0;
-  std::vector<double> priorities_;
-  std::vector<float> scale_;
+  std::vector<Measured> measured_;
+  std::vector<Unseen> unseen_;
 };
 
 }  // namespace stc::detail

@@ -10,12 +10,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <atomic>
 #include <cstdlib>
 #include <new>
 #include <numeric>
 #include <random>
+#include <set>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -280,6 +282,59 @@ TEST_F(SchedulerTest, PriorityQueuesServeTheTopQueueBeforeLowerOnes) {
       EXPECT_EQ(steps[1], 0);
     }
   }
+}
+
+// A pair's priority is measured once per run: f(e, g) with e its bodies'
+// mean eccentricity and g the distance of its root spheres' centres, in
+// pixels. With the paper's f (no cost) a pair's queue then never changes, so
+// no pair is stepped while a pair of a higher bin is unresolved. The bins are
+// computed here from Perception::gazeWeight (std::exp), independently of the
+// scheduler's own exp.
+TEST_F(SchedulerTest, PriorityQueuesBinEachPairOnceByItsRootsGap) {
+  // Pairs on the line of sight through the fixation (every body's weight 1)
+  // whose bodies are further apart down the list: the gap decides the bins,
+  // the highest last in the list.
+  build(rowAt({640, 640, 640, 640, 640, 640}), {1, 2, 3, 4, 5, 6});
+  for (std::size_t i = 0; i < tests_.size(); ++i) {
+    const Vec3 centre = atPixel(640, 360);
+    const Vec3 axis = Vec3::UnitZ();
+    const double distance = 0.3 * std::pow(1.6, static_cast<double>(i));
+    poses_[2 * i].position = centre - 0.5 * distance * axis;
+    poses_[2 * i + 1].position = centre + 0.5 * distance * axis;
+  }
+  resetAll();
+  camera_.setFixation(Vec2(640, 360));
+  constexpr int kQueues = 16;
+  std::vector<double> f(tests_.size());
+  for (std::size_t i = 0; i < tests_.size(); ++i) {
+    const Perception::GazeWeight a = camera_.gazeWeight(poses_[2 * i].position);
+    const Perception::GazeWeight b = camera_.gazeWeight(poses_[2 * i + 1].position);
+    const double g = (poses_[2 * i].apply(tree_.root().centre) - poses_[2 * i + 1].apply(tree_.root().centre)).norm();
+    f[i] = std::sqrt(a.weight * b.weight * a.px_per_metre * b.px_per_metre) * g;
+  }
+  const double fmax = *std::max_element(f.begin(), f.end());
+  std::vector<int> bin(tests_.size());
+  for (std::size_t i = 0; i < tests_.size(); ++i) {
+    bin[i] = std::clamp(kQueues + static_cast<int>(std::floor(std::log2(f[i] / fmax))), 0, kQueues - 1);
+  }
+  ASSERT_GE(std::set<int>(bin.begin(), bin.end()).size(), 3u);  // the bins have an order to keep
+
+  // Pairs take their first step by bin, highest first, and in list order in a bin.
+  std::vector<std::size_t> expected(tests_.size());
+  std::iota(expected.begin(), expected.end(), 0);
+  std::stable_sort(expected.begin(), expected.end(), [&](std::size_t x, std::size_t y) { return bin[x] > bin[y]; });
+  auto pq = makeScheduler(SchedulerOptions{SchedulerKind::PriorityQueues, kQueues, 2.0, 0.0});
+  std::vector<std::vector<int>> stops;
+  finishOrder(*pq, true, &stops);
+  std::vector<std::size_t> first_steps;
+  for (const auto& steps : stops) {
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+      if (steps[i] != 0 && std::find(first_steps.begin(), first_steps.end(), i) == first_steps.end()) {
+        first_steps.push_back(i);
+      }
+    }
+  }
+  EXPECT_EQ(first_steps, expected);
 }
 
 TEST_F(SchedulerTest, CostAwarePriorityGivesAFarPairItsCheapRootTestEarly) {
