@@ -47,8 +47,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace stc::detail {
 namespace {
@@ -57,11 +59,12 @@ namespace {
 // next PairTest coming: ask for it a few steps ahead (a step reads most of it).
 constexpr std::size_t kPrefetchAhead = 4;
 
-// The biased IEEE exponent of x >= 0 (0 for 0 and subnormals).
+// The biased IEEE exponent of x (0 for 0 and subnormals, 2047 for infinity
+// and NaN); the sign is dropped, so it always indexes a 2048-entry table.
 inline unsigned biasedExponent(double x) {
   std::uint64_t bits;
   std::memcpy(&bits, &x, sizeof bits);
-  return static_cast<unsigned>(bits >> 52);
+  return static_cast<unsigned>(bits >> 52) & 0x7FFu;
 }
 
 // 2^x for x <= 0 (0 below -1022), within 3e-13 of it and monotone, with no
@@ -210,16 +213,22 @@ void PriorityQueueScheduler::binAll(PairTest* tests, std::size_t count,
     const BodyGaze& a = gaze[of_pair[i][0]];
     const BodyGaze& b = gaze[of_pair[i][1]];
     const double f = a.root_scale * b.root_scale * (a.root_centre - b.root_centre).norm();
-    measured[k].priority = f;
-    reference = std::max(reference, f);
+    // Finite (and so is every share): a pose far enough out to overflow the
+    // gap is worth nothing to the eye.
+    measured[k].priority = f <= std::numeric_limits<double>::max() ? f : 0.0;
+    reference = std::max(reference, measured[k].priority);
   }
-  // Priorities from here on are shares of the largest.
-  const double inverse_reference = reference > 0.0 ? 1.0 / reference : 0.0;
+  // Priorities from here on are shares of the largest, in [0, 1]. A divide,
+  // not a multiply by 1 / reference: a subnormal largest (a far, small scene
+  // under a wide camera) has an infinite inverse, and 0 times that is a NaN
+  // with no bin (found by fuzz_gaze).
   Queued** const ends = ends_.data();
   for (std::size_t k = 0; k < n; ++k) {
-    Queued*& end = ends[binOf(measured[k].priority * inverse_reference)];
+    const double share = reference > 0.0 ? measured[k].priority / reference : 0.0;
+    assert(share >= 0.0 && share <= 1.0);
+    Queued*& end = ends[binOf(share)];
     end->test = tests + measured[k].pair;
-    end->share = measured[k].priority * inverse_reference;
+    end->share = share;
     ++end;
   }
 }

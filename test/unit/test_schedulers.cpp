@@ -14,6 +14,7 @@
 #include <array>
 #include <atomic>
 #include <cstdlib>
+#include <limits>
 #include <new>
 #include <numeric>
 #include <random>
@@ -30,6 +31,12 @@ void* operator new(std::size_t n) {
   g_allocations.fetch_add(1, std::memory_order_relaxed);
   if (void* p = std::malloc(n ? n : 1)) return p;
   throw std::bad_alloc();
+}
+// std::stable_sort's buffer comes from the nothrow form: it must come from
+// malloc too, as the delete above frees it (AddressSanitizer caught the mismatch).
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return std::malloc(n ? n : 1);
 }
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
@@ -369,6 +376,49 @@ TEST_F(SchedulerTest, CostAwarePriorityGivesAFarPairItsCheapRootTestEarly) {
   // Per sphere test: once the near pair's steps cost tens of tests, the far
   // pair's 1-test root step is worth more.
   EXPECT_TRUE(far_stepped_while_near_open(1.0));
+}
+
+// Found by fuzz_gaze: with every pair far off to the side of the fixation
+// the largest priority is subnormal, so 1 / fmax is infinite and a pair whose
+// priority underflowed to 0 got a share of 0 * inf = NaN, a bin past the
+// queues, and a write through a null queue end. Every pair must still be
+// queued and resolved as round-robin resolves it.
+TEST_F(SchedulerTest, PriorityQueuesServePairsWhoseLargestPriorityIsSubnormal) {
+  build(rowAt({640 + 72000, 640 + 80000}), {5, 6});
+  camera_.setFixation(Vec2(640, 360));
+  // log f, from Perception's pixels (not the scheduler's arithmetic): the
+  // weight exp(-e / 100) of the bodies' mean eccentricity, times pixels per
+  // metre, times the gap of the root centres.
+  auto log_priority = [&](std::size_t i) {
+    const Perception::GazeWeight a = camera_.gazeWeight(poses_[2 * i].position);
+    const Perception::GazeWeight b = camera_.gazeWeight(poses_[2 * i + 1].position);
+    const double mean_e = 0.5 * ((a.pixel - Vec2(640, 360)).norm() + (b.pixel - Vec2(640, 360)).norm());
+    const double g = (poses_[2 * i].apply(tree_.root().centre) - poses_[2 * i + 1].apply(tree_.root().centre)).norm();
+    return -mean_e / 100.0 + 0.5 * std::log(a.px_per_metre * b.px_per_metre) + std::log(g);
+  };
+  const double log_smallest_normal = std::log(std::numeric_limits<double>::min());
+  const double log_smallest_subnormal = std::log(std::numeric_limits<double>::denorm_min());
+  ASSERT_LT(log_priority(0), log_smallest_normal - 1.0);     // the largest is subnormal
+  ASSERT_GT(log_priority(0), log_smallest_subnormal + 1.0);  // but not 0
+  ASSERT_LT(log_priority(1), log_smallest_subnormal - 1.0);  // the other underflows to 0
+
+  auto rr = makeScheduler(SchedulerOptions{SchedulerKind::RoundRobin, 4, 4.0});
+  const ScheduleStats reference = runWith(*rr, Budget::unlimited());
+  std::vector<int> steps;
+  for (const PairTest& t : tests_) steps.push_back(t.stepsDone());
+  for (double ratio : {2.0, 8.0}) {
+    for (double cost_exponent : {0.0, 1.0}) {
+      auto pq = makeScheduler(SchedulerOptions{SchedulerKind::PriorityQueues, 16, ratio, cost_exponent});
+      const ScheduleStats stats = runWith(*pq, Budget::unlimited());
+      EXPECT_TRUE(stats.used_perception);
+      EXPECT_FALSE(stats.interrupted);
+      EXPECT_EQ(stats.sphere_tests, reference.sphere_tests) << ratio << " " << cost_exponent;
+      for (std::size_t i = 0; i < tests_.size(); ++i) {
+        EXPECT_TRUE(tests_[i].resolved()) << i;
+        EXPECT_EQ(tests_[i].stepsDone(), steps[i]) << i;
+      }
+    }
+  }
 }
 
 TEST_F(SchedulerTest, PerceptualSequentialFinishesInPriorityOrder) {
