@@ -7,7 +7,9 @@
 // Per tick: whole-tick thread CPU time (clock_gettime(CLOCK_THREAD_CPUTIME_ID))
 // and wall time; the phase split and what the narrow phase and the response got
 // (TickReport); solver passes. At the end: bodies with a non-finite state and
-// bodies outside the scene's bounds. Target: p99 whole tick <= 1.1 x budget.
+// bodies outside the scene's bounds (each named on stderr; --trace-escape
+// names them at every tick they are outside, from the first, with what that
+// tick did). Target: p99 whole tick <= 1.1 x budget.
 //
 // The budget runs on the thread's CPU clock by default (World::setClock), so
 // the other processes of a shared machine do not eat it; --wall-clock runs it
@@ -15,7 +17,7 @@
 //
 // Usage: bench_steady_frame_rate [--scene corner_drift|rockfall|all] [--entities N]
 //          [--tick-budget-ms 16.7] [--seconds 60] [--budget-off] [--wall-clock]
-//          [--markdown FILE]
+//          [--trace-escape] [--markdown FILE]
 #include "bench_args.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -57,7 +59,8 @@ bool finiteBody(const BodyState& b) {
          allFinite(b.linear_velocity) && allFinite(b.angular_velocity);
 }
 
-Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget, bool wall_clock) {
+Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget, bool wall_clock,
+             bool trace_escape) {
   WorldConfig config;
   config.scheduler.kind = SchedulerKind::PriorityQueues;
   SceneParams params;
@@ -95,6 +98,18 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
     run.unresolved_share.push_back(r.broad_pairs ? double(r.unresolved) / double(r.broad_pairs) : 0.0);
     run.interrupted += r.interrupted ? 1 : 0;
     if (i % 600 == 599) std::fprintf(stderr, "  %s: %d / %d ticks\n", run.scene.c_str(), i + 1, ticks);
+    if (trace_escape) {  // every tick a mover is outside: where, how fast, what the tick did
+      for (EntityId id : spec.movers) {
+        const BodyState& b = world.bodies()[*world.indexOf(id)];
+        if ((b.pose.position.array() < spec.bounds.min.array()).any() ||
+            (b.pose.position.array() > spec.bounds.max.array()).any()) {
+          std::fprintf(stderr, "  ESCAPE tick %d entity %u at (%.3f, %.3f, %.3f) v (%.3f, %.3f, %.3f) passes %d/%d unresolved %zu contacts %zu\n",
+                       i, static_cast<unsigned>(id), b.pose.position.x(), b.pose.position.y(), b.pose.position.z(),
+                       b.linear_velocity.x(), b.linear_velocity.y(), b.linear_velocity.z(), r.velocity_passes,
+                       r.position_passes, static_cast<std::size_t>(r.unresolved), static_cast<std::size_t>(r.contacts));
+        }
+      }
+    }
   }
   for (EntityId id : spec.movers) {
     const BodyState& b = world.bodies()[*world.indexOf(id)];
@@ -103,6 +118,9 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
     } else if ((b.pose.position.array() < spec.bounds.min.array()).any() ||
                (b.pose.position.array() > spec.bounds.max.array()).any()) {
       ++run.outside;
+      std::fprintf(stderr, "  %s: entity %u outside the bounds at (%.3f, %.3f, %.3f), |v| %.3f m/s\n",
+                   run.scene.c_str(), static_cast<unsigned>(id), b.pose.position.x(), b.pose.position.y(),
+                   b.pose.position.z(), b.linear_velocity.norm());
     }
   }
   return run;
@@ -125,7 +143,7 @@ int main(int argc, char** argv) {
   int entities = 0;
   double budget_ms = 16.7;
   double seconds = 60.0;
-  bool budget_off = false, wall_clock = false;
+  bool budget_off = false, wall_clock = false, trace_escape = false;
   std::string markdown;
   for (stc_bench::Args args(argc, argv); args.more();) {
     const std::string& a = args.flag();
@@ -135,6 +153,7 @@ int main(int argc, char** argv) {
     else if (a == "--seconds") seconds = std::stod(args.value());
     else if (a == "--budget-off") budget_off = true;
     else if (a == "--wall-clock") wall_clock = true;
+    else if (a == "--trace-escape") trace_escape = true;
     else if (a == "--markdown") markdown = args.value();
     else return args.unknown();
   }
@@ -151,7 +170,7 @@ int main(int argc, char** argv) {
   std::vector<Run> runs;
   for (const Case& c : cases) {
     std::fprintf(stderr, "%s %d: %.0f s simulated ...\n", toString(c.kind), c.entities, seconds);
-    runs.push_back(simulate(c.kind, c.entities, seconds, budget, wall_clock));
+    runs.push_back(simulate(c.kind, c.entities, seconds, budget, wall_clock, trace_escape));
   }
 
   std::string md;
