@@ -182,6 +182,39 @@ TEST(Response, FrictionIsBoundedByMuTimesTheNormalImpulse) {
   EXPECT_NEAR(slip.x(), 0.0, 1e-9);
 }
 
+TEST(Response, RollingResistanceIsACoupleBoundedByCTimesRTimesTheNormalImpulse) {
+  // Two free unit cubes (1 kg, I = 1/6) stacked along z, touching at the
+  // point between their centres (r = 0.5 each), closing at 1 m/s, spinning
+  // relative to each other; no friction and no bounce, so only the rolling
+  // resistance turns them: normal impulse 0.5 N s (the reduced mass, 0.5 kg,
+  // stopped), rolling limit c r N = 0.5 * 0.5 * 0.5 = 0.125 N m s.
+  for (const SolverKind kind : {SolverKind::Sequential, SolverKind::Jacobi}) {
+    for (const double c : {0.0, 0.5}) {
+      for (const double spin : {6.0, 0.5}) {  // the limit stops 0.125 * 12 = 1.5 rad/s of relative spin
+        std::vector<BodyState> bodies = {boxBody(1.0, Vec3::Ones()), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 1))};
+        bodies[1].linear_velocity = Vec3(0, 0, -1);
+        const Vec3 w_rel0 = spin * Vec3(2.0, -1.0, -2.0) / 3.0;
+        bodies[0].angular_velocity = Vec3(0.3, 0.2, 1.0);
+        bodies[1].angular_velocity = bodies[0].angular_velocity + w_rel0;
+        for (BodyState& b : bodies) b.material = Material{0.0, 0.0, 0.0, c};
+        const Vec3 p0 = linearMomentum(bodies), l0 = angularMomentum(bodies);
+        std::vector<Contact> contacts = {contactBetween(0, 1, Vec3(0, 0, 0.5), Vec3::UnitZ(), 0.0)};
+        ResponseOptions options;
+        options.solver = kind;
+        solveContacts(bodies, contacts, options, 0.01);
+        const std::string where = std::string(toString(kind)) + " c " + std::to_string(c) + " spin " +
+                                  std::to_string(spin);
+        EXPECT_NEAR(contacts[0].normal_impulse, 0.5, 1e-12) << where;
+        EXPECT_NEAR((linearMomentum(bodies) - p0).norm(), 0.0, 1e-12) << where;
+        EXPECT_NEAR((angularMomentum(bodies) - l0).norm(), 0.0, 1e-12) << where;  // a couple
+        const Vec3 w_rel = bodies[1].angular_velocity - bodies[0].angular_velocity;
+        const double stopped = c == 0.0 ? 0.0 : std::min(spin, 0.125 * 12.0);
+        EXPECT_NEAR((w_rel - w_rel0 * (1.0 - stopped / spin)).norm(), 0.0, 1e-9) << where;
+      }
+    }
+  }
+}
+
 TEST(Response, SplitImpulseRemovesPenetrationWithoutAddingVelocity) {
   std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 0.45))};
   std::vector<Contact> contacts;
