@@ -225,6 +225,7 @@ class ContactSolver {
   std::vector<std::uint32_t> adjacency_, queue_;
   std::vector<CachedPoint> cache_, next_cache_;
   std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // sorted by pair
+  std::vector<CachedManifold> merged_manifolds_;  // keepHeldManifolds' merge (swapped with next_manifolds_)
   // Colouring (contact_solver_colours.cpp): the manifolds in the order from
   // the ground (groups_, each one's first place in order_), their colours,
   // and in colour order where each colour's manifolds start.

@@ -135,7 +135,9 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   // allocation in a later tick whose waves or manifolds happen to be larger;
   // both warm-start buffers, as they swap every tick).
   wave_rows_.reserve(rows_.size());
-  for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_}) v->reserve(rows_.size());
+  for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_, &merged_manifolds_}) {
+    v->reserve(rows_.size());
+  }
   for (std::vector<CachedPoint>* v : {&cache_, &next_cache_}) v->reserve(rows_.size());
   for (std::size_t r = 0; r < order_.size(); ++r) {
     const std::uint32_t ci = order_[r];
@@ -657,6 +659,7 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
 void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
   const std::size_t solved = next_manifolds_.size();
   if (held_ids_ != nullptr && held_ != nullptr) {
+    std::size_t cursor = 0;  // both lists are sorted by pair: one walk finds the solved ones
     for (const CachedManifold& old : cache_manifolds_) {
       // Both bodies still there (a despawn moves indices: the ids must
       // match) and out of the solve, one of them asleep; tested first, so
@@ -668,7 +671,8 @@ void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
           (*held_ids_)[ib] != static_cast<EntityId>(old.pair & 0xffffffffu)) {
         continue;
       }
-      if (std::binary_search(next_manifolds_.begin(), next_manifolds_.begin() + solved, old, byPair)) {
+      while (cursor < solved && byPair(next_manifolds_[cursor], old)) ++cursor;
+      if (cursor < solved && next_manifolds_[cursor].pair == old.pair) {
         continue;  // solved this tick: its new impulses are kept
       }
       CachedManifold kept = old;
@@ -677,7 +681,12 @@ void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
       next_manifolds_.push_back(kept);
     }
     if (next_manifolds_.size() > solved) {
-      std::sort(next_manifolds_.begin(), next_manifolds_.end(), byPair);
+      // Two sorted runs (the solved, then the kept in cache order): merged,
+      // not sorted again (a pile mostly asleep keeps most of its manifolds).
+      merged_manifolds_.resize(next_manifolds_.size());
+      std::merge(next_manifolds_.begin(), next_manifolds_.begin() + solved, next_manifolds_.begin() + solved,
+                 next_manifolds_.end(), merged_manifolds_.begin(), byPair);
+      next_manifolds_.swap(merged_manifolds_);
     }
   }
   cache_.swap(next_cache_);
