@@ -146,6 +146,7 @@ class ContactSolver {
     double restitution = 0.0;
     double approach = 0.0;     // normal relative velocity before the solve (< 0: closing)
     double push = 0.0;         // split impulse: target normal pseudo-velocity
+    double push_mass = 0.0;    // 1 / effective mass along n of the bodies' translation alone
     double lambda_main = 0.0;  // normal impulse before restitution (what warm starts)
     double lambda_push = 0.0;
     double bounce_from = 0.0;  // normal velocity its bounce reverses (< 0), in its wave

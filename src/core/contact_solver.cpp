@@ -178,6 +178,8 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
       const double k_shock = (info.move_a ? ka : 0.0) + (info.move_b ? kb : 0.0);
       info.shock_mass[k] = k_shock > 0.0 ? 1.0 / k_shock : 0.0;
     }
+    const double k_translation = split_a * row.inv_ma + split_b * row.inv_mb;
+    info.push_mass = k_translation > 0.0 ? 1.0 / k_translation : 0.0;
     row.lambda[0] = row.lambda[1] = row.lambda[2] = 0.0;
     row.bounce_impulse = 0.0;
     row.friction = std::sqrt(std::max(0.0, ba.material.friction * bb.material.friction));
@@ -560,20 +562,28 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
   if (!any) return 0;
   const bool jacobi = options.solver == SolverKind::Jacobi;
   std::vector<Motion>& out = jacobi ? delta_ : pseudo_;
+  const bool turns = options.position_turns;
   const auto positionStep = [&](std::size_t r, Motion& out_a, Motion& out_b) {
     const Row& row = rows_[r];
     RowInfo& info = info_[r];
     const Motion& a = jacobi ? pseudo_[row.a] : out_a;  // Jacobi: pseudo_ untouched until the commit
     const Motion& b = jacobi ? pseudo_[row.b] : out_b;
-    const double vn = relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n);
+    // Translation alone (the default): the pass never turns a body, so it
+    // cannot set a resting one rocking (docs/sleeping.md).
+    const double vn = turns ? relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n) : (b.v - a.v).dot(row.n);
     // A contact that bounced across a speculative gap also closes the gap
     // (may pull): the bounce starts at the surface, not where the gap
     // was seen, so the rebound height does not gain up to |v| dt.
-    const double unclamped = info.lambda_push + row.mass[0] * (info.push - vn);
+    const double unclamped = info.lambda_push + (turns ? row.mass[0] : info.push_mass) * (info.push - vn);
     const double normal = info.bounced && info.push < 0.0 ? unclamped : std::max(0.0, unclamped);
     const double delta = normal - info.lambda_push;
     info.lambda_push = normal;
-    applyNormal(row, delta, out_a, out_b);
+    if (turns) {
+      applyNormal(row, delta, out_a, out_b);
+    } else {
+      out_a.v -= row.inv_ma * delta * row.n;
+      out_b.v += row.inv_mb * delta * row.n;
+    }
   };
   int passes = 0;
   for (int it = 0; it < options.iterations; ++it, ++passes) {

@@ -235,6 +235,34 @@ TEST(Response, SplitImpulseRemovesPenetrationWithoutAddingVelocity) {
   EXPECT_NEAR(bodies[1].pose.position.x(), 0.0, 1e-9);
 }
 
+TEST(Response, SplitImpulseMovesOutOfPenetrationWithoutTurningUnlessAskedTo) {
+  // One corner of a box 5 cm into the floor: the position pass lifts the
+  // box by translation alone (default), never turning it, which would set a
+  // resting body rocking by pseudo-velocities the velocity solve does not
+  // see; with position_turns it lifts and turns it (the pass before).
+  for (const bool turns : {false, true}) {
+    std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 0.45))};
+    std::vector<Contact> contacts = {contactBetween(0, 1, Vec3(0.5, 0.5, -0.05), Vec3::UnitZ(), -0.05)};
+    ResponseOptions options;
+    options.allowed_penetration = 0.01;
+    options.position_correction = 0.5;
+    options.position_turns = turns;
+    solveContacts(bodies, contacts, options, 0.01);
+    const BodyState& box = bodies[1];
+    EXPECT_EQ(box.linear_velocity, Vec3::Zero()) << "turns " << turns;  // pseudo-velocities are discarded
+    EXPECT_EQ(box.angular_velocity, Vec3::Zero()) << "turns " << turns;
+    const double turned = box.pose.orientation.angularDistance(Quat::Identity());
+    if (turns) {
+      EXPECT_GT(turned, 1e-3);
+      EXPECT_GT(box.pose.position.z(), 0.45);
+    } else {
+      EXPECT_EQ(turned, 0.0);
+      EXPECT_NEAR(box.pose.position.z(), 0.45 + 0.5 * (0.05 - 0.01), 1e-9);  // half the excess, at once
+      EXPECT_EQ(box.pose.position.x(), 0.0);
+    }
+  }
+}
+
 TEST(Response, SpeculativeGapLetsABodyCloseItButNotMore) {
   std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 0.52))};
   bodies[1].linear_velocity = Vec3(0, 0, -0.1);  // 1 mm per 10 ms tick, gap 20 mm: untouched
