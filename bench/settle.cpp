@@ -29,6 +29,8 @@
 //   --every    seconds between lines (default 5)
 //   (the timed window also prints its wall ms per tick by phase)
 //   --sleep-off  WorldConfig::sleeping.enabled = false (what the pile costs awake)
+//   --rolling C  every body's Material::rolling_resistance set to C after the
+//              scene is built (default: the scene's own)
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
@@ -51,6 +53,7 @@ struct Options {
   double seconds = 5.0;
   double every = 5.0;
   bool sleep_off = false;
+  double rolling = -1.0;  // < 0: the scene's
 };
 
 Options parse(int argc, char** argv) {
@@ -67,6 +70,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--seconds") o.seconds = std::stod(next());
     else if (a == "--every") o.every = std::stod(next());
     else if (a == "--sleep-off") o.sleep_off = true;
+    else if (a == "--rolling") o.rolling = std::stod(next());
     else throw InputError(a, "unknown option");
   }
   if (!(o.every > 0.0)) throw InputError("--every", "must be > 0");
@@ -243,11 +247,16 @@ int main(int argc, char** argv) {
     params.entities = opt.bodies;
     SceneWorld scene = makeSceneWorld(opt.scene, params, config);
     World& world = scene.world;
+    if (opt.rolling >= 0.0) {
+      for (BodyState& b : world.bodies()) b.material.rolling_resistance = opt.rolling;
+    }
     const SceneSpec& spec = scene.spec;
     const double dt = spec.dt;
-    std::printf("scene=%s bodies=%d dt=%.5f sleeping=%s (linear_speed %.3g m/s for %.3g s)\n",
+    double rolling = 0.0;
+    for (const BodyState& b : world.bodies()) rolling = std::max(rolling, b.material.rolling_resistance);
+    std::printf("scene=%s bodies=%d dt=%.5f sleeping=%s (linear_speed %.3g m/s for %.3g s) rolling_resistance=%.3g\n",
                 toString(opt.scene), opt.bodies, dt, opt.sleep_off ? "off" : "on", config.sleeping.linear_speed,
-                config.sleeping.time_to_sleep);
+                config.sleeping.time_to_sleep, rolling);
     Diagnosis diagnosis(world, spec);
     const int every = std::max(1, static_cast<int>(std::lround(opt.every / dt)));
     const int settle = static_cast<int>(std::lround(opt.settle / dt));

@@ -11,6 +11,13 @@ struct Material {
   // Contact impulse (N s, summed over a tick's contacts) the body takes
   // before it breaks (fracture.hpp); 0: unbreakable. Finite, >= 0.
   double strength = 0.0;
+  // Rolling (and spinning) resistance, dimensionless: a touching pair's
+  // angular impulse against the relative spin of its two bodies is held
+  // within this coefficient times the rolling radius times the pair's
+  // normal impulse (torque c_rr * r * N, as Box2D v3's rollingResistance);
+  // of a pair the larger coefficient counts (ContactSolver). 0: none (a
+  // ball rolls on for ever). In [0, 1].
+  double rolling_resistance = 0.0;
 };
 
 // Pose is of the body frame, whose origin is the centre of mass.

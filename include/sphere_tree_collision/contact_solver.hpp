@@ -121,6 +121,16 @@ class ContactSolver {
     double lambda[3] = {0.0, 0.0, 0.0};
     double bounce_impulse = 0.0;       // of all its restitution waves (before the solve)
   };
+  // Rolling resistance of one body pair (Material::rolling_resistance): an
+  // angular impulse on the two bodies' relative spin, held within
+  // `per_normal` times the pair's normal impulse. Solved after the pair's
+  // rows, in the velocity iterations.
+  struct Rolling {
+    Mat3 mass = Mat3::Zero();   // (I_a^-1 + I_b^-1)^-1, world frame
+    Mat3 inv_ia = Mat3::Zero(), inv_ib = Mat3::Zero();  // zero for a static body
+    double per_normal = 0.0;    // coefficient * rolling radius (m); 0: none
+    Vec3 lambda = Vec3::Zero(); // angular impulse so far (b gets +, a gets -)
+  };
   // One sequential-impulse step of a row (friction, then non-penetration)
   // on the velocities of its two bodies: the unit of work of a pass.
   static void relax(Row& row, Motion& a, Motion& b);
@@ -136,6 +146,7 @@ class ContactSolver {
     double restitution = 0.0;
     double approach = 0.0;     // normal relative velocity before the solve (< 0: closing)
     double push = 0.0;         // split impulse: target normal pseudo-velocity
+    double push_mass = 0.0;    // 1 / effective mass along n of the bodies' translation alone
     double lambda_main = 0.0;  // normal impulse before restitution (what warm starts)
     double lambda_push = 0.0;
     double bounce_from = 0.0;  // normal velocity its bounce reverses (< 0), in its wave
@@ -155,6 +166,7 @@ class ContactSolver {
     std::uint64_t pair = 0;              // entity ids a, b packed: the sort key
     std::uint32_t first = 0, count = 0;  // its points in cache_
     std::uint32_t index_a = 0, index_b = 0;  // the bodies' dense indices when it was solved
+    Vec3 rolling = Vec3::Zero();             // its rolling-resistance impulse, world frame
   };
   static bool byPair(const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; }
   // Into the next cache (after the solved manifolds): last tick's manifolds
@@ -181,6 +193,13 @@ class ContactSolver {
   // never is: colours do not hold it apart).
   template <typename Step>
   void overManifolds(std::size_t first, std::size_t end, std::vector<Motion>& motion, Step&& step);
+  // The same, then after(m, a, b) once a manifold m's rows are done.
+  template <typename Step, typename After>
+  void overManifolds(std::size_t first, std::size_t end, std::vector<Motion>& motion, Step&& step,
+                     After&& after);
+  // Fills rolling_ (after the rows); any_rolling_ when a pair resists.
+  void prepareRolling(const std::vector<BodyState>& bodies, bool jacobi);
+  double normalImpulse(std::size_t manifold) const;  // its rows' normal impulses so far, bounces included
   void warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
                  SolveStats& stats);
   void commitJacobi(std::vector<Motion>& motion);
@@ -194,6 +213,8 @@ class ContactSolver {
 
   std::vector<Row> rows_;
   std::vector<RowInfo> info_;
+  std::vector<Rolling> rolling_;  // by manifold (filled only when any_rolling_)
+  bool any_rolling_ = false;
   std::vector<std::uint32_t> manifold_start_;  // rows of one body pair: [start[m], start[m + 1])
   std::vector<ColourGroup> manifolds_;         // each manifold's movable bodies (kStatic: static)
   std::vector<std::uint32_t> order_, active_, level_start_, wave_rows_;
@@ -205,6 +226,7 @@ class ContactSolver {
   std::vector<std::uint32_t> adjacency_, queue_;
   std::vector<CachedPoint> cache_, next_cache_;
   std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // sorted by pair
+  std::vector<CachedManifold> merged_manifolds_;  // keepHeldManifolds' merge (swapped with next_manifolds_)
   // Colouring (contact_solver_colours.cpp): the manifolds in the order from
   // the ground (groups_, each one's first place in order_), their colours,
   // and in colour order where each colour's manifolds start.

@@ -30,7 +30,8 @@ void validateGravity(const Vec3& gravity, const PhysicalLimits& limits);
 // Throws InputError naming the field and the limit: "pose.orientation" (not
 // a unit quaternion within 1e-3), "pose.position" (not finite or beyond world_extent), "linear_velocity" (max_speed), "angular_velocity"
 // (max_spin), "density" (min_density..max_density), "material.restitution"
-// ([0, 1]), "material.friction" ([0, max_friction]).
+// ([0, 1]), "material.friction" ([0, max_friction]),
+// "material.rolling_resistance" ([0, 1]).
 void validateBodyInput(const Pose& pose, const Vec3& linear_velocity, const Vec3& angular_velocity,
                        double density, const Material& material, const PhysicalLimits& limits);
 

@@ -25,6 +25,11 @@ struct ResponseOptions {
   // speculative gap in one or two ticks, and bouncing on that would never settle.
   double restitution_threshold = 0.2;
   double position_correction = 0.2;     // fraction of penetration removed per tick, [0, 1]
+  // The split-impulse position pass moves bodies out of penetration by
+  // translation alone (false), or by translation and rotation (true: the
+  // pass before; a pile's rocks then kept rocking in place, turned by
+  // pseudo-velocities the velocity solve never sees; docs/sleeping.md).
+  bool position_turns = false;
   double allowed_penetration = 0.0;     // metres kept as slop (0: 2% of the contact's gap bound h_a + h_b)
   SolverKind solver = SolverKind::Sequential;
   bool warm_starting = true;            // start from last tick's impulses of matching contacts

@@ -82,6 +82,21 @@ STC_HOT_INLINE void relaxRow(ContactSolver::Row& row, ContactSolver::Motion& a, 
   applyNormal(row, dn, a, b);
 }
 
+// One step of a pair's rolling resistance: the angular impulse that stops
+// the bodies' relative spin, its sum held within per_normal times the
+// pair's normal impulse so far (a ball of the cone, as friction's).
+STC_HOT_INLINE void rollingStep(ContactSolver::Rolling& roll, double normal, const Vec3& wa, const Vec3& wb,
+                                ContactSolver::Motion& out_a, ContactSolver::Motion& out_b) {
+  const double limit = roll.per_normal * normal;
+  Vec3 lambda = roll.lambda - roll.mass * (wb - wa);
+  const double norm = lambda.norm();
+  if (norm > limit) lambda *= norm > 0.0 ? limit / norm : 0.0;
+  const Vec3 delta = lambda - roll.lambda;
+  roll.lambda = lambda;
+  out_a.w -= roll.inv_ia * delta;
+  out_b.w += roll.inv_ib * delta;
+}
+
 }  // namespace
 
 void ContactSolver::relax(Row& row, Motion& a, Motion& b) { relaxRow(row, a, b); }
@@ -120,7 +135,9 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   // allocation in a later tick whose waves or manifolds happen to be larger;
   // both warm-start buffers, as they swap every tick).
   wave_rows_.reserve(rows_.size());
-  for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_}) v->reserve(rows_.size());
+  for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_, &merged_manifolds_}) {
+    v->reserve(rows_.size());
+  }
   for (std::vector<CachedPoint>* v : {&cache_, &next_cache_}) v->reserve(rows_.size());
   for (std::size_t r = 0; r < order_.size(); ++r) {
     const std::uint32_t ci = order_[r];
@@ -161,6 +178,8 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
       const double k_shock = (info.move_a ? ka : 0.0) + (info.move_b ? kb : 0.0);
       info.shock_mass[k] = k_shock > 0.0 ? 1.0 / k_shock : 0.0;
     }
+    const double k_translation = split_a * row.inv_ma + split_b * row.inv_mb;
+    info.push_mass = k_translation > 0.0 ? 1.0 / k_translation : 0.0;
     row.lambda[0] = row.lambda[1] = row.lambda[2] = 0.0;
     row.bounce_impulse = 0.0;
     row.friction = std::sqrt(std::max(0.0, ba.material.friction * bb.material.friction));
@@ -180,6 +199,44 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   }
   stats.contacts = rows_.size();
   stats.manifolds = manifold_start_.size() - 1;
+  prepareRolling(bodies, jacobi);
+}
+
+// A pair resists rolling with the larger coefficient of its two materials,
+// over a rolling radius: the mean over its points of the distance from the
+// point to the nearer centre of mass of a movable body (a ball's radius; a
+// rock's, where it touches). Box2D v3 takes the larger coefficient too.
+void ContactSolver::prepareRolling(const std::vector<BodyState>& bodies, bool jacobi) {
+  any_rolling_ = false;
+  const std::size_t manifolds = manifold_start_.size() - 1;
+  if (rolling_.size() < manifolds) rolling_.resize(manifolds);
+  for (std::size_t m = 0; m < manifolds; ++m) {
+    Rolling& roll = rolling_[m];
+    roll.lambda.setZero();
+    roll.per_normal = 0.0;
+    const std::uint32_t begin = manifold_start_[m], stop = manifold_start_[m + 1];
+    const BodyState& ba = bodies[rows_[begin].a];
+    const BodyState& bb = bodies[rows_[begin].b];
+    const double coefficient = std::max(ba.material.rolling_resistance, bb.material.rolling_resistance);
+    if (!(coefficient > 0.0)) continue;
+    roll.inv_ia = ba.is_static ? Mat3::Zero() : ba.inv_inertia_world;
+    roll.inv_ib = bb.is_static ? Mat3::Zero() : bb.inv_inertia_world;
+    // Mass splitting (Jacobi), as the rows: each body counts once per contact on it.
+    const double split_a = jacobi ? std::max(1, contact_count_[rows_[begin].a]) : 1.0;
+    const double split_b = jacobi ? std::max(1, contact_count_[rows_[begin].b]) : 1.0;
+    const Mat3 k = split_a * roll.inv_ia + split_b * roll.inv_ib;
+    if (!(std::abs(k.determinant()) > 0.0)) continue;
+    roll.mass = k.inverse();
+    double radius = 0.0;
+    for (std::uint32_t r = begin; r < stop; ++r) {
+      double nearer = std::numeric_limits<double>::infinity();
+      if (!ba.is_static) nearer = std::min(nearer, rows_[r].ra.norm());
+      if (!bb.is_static) nearer = std::min(nearer, rows_[r].rb.norm());
+      radius += nearer;
+    }
+    roll.per_normal = coefficient * radius / (stop - begin);
+    any_rolling_ = any_rolling_ || roll.per_normal > 0.0;
+  }
 }
 
 // Gauss-Seidel converges fastest on a stack when the support is solved
@@ -244,6 +301,12 @@ int ContactSolver::levelOf(const Contact& c) const { return std::min(depth_[c.in
 
 template <typename Step>
 void ContactSolver::overManifolds(std::size_t first, std::size_t end, std::vector<Motion>& motion, Step&& step) {
+  overManifolds(first, end, motion, step, [](std::size_t, Motion&, Motion&) {});
+}
+
+template <typename Step, typename After>
+void ContactSolver::overManifolds(std::size_t first, std::size_t end, std::vector<Motion>& motion, Step&& step,
+                                  After&& after) {
   for (std::size_t m = first; m < end; ++m) {
     const std::uint32_t begin = manifold_start_[m];
     const std::uint32_t stop = manifold_start_[m + 1];
@@ -252,6 +315,7 @@ void ContactSolver::overManifolds(std::size_t first, std::size_t end, std::vecto
     Motion a = motion[ia];
     Motion b = motion[ib];
     for (std::uint32_t r = begin; r < stop; ++r) step(r, a, b);
+    after(m, a, b);
     if (manifolds_[m].a != ColourGroup::kStatic) motion[ia] = a;
     if (manifolds_[m].b != ColourGroup::kStatic) motion[ib] = b;
   }
@@ -303,6 +367,12 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
     const auto found = std::lower_bound(cache_manifolds_.begin(), cache_manifolds_.end(), key,
                                         [](const CachedManifold& x, std::uint64_t k) { return x.pair < k; });
     if (found == cache_manifolds_.end() || found->pair != key) continue;
+    if (any_rolling_ && rolling_[m].per_normal > 0.0) {
+      Rolling& roll = rolling_[m];
+      roll.lambda = found->rolling;
+      motion_[rows_[first].a].w -= roll.inv_ia * roll.lambda;
+      motion_[rows_[first].b].w += roll.inv_ib * roll.lambda;
+    }
     const CachedPoint* old = cache_.data() + found->first;
     const std::uint32_t old_count = found->count;
     std::uint32_t used = 0;  // bit j: old point j taken (at most 16 points a pair)
@@ -374,18 +444,48 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
       applyNormal(row, normal - row.lambda[0], delta_a, delta_b);
       row.lambda[0] = normal;
     };
+    const auto jacobiRolling = [&](std::size_t m, Motion& delta_a, Motion& delta_b) {
+      Rolling& roll = rolling_[m];
+      if (roll.per_normal == 0.0) return;
+      const std::uint32_t begin = manifold_start_[m];
+      rollingStep(roll, normalImpulse(m), motion_[rows_[begin].a].w, motion_[rows_[begin].b].w, delta_a, delta_b);
+    };
     for (int it = 0; it < passes; ++it) {
-      forEachColour([&](std::size_t first, std::size_t end) { overManifolds(first, end, delta_, jacobiStep); });
+      forEachColour([&](std::size_t first, std::size_t end) {
+        if (any_rolling_) {
+          overManifolds(first, end, delta_, jacobiStep, jacobiRolling);
+        } else {
+          overManifolds(first, end, delta_, jacobiStep);
+        }
+      });
       commitJacobi(motion_);
     }
     return;
   }
   // Sequential: the rows of one body pair in a row, on local copies of the
-  // two bodies' velocities.
+  // two bodies' velocities, then the pair's rolling resistance.
   const auto relaxStep = [&](std::size_t r, Motion& a, Motion& b) { relaxRow(rows_[r], a, b); };
+  const auto relaxRolling = [&](std::size_t m, Motion& a, Motion& b) {
+    Rolling& roll = rolling_[m];
+    if (roll.per_normal != 0.0) rollingStep(roll, normalImpulse(m), a.w, b.w, a, b);
+  };
   for (int it = 0; it < passes; ++it) {
-    forEachColour([&](std::size_t first, std::size_t end) { overManifolds(first, end, motion_, relaxStep); });
+    forEachColour([&](std::size_t first, std::size_t end) {
+      if (any_rolling_) {
+        overManifolds(first, end, motion_, relaxStep, relaxRolling);
+      } else {
+        overManifolds(first, end, motion_, relaxStep);
+      }
+    });
   }
+}
+
+double ContactSolver::normalImpulse(std::size_t m) const {
+  double sum = 0.0;
+  for (std::uint32_t r = manifold_start_[m]; r < manifold_start_[m + 1]; ++r) {
+    sum += rows_[r].lambda[0] + rows_[r].bounce_impulse;
+  }
+  return sum;
 }
 
 // Restitution before the solve, as collisions (Guendelman et al. 2003): wave
@@ -462,20 +562,28 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
   if (!any) return 0;
   const bool jacobi = options.solver == SolverKind::Jacobi;
   std::vector<Motion>& out = jacobi ? delta_ : pseudo_;
+  const bool turns = options.position_turns;
   const auto positionStep = [&](std::size_t r, Motion& out_a, Motion& out_b) {
     const Row& row = rows_[r];
     RowInfo& info = info_[r];
     const Motion& a = jacobi ? pseudo_[row.a] : out_a;  // Jacobi: pseudo_ untouched until the commit
     const Motion& b = jacobi ? pseudo_[row.b] : out_b;
-    const double vn = relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n);
+    // Translation alone (the default): the pass never turns a body, so it
+    // cannot set a resting one rocking (docs/sleeping.md).
+    const double vn = turns ? relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n) : (b.v - a.v).dot(row.n);
     // A contact that bounced across a speculative gap also closes the gap
     // (may pull): the bounce starts at the surface, not where the gap
     // was seen, so the rebound height does not gain up to |v| dt.
-    const double unclamped = info.lambda_push + row.mass[0] * (info.push - vn);
+    const double unclamped = info.lambda_push + (turns ? row.mass[0] : info.push_mass) * (info.push - vn);
     const double normal = info.bounced && info.push < 0.0 ? unclamped : std::max(0.0, unclamped);
     const double delta = normal - info.lambda_push;
     info.lambda_push = normal;
-    applyNormal(row, delta, out_a, out_b);
+    if (turns) {
+      applyNormal(row, delta, out_a, out_b);
+    } else {
+      out_a.v -= row.inv_ma * delta * row.n;
+      out_b.v += row.inv_mb * delta * row.n;
+    }
   };
   int passes = 0;
   for (int it = 0; it < options.iterations; ++it, ++passes) {
@@ -551,6 +659,7 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
       next_cache_.push_back(point);
     }
     manifold.count = static_cast<std::uint32_t>(next_cache_.size()) - manifold.first;
+    if (any_rolling_) manifold.rolling = rolling_[m].lambda;
     next_manifolds_.push_back(manifold);
   }
   std::sort(next_manifolds_.begin(), next_manifolds_.end(), byPair);
@@ -560,6 +669,7 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
 void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
   const std::size_t solved = next_manifolds_.size();
   if (held_ids_ != nullptr && held_ != nullptr) {
+    std::size_t cursor = 0;  // both lists are sorted by pair: one walk finds the solved ones
     for (const CachedManifold& old : cache_manifolds_) {
       // Both bodies still there (a despawn moves indices: the ids must
       // match) and out of the solve, one of them asleep; tested first, so
@@ -571,7 +681,8 @@ void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
           (*held_ids_)[ib] != static_cast<EntityId>(old.pair & 0xffffffffu)) {
         continue;
       }
-      if (std::binary_search(next_manifolds_.begin(), next_manifolds_.begin() + solved, old, byPair)) {
+      while (cursor < solved && byPair(next_manifolds_[cursor], old)) ++cursor;
+      if (cursor < solved && next_manifolds_[cursor].pair == old.pair) {
         continue;  // solved this tick: its new impulses are kept
       }
       CachedManifold kept = old;
@@ -580,7 +691,12 @@ void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
       next_manifolds_.push_back(kept);
     }
     if (next_manifolds_.size() > solved) {
-      std::sort(next_manifolds_.begin(), next_manifolds_.end(), byPair);
+      // Two sorted runs (the solved, then the kept in cache order): merged,
+      // not sorted again (a pile mostly asleep keeps most of its manifolds).
+      merged_manifolds_.resize(next_manifolds_.size());
+      std::merge(next_manifolds_.begin(), next_manifolds_.begin() + solved, next_manifolds_.begin() + solved,
+                 next_manifolds_.end(), merged_manifolds_.begin(), byPair);
+      next_manifolds_.swap(merged_manifolds_);
     }
   }
   cache_.swap(next_cache_);

@@ -81,6 +81,9 @@ void validateBodyInput(const Pose& pose, const Vec3& linear_velocity, const Vec3
     throw InputError("material.friction", number(material.friction) + " is outside [0, max_friction = " +
                                               number(limits.max_friction) + "]");
   }
+  if (!(material.rolling_resistance >= 0.0 && material.rolling_resistance <= 1.0)) {
+    throw InputError("material.rolling_resistance", "must be in [0, 1], got " + number(material.rolling_resistance));
+  }
   if (!(std::isfinite(material.strength) && material.strength >= 0.0)) {
     throw InputError("material.strength", "must be finite and >= 0 N s (0: unbreakable), got " +
                                               number(material.strength));

@@ -1,6 +1,8 @@
 // World: owns shapes, trees, entities and the phases of one tick.
 #include "sphere_tree_collision/world.hpp"
 
+#include "flat_hash_map.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -69,6 +71,7 @@ World::World(const WorldConfig& config)
     : config_(config),
       workers_(config.threads),
       narrow_chunks_(makeNarrowChunks(static_cast<std::size_t>(workers_.threads()), config.scheduler)) {
+  index_of_ = std::make_unique<detail::FlatHashMap>();
   validateLimits(config_.limits);
   validateGravity(config_.gravity, config_.limits);
   validateFractureOptions(config_.fracture);
@@ -167,7 +170,7 @@ EntityId World::addEntity(const EntitySpec& spec) {
   body_shapes_.push_back(spec.shape);
   box_modes_.push_back(mode);
   names_.push_back(spec.name);
-  index_of_.emplace(id, index);
+  index_of_->set(id, static_cast<std::uint32_t>(index));
   if (!spec.name.empty()) id_by_name_.emplace(spec.name, id);
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
   islands_.add(info.bounding_radius);
@@ -177,26 +180,26 @@ EntityId World::addEntity(const EntitySpec& spec) {
 }
 
 bool World::removeEntity(EntityId id) {
-  const auto it = index_of_.find(id);
-  if (it == index_of_.end()) return false;
-  const std::size_t index = it->second;
+  const std::uint32_t found = index_of_->find(id);
+  if (found == detail::FlatHashMap::kMissing) return false;
+  const std::size_t index = found;
   const std::size_t last = ids_.size() - 1;
   for (const BroadPair& pair : broad_phase_.pairs()) {  // what it touched loses it: wakes
     if (pair.first != id && pair.second != id) continue;
-    const auto other = index_of_.find(pair.first == id ? pair.second : pair.first);
-    if (other != index_of_.end()) islands_.wake(other->second);  // end: removed since the last update
+    const std::uint32_t other = index_of_->find(pair.first == id ? pair.second : pair.first);
+    if (other != detail::FlatHashMap::kMissing) islands_.wake(other);  // missing: removed since the last update
   }
   islands_.remove(index, last);
   broad_phase_.remove(id);
   if (!names_[index].empty()) id_by_name_.erase(names_[index]);
-  index_of_.erase(it);
+  index_of_->erase(id);
   if (index != last) {  // swap-remove keeps the arrays dense
     ids_[index] = ids_[last];
     bodies_[index] = bodies_[last];
     body_shapes_[index] = body_shapes_[last];
     box_modes_[index] = box_modes_[last];
     names_[index] = std::move(names_[last]);
-    index_of_[ids_[index]] = index;
+    index_of_->set(ids_[index], static_cast<std::uint32_t>(index));
   }
   ids_.pop_back();
   bodies_.pop_back();
@@ -214,9 +217,9 @@ std::optional<EntityId> World::findByName(const std::string& name) const {
 }
 
 std::optional<std::size_t> World::indexOf(EntityId id) const {
-  const auto it = index_of_.find(id);
-  if (it == index_of_.end()) return std::nullopt;
-  return it->second;
+  const std::uint32_t found = index_of_->find(id);
+  if (found == detail::FlatHashMap::kMissing) return std::nullopt;
+  return static_cast<std::size_t>(found);
 }
 
 void World::clear() {
@@ -225,7 +228,7 @@ void World::clear() {
   body_shapes_.clear();
   box_modes_.clear();
   names_.clear();
-  index_of_.clear();
+  *index_of_ = detail::FlatHashMap();
   id_by_name_.clear();
   broad_phase_ = SweepAndPrune();
   islands_.clear();
@@ -420,8 +423,8 @@ bool World::setUpPairTests() {
   if (islands_.quiet()) return false;  // all asleep: every pair is held-held or held-static
   bool woke = false;
   for (const BroadPair& pair : broad_phase_.pairs()) {
-    const std::size_t ia = index_of_.find(pair.first)->second;
-    const std::size_t ib = index_of_.find(pair.second)->second;
+    const std::size_t ia = index_of_->find(pair.first);
+    const std::size_t ib = index_of_->find(pair.second);
     woke |= islands_.noteOverlap(static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib), bodies_);
     if (bodies_[ia].is_static && bodies_[ib].is_static) continue;  // nothing can change (or asleep)
     pair_bodies_[pair_count_] = {static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib)};

@@ -117,7 +117,7 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   checkKeys(node, p,
             {"name", "preset", "resolution", "voxel_size", "seed", "position", "orientation", "velocity",
              "angular_velocity", "density", "restitution", "friction", "color", "static", "box_mode",
-             "repeat", "mesh_resource", "scale", "strength", "up_axis"});
+             "repeat", "mesh_resource", "scale", "strength", "rolling_resistance", "up_axis"});
   EntityRequest r;
   if (node["mesh_resource"]) {
     r.mesh_resource = readString(node["mesh_resource"], p + "mesh_resource");
@@ -150,6 +150,9 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   if (node["restitution"]) r.spec.material.restitution = readDouble(node["restitution"], p + "restitution");
   if (node["friction"]) r.spec.material.friction = readDouble(node["friction"], p + "friction");
   if (node["strength"]) r.spec.material.strength = readDouble(node["strength"], p + "strength");
+  if (node["rolling_resistance"]) {
+    r.spec.material.rolling_resistance = readDouble(node["rolling_resistance"], p + "rolling_resistance");
+  }
   if (node["color"]) r.color = readColor(node["color"], p + "color");
   if (node["static"]) r.spec.is_static = readBool(node["static"], p + "static");
   if (node["box_mode"]) {
@@ -202,7 +205,7 @@ std::string sceneKeyOf(const std::string& field) {
       {"pose.position", "position"},        {"pose.orientation", "orientation"},
       {"linear_velocity", "velocity"},      {"material.restitution", "restitution"},
       {"material.friction", "friction"},    {"dims", "resolution"},
-      {"material.strength", "strength"}};
+      {"material.strength", "strength"},    {"material.rolling_resistance", "rolling_resistance"}};
   const auto it = kKeys.find(field);
   return it == kKeys.end() ? field : it->second;
 }

@@ -182,6 +182,39 @@ TEST(Response, FrictionIsBoundedByMuTimesTheNormalImpulse) {
   EXPECT_NEAR(slip.x(), 0.0, 1e-9);
 }
 
+TEST(Response, RollingResistanceIsACoupleBoundedByCTimesRTimesTheNormalImpulse) {
+  // Two free unit cubes (1 kg, I = 1/6) stacked along z, touching at the
+  // point between their centres (r = 0.5 each), closing at 1 m/s, spinning
+  // relative to each other; no friction and no bounce, so only the rolling
+  // resistance turns them: normal impulse 0.5 N s (the reduced mass, 0.5 kg,
+  // stopped), rolling limit c r N = 0.5 * 0.5 * 0.5 = 0.125 N m s.
+  for (const SolverKind kind : {SolverKind::Sequential, SolverKind::Jacobi}) {
+    for (const double c : {0.0, 0.5}) {
+      for (const double spin : {6.0, 0.5}) {  // the limit stops 0.125 * 12 = 1.5 rad/s of relative spin
+        std::vector<BodyState> bodies = {boxBody(1.0, Vec3::Ones()), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 1))};
+        bodies[1].linear_velocity = Vec3(0, 0, -1);
+        const Vec3 w_rel0 = spin * Vec3(2.0, -1.0, -2.0) / 3.0;
+        bodies[0].angular_velocity = Vec3(0.3, 0.2, 1.0);
+        bodies[1].angular_velocity = bodies[0].angular_velocity + w_rel0;
+        for (BodyState& b : bodies) b.material = Material{0.0, 0.0, 0.0, c};
+        const Vec3 p0 = linearMomentum(bodies), l0 = angularMomentum(bodies);
+        std::vector<Contact> contacts = {contactBetween(0, 1, Vec3(0, 0, 0.5), Vec3::UnitZ(), 0.0)};
+        ResponseOptions options;
+        options.solver = kind;
+        solveContacts(bodies, contacts, options, 0.01);
+        const std::string where = std::string(toString(kind)) + " c " + std::to_string(c) + " spin " +
+                                  std::to_string(spin);
+        EXPECT_NEAR(contacts[0].normal_impulse, 0.5, 1e-12) << where;
+        EXPECT_NEAR((linearMomentum(bodies) - p0).norm(), 0.0, 1e-12) << where;
+        EXPECT_NEAR((angularMomentum(bodies) - l0).norm(), 0.0, 1e-12) << where;  // a couple
+        const Vec3 w_rel = bodies[1].angular_velocity - bodies[0].angular_velocity;
+        const double stopped = c == 0.0 ? 0.0 : std::min(spin, 0.125 * 12.0);
+        EXPECT_NEAR((w_rel - w_rel0 * (1.0 - stopped / spin)).norm(), 0.0, 1e-9) << where;
+      }
+    }
+  }
+}
+
 TEST(Response, SplitImpulseRemovesPenetrationWithoutAddingVelocity) {
   std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 0.45))};
   std::vector<Contact> contacts;
@@ -200,6 +233,34 @@ TEST(Response, SplitImpulseRemovesPenetrationWithoutAddingVelocity) {
   EXPECT_EQ(kineticEnergy(bodies[1]), 0.0);
   EXPECT_NEAR(bodies[1].pose.position.z(), 0.45 + 0.5 * (0.05 - 0.01), 1e-6);
   EXPECT_NEAR(bodies[1].pose.position.x(), 0.0, 1e-9);
+}
+
+TEST(Response, SplitImpulseMovesOutOfPenetrationWithoutTurningUnlessAskedTo) {
+  // One corner of a box 5 cm into the floor: the position pass lifts the
+  // box by translation alone (default), never turning it, which would set a
+  // resting body rocking by pseudo-velocities the velocity solve does not
+  // see; with position_turns it lifts and turns it (the pass before).
+  for (const bool turns : {false, true}) {
+    std::vector<BodyState> bodies = {staticBody(), boxBody(1.0, Vec3::Ones(), Vec3(0, 0, 0.45))};
+    std::vector<Contact> contacts = {contactBetween(0, 1, Vec3(0.5, 0.5, -0.05), Vec3::UnitZ(), -0.05)};
+    ResponseOptions options;
+    options.allowed_penetration = 0.01;
+    options.position_correction = 0.5;
+    options.position_turns = turns;
+    solveContacts(bodies, contacts, options, 0.01);
+    const BodyState& box = bodies[1];
+    EXPECT_EQ(box.linear_velocity, Vec3::Zero()) << "turns " << turns;  // pseudo-velocities are discarded
+    EXPECT_EQ(box.angular_velocity, Vec3::Zero()) << "turns " << turns;
+    const double turned = box.pose.orientation.angularDistance(Quat::Identity());
+    if (turns) {
+      EXPECT_GT(turned, 1e-3);
+      EXPECT_GT(box.pose.position.z(), 0.45);
+    } else {
+      EXPECT_EQ(turned, 0.0);
+      EXPECT_NEAR(box.pose.position.z(), 0.45 + 0.5 * (0.05 - 0.01), 1e-9);  // half the excess, at once
+      EXPECT_EQ(box.pose.position.x(), 0.0);
+    }
+  }
 }
 
 TEST(Response, SpeculativeGapLetsABodyCloseItButNotMore) {

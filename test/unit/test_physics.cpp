@@ -154,5 +154,94 @@ TEST(Physics, SlidingCubeStopsAfterVSquaredOverTwoMuG) {
   EXPECT_NEAR(steps * dt, v0 / (mu * kG), 0.05 * v0 / (mu * kG));
 }
 
+// Flat ground for a ball: a plate's voxels give it bumps (its leaf spheres)
+// that would hold and shake a rolling ball, so the ground is the top of a
+// static ball of radius 1 km centred 1 km below z = 0 (over 2 m it drops 2 mm).
+void addRoundGround(World& w, const Material& m) {
+  const ShapeId globe = preset(w, "sphere", 8, 250.0);
+  EntitySpec ground;
+  ground.shape = globe;
+  ground.is_static = true;
+  ground.material = m;
+  ground.pose.position = Vec3(0.0, 0.0, -1000.0);
+  w.addEntity(ground);
+}
+
+// A ball (0.2 m, the sphere preset) on the ground, rolling along +x at v0
+// without slipping (w = v0 / r about +y), under gravity g (which may lean
+// along x: a slope). Returns the world; the ball is entity 1.
+World rollingBall(double rolling_resistance, const Vec3& gravity, double v0, double start) {
+  WorldConfig config;
+  config.gravity = gravity;
+  World w(config);
+  const double radius = 0.2;
+  Material m{0.0, 0.8};
+  m.rolling_resistance = rolling_resistance;
+  addRoundGround(w, m);
+  const ShapeId ball = preset(w, "sphere", 8, 0.05);
+  EntitySpec s = body(ball, Vec3(start, 0.0, radius), Vec3(v0, 0.0, 0.0), m);
+  s.angular_velocity = Vec3(0.0, v0 / radius, 0.0);
+  w.addEntity(s);
+  return w;
+}
+
+TEST(Physics, BallRollsOnWithoutRollingResistance) {
+  const double v0 = 1.0, start = -1.2, dt = 1.0 / 120.0;
+  World w = rollingBall(0.0, Vec3(0.0, 0.0, -kG), v0, start);
+  const double e0 = kineticEnergy(w.bodies()[1]);
+  double path = 0.0;  // what the stored velocity adds up to
+  for (int i = 0; i < 240; ++i) {
+    w.step(dt, Budget::unlimited());
+    path += w.bodies()[1].linear_velocity.x() * dt;
+  }
+  const BodyState& b = w.bodies()[1];
+  EXPECT_GT(b.linear_velocity.x(), 0.97 * v0);
+  EXPECT_GT(kineticEnergy(b), 0.95 * e0);
+  // Still rolling, not sliding (w r within 4 %: the contact point sits a
+  // little inside the ball, so it rolls on a slightly smaller radius).
+  EXPECT_NEAR(b.angular_velocity.y() * 0.2, b.linear_velocity.x(), 0.04 * v0);
+  EXPECT_NEAR(b.pose.position.x() - start, path, 0.01);                      // stored velocity = motion
+  EXPECT_GT(b.pose.position.x() - start, 1.9 * v0);
+  EXPECT_NEAR(b.pose.position.z(), 0.2, 0.005);
+}
+
+// Rolling resistance c: a torque c r N against the roll. A solid ball then
+// slows at a = c g / (1 + 2/5) = 5 c g / 7 and stops after v0^2 / (2 a).
+TEST(Physics, RollingResistanceStopsABallAfterVSquaredOverTwoA) {
+  const double c = 0.1, v0 = 1.0, start = -1.2, dt = 1.0 / 120.0;
+  World w = rollingBall(c, Vec3(0.0, 0.0, -kG), v0, start);
+  const double a = 5.0 * c * kG / 7.0;
+  int steps = 0;
+  while (w.bodies()[1].linear_velocity.x() > 1e-3 && steps < 600) {
+    w.step(dt, Budget::unlimited());
+    ++steps;
+  }
+  const double stop = w.bodies()[1].pose.position.x();
+  EXPECT_NEAR(stop - start, v0 * v0 / (2.0 * a), 0.05 * v0 * v0 / (2.0 * a));
+  EXPECT_NEAR(steps * dt, v0 / a, 0.05 * v0 / a);
+  // It stays where it stopped: the resistance only opposes, never drives.
+  for (int i = 0; i < 120; ++i) w.step(dt, Budget::unlimited());
+  EXPECT_NEAR(w.bodies()[1].pose.position.x(), stop, 2e-3);
+}
+
+// On a slope of angle t the ball is held when c >= tan t (torque about the
+// contact), else it rolls down at a = 5 g (sin t - c cos t) / 7.
+TEST(Physics, RollingResistanceHoldsABallOnASlopeOnlyAboveTanTheta) {
+  const double slope = 10.0 * 3.14159265358979 / 180.0, dt = 1.0 / 120.0, start = 0.0;
+  const Vec3 g = kG * Vec3(std::sin(slope), 0.0, -std::cos(slope));  // downhill: +x
+  for (const double c : {0.25, 0.1}) {  // tan 10 deg = 0.176
+    World w = rollingBall(c, g, 0.0, start);
+    for (int i = 0; i < 120; ++i) w.step(dt, Budget::unlimited());
+    const double x = w.bodies()[1].pose.position.x() - start;
+    if (c > std::tan(slope)) {
+      EXPECT_LT(std::abs(x), 1e-3) << "c = " << c;
+    } else {
+      const double a = 5.0 * kG * (std::sin(slope) - c * std::cos(slope)) / 7.0;
+      EXPECT_NEAR(x, 0.5 * a, 0.1 * 0.5 * a) << "c = " << c;
+      EXPECT_NEAR(w.bodies()[1].linear_velocity.x(), a, 0.1 * a) << "c = " << c;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace stc

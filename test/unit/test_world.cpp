@@ -110,6 +110,11 @@ TEST(World, AddEntityValidatesEveryFieldAndChangesNothingOnThrow) {
     s.material.friction = mu;
     expectRejected(w, s, "material.friction");
   }
+  for (double c : {-0.1, 1.5, nan, inf}) {
+    s = specAt(cube, Vec3::Zero(), "first");
+    s.material.rolling_resistance = c;
+    expectRejected(w, s, "material.rolling_resistance");
+  }
 
   // Nothing above used an id: the first real entity gets id 0.
   s = specAt(cube, Vec3::Zero(), "first");
