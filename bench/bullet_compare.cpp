@@ -8,7 +8,8 @@
 //   hull      btConvexHullShape of the corners of the occupied voxels, shrunk
 //             by its collision margin so that hull + margin is the voxel hull.
 // Walls (static plates) are built the same way as the movers in each run.
-// Materials combine as in this package: restitution max, friction sqrt(a b).
+// Materials combine as in this package: restitution max, friction sqrt(a b),
+// rolling resistance the larger (see combinedRolling).
 //
 // Per tick: wall and thread-CPU time of one step, this package's phase
 // split (TickReport), and sanity figures over the movers: mean stored speed
@@ -188,6 +189,17 @@ btScalar combinedRestitution(const btCollisionObject* a, const btCollisionObject
 btScalar combinedFriction(const btCollisionObject* a, const btCollisionObject* b) {
   return std::sqrt(a->getFriction() * b->getFriction());
 }
+// Rolling resistance: this package bounds a pair's angular impulse by
+// c * r * N (c the larger coefficient, r the rolling radius at the contact);
+// Bullet bounds it by its combined coefficient (a length) * N, for rolling and
+// for spinning apart. Each movable body carries c * r with r its ball radius
+// of gyration, sqrt(5/2 * I / m); static bodies 0; the pair takes the larger.
+btScalar combinedRolling(const btCollisionObject* a, const btCollisionObject* b) {
+  return std::max(a->getRollingFriction(), b->getRollingFriction());
+}
+btScalar combinedSpinning(const btCollisionObject* a, const btCollisionObject* b) {
+  return std::max(a->getSpinningFriction(), b->getSpinningFriction());
+}
 
 // One voxel shape as Bullet sees it: Bullet wants the body frame on the
 // principal axes of inertia, so points are taken from this package's body
@@ -203,6 +215,8 @@ class BulletScene {
   BulletScene(const World& world, const SceneSpec& spec, BulletShape kind) : kind_(kind) {
     gCalculateCombinedRestitutionCallback = &combinedRestitution;
     gCalculateCombinedFrictionCallback = &combinedFriction;
+    gCalculateCombinedRollingFrictionCallback = &combinedRolling;
+    gCalculateCombinedSpinningFrictionCallback = &combinedSpinning;
     world_.setGravity(bt(spec.gravity));
     for (std::size_t i = 0; i < world.entityCount(); ++i) add(world, i);
     for (EntityId id : spec.movers) movers_.push_back(bodies_[*world.indexOf(id)].get());
@@ -238,6 +252,11 @@ class BulletScene {
                     bt(state.pose.position));
     info.m_restitution = btScalar(state.material.restitution);
     info.m_friction = btScalar(state.material.friction);
+    if (!state.is_static && state.material.rolling_resistance > 0.0) {
+      const double radius = std::sqrt(2.5 * s.moments.mean());
+      info.m_rollingFriction = btScalar(state.material.rolling_resistance * radius);
+      info.m_spinningFriction = info.m_rollingFriction;
+    }
     bodies_.push_back(std::make_unique<btRigidBody>(info));
     btRigidBody* body = bodies_.back().get();
     body->setLinearVelocity(bt(state.linear_velocity));
