@@ -116,8 +116,7 @@ class MotionCheck {
 
  private:
   bool inside(const Vec3& p) const {
-    return p.allFinite() && (p.array() >= bounds_.min.array()).all() &&
-           (p.array() <= bounds_.max.array()).all();
+    return p.allFinite() && bounds_.contains(p);
   }
   Aabb bounds_;
   double dt_;

@@ -101,8 +101,7 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
     if (trace_escape) {  // every tick a mover is outside: where, how fast, what the tick did
       for (EntityId id : spec.movers) {
         const BodyState& b = world.bodies()[*world.indexOf(id)];
-        if ((b.pose.position.array() < spec.bounds.min.array()).any() ||
-            (b.pose.position.array() > spec.bounds.max.array()).any()) {
+        if (!spec.bounds.contains(b.pose.position)) {
           std::fprintf(stderr, "  ESCAPE tick %d entity %u at (%.3f, %.3f, %.3f) v (%.3f, %.3f, %.3f) passes %d/%d unresolved %zu contacts %zu\n",
                        i, static_cast<unsigned>(id), b.pose.position.x(), b.pose.position.y(), b.pose.position.z(),
                        b.linear_velocity.x(), b.linear_velocity.y(), b.linear_velocity.z(), r.velocity_passes,
@@ -115,8 +114,7 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
     const BodyState& b = world.bodies()[*world.indexOf(id)];
     if (!finiteBody(b)) {
       ++run.non_finite;
-    } else if ((b.pose.position.array() < spec.bounds.min.array()).any() ||
-               (b.pose.position.array() > spec.bounds.max.array()).any()) {
+    } else if (!spec.bounds.contains(b.pose.position)) {
       ++run.outside;
       std::fprintf(stderr, "  %s: entity %u outside the bounds at (%.3f, %.3f, %.3f), |v| %.3f m/s\n",
                    run.scene.c_str(), static_cast<unsigned>(id), b.pose.position.x(), b.pose.position.y(),

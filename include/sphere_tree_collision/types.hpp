@@ -35,6 +35,10 @@ struct Aabb {
     return min.x() <= o.max.x() && o.min.x() <= max.x() && min.y() <= o.max.y() &&
            o.min.y() <= max.y() && min.z() <= o.max.z() && o.min.z() <= max.z();
   }
+  // Inside or on the boundary (false for a NaN coordinate).
+  bool contains(const Vec3& p) const {
+    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  }
 };
 
 // Rejected input. `field()` names the offending field (e.g. "voxel_size",
