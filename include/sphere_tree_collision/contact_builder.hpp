@@ -29,11 +29,20 @@ struct ContactCandidate {
   bool refined = false;        // separation and face normal evaluated (deep enough)
 };
 
-// The two bodies of a pair as the contact steps see them: trees, node bounds
-// (nullptr: the surface is the sphere) and poses.
+// One body's surface as the contact steps see it: its shape's node bounds
+// (nullptr: the surface is the sphere) and, for a static body, the faces of
+// its node boxes other static bodies cover (StaticCover::of; nullptr: none).
+struct BodySurface {
+  const ShapeBounds* bounds = nullptr;
+  const std::uint8_t* covered_faces = nullptr;
+};
+
+// The two bodies of a pair as the contact steps see them: trees, surfaces and poses.
 class PairGeometry {
  public:
-  PairGeometry(const PairTest& test, const ShapeBounds* bounds_a, const ShapeBounds* bounds_b);
+  PairGeometry(const PairTest& test, const BodySurface& a, const BodySurface& b);
+  PairGeometry(const PairTest& test, const ShapeBounds* bounds_a, const ShapeBounds* bounds_b)
+      : PairGeometry(test, BodySurface{bounds_a, nullptr}, BodySurface{bounds_b, nullptr}) {}
 
   // Paper Fig. 4: normal along the line of centres a -> b (coincident: the
   // body centres, then +Z), point dividing the centres in proportion to the radii.
@@ -42,7 +51,8 @@ class PairGeometry {
   double gapAlong(const ContactCandidate& c, const Vec3& n) const;
   // Separation along the candidate's normal; with face_normals and bounds, a
   // face axis of either voxel box that separates the nodes more becomes the
-  // normal, and the point moves to the middle of the faces' overlap.
+  // normal, and the point moves to the middle of the faces' overlap. A face
+  // another static body covers is not a surface: its axis is skipped.
   void refine(ContactCandidate& c, bool face_normals) const;
 
  private:
@@ -52,11 +62,17 @@ class PairGeometry {
   double supportA(std::int32_t node, const Vec3& dir) const { return localSupportA(node, rot_a_.transpose() * dir); }
   double supportB(std::int32_t node, const Vec3& dir) const { return localSupportB(node, rot_b_.transpose() * dir); }
   Vec3 faceContactPoint(const ContactCandidate& c) const;
+  // Whether n (a -> b) points through a face of a's node, or -n through one of
+  // b's node, that another static body covers; and n with those parts removed.
+  bool intoCover(const ContactCandidate& c, const Vec3& n) const;
+  Vec3 awayFromCover(const ContactCandidate& c, const Vec3& n) const;
 
   const SphereTree& tree_a_;
   const SphereTree& tree_b_;
   const ShapeBounds* bounds_a_;
   const ShapeBounds* bounds_b_;
+  const std::uint8_t* covered_a_;
+  const std::uint8_t* covered_b_;
   Mat3 rot_a_, rot_b_;
   Mat3 b_in_a_;  // B's axes in A's frame (columns)
   Vec3 pos_a_, pos_b_;
@@ -125,8 +141,14 @@ class ContactBuilder {
   // pickRepresentatives, assignClusters, then one contact per cluster
   // (clusterNormals, clusterSeparations).
   void append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b, double priority,
+              const BodySurface& a, const BodySurface& b, const ContactBuildOptions& options,
+              std::vector<Contact>& out);
+  void append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b, double priority,
               const ShapeBounds* bounds_a, const ShapeBounds* bounds_b,
-              const ContactBuildOptions& options, std::vector<Contact>& out);
+              const ContactBuildOptions& options, std::vector<Contact>& out) {
+    append(test, index_a, index_b, priority, BodySurface{bounds_a, nullptr}, BodySurface{bounds_b, nullptr},
+           options, out);
+  }
 
  private:
   std::vector<ContactCandidate> candidates_;  // scratch kept between pairs: no allocation per tick

@@ -8,6 +8,7 @@
 #include "sphere_tree_collision/continuous.hpp"
 #include "sphere_tree_collision/response_options.hpp"
 #include "sphere_tree_collision/shape_bounds.hpp"
+#include "sphere_tree_collision/static_cover.hpp"
 #include "sphere_tree_collision/workers.hpp"
 
 #include <array>
@@ -44,6 +45,8 @@ struct StepContext {
   // solver keeps sleeping pairs' warm-start impulses (respond; nullptr: not).
   const std::vector<EntityId>* ids = nullptr;
   const std::vector<std::uint8_t>* held_asleep = nullptr;
+  // Static bodies' faces other static bodies cover (respond's contacts; nullptr: none).
+  const StaticCover* static_cover = nullptr;
 };
 
 struct PhysicsReport {

@@ -15,6 +15,7 @@
 #include "sphere_tree_collision/response.hpp"
 #include "sphere_tree_collision/scheduler.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
+#include "sphere_tree_collision/static_cover.hpp"
 #include "sphere_tree_collision/sweep_and_prune.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
 #include "sphere_tree_collision/workers.hpp"
@@ -73,6 +74,12 @@ struct EntitySpec {
   Material material;
   bool is_static = false;
   BoxMode box_mode = BoxMode::Auto;
+  // Static bodies only: faces of the body frame that are not surfaces
+  // (faceBit, static_cover.hpp), so no contact pushes a body out through them.
+  // The back of a one-sided wall or floor (faceBit(2, false) when its inside
+  // faces +z): a body pressed deeper than half the wall's thickness is still
+  // pushed back in, not out through the back. 0: every face is a surface.
+  std::uint8_t closed_faces = 0;
 };
 
 struct TickReport {
@@ -270,6 +277,7 @@ class World {
   Workers workers_;  // before the phases that use it
   std::deque<ShapeInfo> shapes_;  // deque: trees keep their address as shapes are added
   std::deque<ShapeBounds> shape_bounds_;  // by shape id, built in addShape; they point at the trees
+  std::vector<CoverShape> cover_shapes_;  // by shape id: what StaticCover reads of each
   std::unordered_map<std::string, ShapeId> shape_by_key_;
 
   // Entities: flat arrays indexed densely; ids_ maps dense -> id.
@@ -278,6 +286,7 @@ class World {
   std::vector<ShapeId> body_shapes_;
   std::vector<BoxMode> box_modes_;
   std::vector<std::string> names_;
+  StaticCover static_cover_;  // static bodies' faces other static bodies cover, by dense index
   // Entity id -> dense index, open addressing on flat arrays: the pair walk
   // of every tick looks up two per broad-phase pair (a settled pile of 5,000
   // rocks: ~50,000 pairs; docs/sleeping.md).

@@ -2,6 +2,7 @@
 #include "sphere_tree_collision/contact_builder.hpp"
 
 #include "sphere_tree_collision/contact_solver.hpp"  // tangentBasis
+#include "sphere_tree_collision/static_cover.hpp"    // faceBit
 
 #include <algorithm>
 #include <cmath>
@@ -47,11 +48,13 @@ double boxExtent(const ShapeBounds* bounds, const SphereTree& tree, const Mat3& 
 
 }  // namespace
 
-PairGeometry::PairGeometry(const PairTest& test, const ShapeBounds* bounds_a, const ShapeBounds* bounds_b)
+PairGeometry::PairGeometry(const PairTest& test, const BodySurface& a, const BodySurface& b)
     : tree_a_(*test.bodyA().tree),
       tree_b_(*test.bodyB().tree),
-      bounds_a_(bounds_a),
-      bounds_b_(bounds_b),
+      bounds_a_(a.bounds),
+      bounds_b_(b.bounds),
+      covered_a_(a.bounds != nullptr ? a.covered_faces : nullptr),
+      covered_b_(b.bounds != nullptr ? b.covered_faces : nullptr),
       rot_a_(test.bodyA().pose->orientation.toRotationMatrix()),
       rot_b_(test.bodyB().pose->orientation.toRotationMatrix()),
       b_in_a_(rot_a_.transpose() * rot_b_),
@@ -107,7 +110,55 @@ Vec3 PairGeometry::faceContactPoint(const ContactCandidate& c) const {
   return point;
 }
 
+namespace {
+
+// A mask's covered faces a direction (body frame, outward from the node) points through.
+bool throughCovered(std::uint8_t mask, const Vec3& outward) {
+  constexpr double kAlong = 1e-6;  // a component this small is across the face, not through it
+  for (int axis = 0; axis < 3; ++axis) {
+    if (outward[axis] > kAlong && (mask & faceBit(axis, true)) != 0) return true;
+    if (outward[axis] < -kAlong && (mask & faceBit(axis, false)) != 0) return true;
+  }
+  return false;
+}
+
+// `outward` without its components through covered faces (zero when nothing is left).
+Vec3 clipCovered(std::uint8_t mask, Vec3 outward) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if ((outward[axis] > 0.0 && (mask & faceBit(axis, true)) != 0) ||
+        (outward[axis] < 0.0 && (mask & faceBit(axis, false)) != 0)) {
+      outward[axis] = 0.0;
+    }
+  }
+  return outward;
+}
+
+}  // namespace
+
+bool PairGeometry::intoCover(const ContactCandidate& c, const Vec3& n) const {
+  const std::uint8_t mask_a = covered_a_ != nullptr ? covered_a_[static_cast<std::size_t>(c.node_a)] : 0;
+  const std::uint8_t mask_b = covered_b_ != nullptr ? covered_b_[static_cast<std::size_t>(c.node_b)] : 0;
+  return (mask_a != 0 && throughCovered(mask_a, rot_a_.transpose() * n)) ||
+         (mask_b != 0 && throughCovered(mask_b, -(rot_b_.transpose() * n)));
+}
+
+Vec3 PairGeometry::awayFromCover(const ContactCandidate& c, const Vec3& n) const {
+  Vec3 open = n;
+  if (covered_a_ != nullptr && covered_a_[static_cast<std::size_t>(c.node_a)] != 0) {
+    open = rot_a_ * clipCovered(covered_a_[static_cast<std::size_t>(c.node_a)], rot_a_.transpose() * open);
+  }
+  if (covered_b_ != nullptr && covered_b_[static_cast<std::size_t>(c.node_b)] != 0) {
+    open = -(rot_b_ * clipCovered(covered_b_[static_cast<std::size_t>(c.node_b)], -(rot_b_.transpose() * open)));
+  }
+  const double length = open.norm();
+  return length > 1e-9 ? Vec3(open / length) : n;
+}
+
 void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
+  // A normal through a face another static body covers would push b into
+  // that body (a tile's rim, into the next tile): its part along the face goes.
+  const bool covered = intoCover(c, c.normal);
+  if (covered) c.normal = awayFromCover(c, c.normal);
   c.separation = gapAlong(c, c.normal);
   c.refined = true;
   if (!face_normals || (bounds_a_ == nullptr && bounds_b_ == nullptr)) return;
@@ -124,12 +175,15 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
     const int axis = of_a ? k : k - 3;
     const double along = of_a ? delta_a[axis] : delta_b[axis];
     const double sign = along < 0.0 ? -1.0 : 1.0;
+    const Vec3 normal = sign * (of_a ? Vec3(rot_a_.col(axis)) : Vec3(rot_b_.col(axis)));
+    if ((covered_a_ != nullptr || covered_b_ != nullptr) && intoCover(c, normal)) continue;
     const Vec3 dir_a = sign * (of_a ? Vec3(Vec3::Unit(axis)) : Vec3(b_in_a_.col(axis)));
     const Vec3 dir_b = sign * (of_a ? Vec3(b_in_a_.row(axis).transpose()) : Vec3(Vec3::Unit(axis)));
     const double g = std::abs(along) - localSupportA(c.node_a, dir_a) - localSupportB(c.node_b, -dir_b);
-    if (g > c.separation + 1e-12 * std::abs(c.overlap + delta.norm())) {
+    // Under cover the line of centres was bent: any open face axis is the better normal.
+    if (g > c.separation + 1e-12 * std::abs(c.overlap + delta.norm()) || (covered && !face)) {
       c.separation = g;
-      c.normal = sign * (of_a ? Vec3(rot_a_.col(axis)) : Vec3(rot_b_.col(axis)));
+      c.normal = normal;
       face = true;
     }
   }
@@ -280,14 +334,13 @@ void clusterSeparations(const std::vector<ContactCandidate>& candidates, const s
 }
 
 void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b,
-                            double priority, const ShapeBounds* bounds_a,
-                            const ShapeBounds* bounds_b, const ContactBuildOptions& options,
-                            std::vector<Contact>& out) {
+                            double priority, const BodySurface& a, const BodySurface& b,
+                            const ContactBuildOptions& options, std::vector<Contact>& out) {
   const PairStatus status = test.status();
   if (status == PairStatus::Separate) return;
   if (status == PairStatus::Unresolved && !options.accept_unresolved) return;
 
-  const PairGeometry geometry(test, bounds_a, bounds_b);
+  const PairGeometry geometry(test, a, b);
   gatherCandidates(test, geometry, candidates_);
   const double deepest = deepestOverlap(candidates_);
   refineDeepCandidates(candidates_, deepest, geometry, options.face_normals);

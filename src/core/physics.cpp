@@ -71,8 +71,11 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
     const std::uint32_t ia = pair_bodies[i][0];
     const std::uint32_t ib = pair_bodies[i][1];
     const std::size_t before = out.size();
-    builder.append(tests[i], ia, ib, priorities[i], &shape_bounds[body_shapes[ia]],
-                   &shape_bounds[body_shapes[ib]], build, out);
+    const StaticCover* cover = step.static_cover;
+    builder.append(tests[i], ia, ib, priorities[i],
+                   BodySurface{&shape_bounds[body_shapes[ia]], cover != nullptr ? cover->of(ia) : nullptr},
+                   BodySurface{&shape_bounds[body_shapes[ib]], cover != nullptr ? cover->of(ib) : nullptr}, build,
+                   out);
     if (out.size() == before && sweep_hit_of_pair_[i] >= 0) {
       // The sweep held a body back at this pair's first touch but the test
       // (interrupted, or not accepted) gave no contact: the hit is the contact,

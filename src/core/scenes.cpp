@@ -110,6 +110,7 @@ class SceneBuilder {
         e.pose.position = centre + at(i, nu, hu) * u + at(j, nv, hv) * v - 0.5 * thickness * inward;
         e.pose.orientation = q;
         e.is_static = true;
+        e.closed_faces = faceBit(2, false);  // one-sided: the back never pushes a body out
         e.material = m;
         spec_.walls.push_back(world_.addEntity(e));
       }

@@ -113,6 +113,7 @@ ShapeId World::addShape(const std::string& key, VoxelShape voxels) {
   shapes_.push_back(std::move(info));  // deque: earlier shapes (and trees) stay put
   bounds.tree = &shapes_.back().tree;  // the tree moved into the deque
   shape_bounds_.push_back(std::move(bounds));
+  cover_shapes_.push_back(CoverShape{&shapes_.back().voxels, shapes_.back().body_origin, &shape_bounds_.back()});
   shape_by_key_.emplace(key, id);
   return id;
 }
@@ -140,6 +141,10 @@ EntityId World::addEntity(const EntitySpec& spec) {
                     spec.material, config_.limits);
   if (!spec.name.empty() && id_by_name_.count(spec.name) != 0) {
     throw InputError("name", "'" + spec.name + "' is already used");
+  }
+  if (spec.closed_faces > kAllFaces || (spec.closed_faces != 0 && !spec.is_static)) {
+    throw InputError("closed_faces", "static bodies only, a mask of faceBit values (at most " +
+                                         std::to_string(kAllFaces) + ")");
   }
   if (ids_.size() >= config_.max_entities || next_id_ == kInvalidEntity) {
     throw InputError("max_entities", "the world holds " + std::to_string(config_.max_entities) +
@@ -170,6 +175,7 @@ EntityId World::addEntity(const EntitySpec& spec) {
   body_shapes_.push_back(spec.shape);
   box_modes_.push_back(mode);
   names_.push_back(spec.name);
+  static_cover_.add(body, spec.closed_faces);
   index_of_->set(id, static_cast<std::uint32_t>(index));
   if (!spec.name.empty()) id_by_name_.emplace(spec.name, id);
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
@@ -190,6 +196,7 @@ bool World::removeEntity(EntityId id) {
     if (other != detail::FlatHashMap::kMissing) islands_.wake(other);  // missing: removed since the last update
   }
   islands_.remove(index, last);
+  static_cover_.remove(index, last);
   broad_phase_.remove(id);
   if (!names_[index].empty()) id_by_name_.erase(names_[index]);
   index_of_->erase(id);
@@ -232,6 +239,7 @@ void World::clear() {
   id_by_name_.clear();
   broad_phase_ = SweepAndPrune();
   islands_.clear();
+  static_cover_.clear();
   invalidateLastTick();
 }
 
@@ -341,6 +349,7 @@ StepContext World::physicsStep() {
   step.workers = &workers_;
   step.ids = &ids_;
   step.held_asleep = &islands_.held();
+  step.static_cover = &static_cover_;
   return step;
 }
 
@@ -505,6 +514,7 @@ double World::narrowPhase(const Budget& budget, const Deadline& tick_end, double
 // then impulses and position correction (contact_builder.hpp,
 // contact_solver.hpp), refined until the tick's deadline or the iteration budget.
 void World::response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report) {
+  static_cover_.update(bodies_, body_shapes_, cover_shapes_);  // rebuilds only when a static body changed
   StepContext step = physicsStep();
   step.dt = dt;
   step.budget.max_iterations = budget.solver_iterations;
