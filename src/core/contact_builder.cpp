@@ -166,6 +166,7 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
   // line of centres is the better normal (separating-axis rule): face-on,
   // the line of centres of two voxel spheres tilts by up to 45 deg.
   bool face = false;
+  const bool any_cover = covered_a_ != nullptr || covered_b_ != nullptr;
   const Vec3 delta = c.cb - c.ca;
   const Vec3 delta_a = rot_a_.transpose() * delta;
   const Vec3 delta_b = b_in_a_.transpose() * delta_a;
@@ -174,12 +175,18 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
     const bool of_a = k < 3;
     const int axis = of_a ? k : k - 3;
     const double along = of_a ? delta_a[axis] : delta_b[axis];
-    const double sign = along < 0.0 ? -1.0 : 1.0;
-    const Vec3 normal = sign * (of_a ? Vec3(rot_a_.col(axis)) : Vec3(rot_b_.col(axis)));
-    if ((covered_a_ != nullptr || covered_b_ != nullptr) && intoCover(c, normal)) continue;
+    double sign = along < 0.0 ? -1.0 : 1.0;
+    Vec3 normal = sign * (of_a ? Vec3(rot_a_.col(axis)) : Vec3(rot_b_.col(axis)));
+    if (any_cover && intoCover(c, normal)) {
+      // b's node lies beyond the covered side (deeper than a one-sided
+      // wall's middle): the open side of the axis is the way out, however deep.
+      sign = -sign;
+      normal = -normal;
+      if (intoCover(c, normal)) continue;
+    }
     const Vec3 dir_a = sign * (of_a ? Vec3(Vec3::Unit(axis)) : Vec3(b_in_a_.col(axis)));
     const Vec3 dir_b = sign * (of_a ? Vec3(b_in_a_.row(axis).transpose()) : Vec3(Vec3::Unit(axis)));
-    const double g = std::abs(along) - localSupportA(c.node_a, dir_a) - localSupportB(c.node_b, -dir_b);
+    const double g = sign * along - localSupportA(c.node_a, dir_a) - localSupportB(c.node_b, -dir_b);
     // Under cover the line of centres was bent: any open face axis is the better normal.
     if (g > c.separation + 1e-12 * std::abs(c.overlap + delta.norm()) || (covered && !face)) {
       c.separation = g;

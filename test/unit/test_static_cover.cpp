@@ -155,6 +155,23 @@ TEST(StaticCover, AOneSidedFloorPushesADeepCubeBackUpEvenWithOneSolverPass) {
   }
 }
 
+// Under a budget a pair is taken at its frontier: with no sphere test, at the
+// roots. A cube whose centre is below the middle of a one-sided floor has its
+// root under the floor's root, so the floor's face towards it is the closed
+// back; the open top must push it, not the line of centres (down, out).
+TEST(StaticCover, AOneSidedFloorPushesADeepCubeUpFromItsRootsAlone) {
+  for (const double x : {0.0, 0.1, 1.0}) {
+    World world = gravityWorld();  // policy accept: untested pairs give contacts at their roots
+    addTiles(world, 2, 0.0, faceBit(2, false));
+    const std::size_t cube = addSunkCube(world, 0.9, x);  // centre 16 cm below the top, 3.5 below the middle
+    for (int t = 0; t < 300; ++t) world.step(1.0 / 60.0, Budget::ofSphereTests(0));
+    const BodyState& b = world.bodies()[cube];
+    SCOPED_TRACE("x " + std::to_string(x));
+    EXPECT_GT(b.pose.position.z(), 0.0) << "pushed up, not out through the back";
+    EXPECT_LT(b.linear_velocity.norm(), 0.5);
+  }
+}
+
 // A free rim stays a surface: a cube sliding at the floor's outer edge from
 // the side is stopped by it, not lifted onto the floor.
 TEST(StaticCover, AFreeRimStillStopsACubeFromTheSide) {
