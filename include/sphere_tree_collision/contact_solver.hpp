@@ -147,6 +147,7 @@ class ContactSolver {
     double approach = 0.0;     // normal relative velocity before the solve (< 0: closing)
     double push = 0.0;         // split impulse: target normal pseudo-velocity
     double push_mass = 0.0;    // 1 / effective mass along n of the bodies' translation alone
+    double shock_push_mass = 0.0;  // the same with the support held (position shock sweep)
     double lambda_main = 0.0;  // normal impulse before restitution (what warm starts)
     double lambda_push = 0.0;
     double bounce_from = 0.0;  // normal velocity its bounce reverses (< 0), in its wave
@@ -209,6 +210,9 @@ class ContactSolver {
   void propagateShock(const ResponseOptions& options);
   void collide(const ResponseOptions& options, SolveStats& stats);
   int solvePositions(const ResponseOptions& options, const Deadline& deadline);
+  // After the position passes, one sweep up the levels with the supporting
+  // body of each row held: what they left of a pile's overlap goes upward.
+  void propagatePositionShock(const ResponseOptions& options);
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
 
   std::vector<Row> rows_;

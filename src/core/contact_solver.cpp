@@ -180,6 +180,8 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     }
     const double k_translation = split_a * row.inv_ma + split_b * row.inv_mb;
     info.push_mass = k_translation > 0.0 ? 1.0 / k_translation : 0.0;
+    const double k_held = (info.move_a ? row.inv_ma : 0.0) + (info.move_b ? row.inv_mb : 0.0);
+    info.shock_push_mass = k_held > 0.0 ? 1.0 / k_held : 0.0;
     row.lambda[0] = row.lambda[1] = row.lambda[2] = 0.0;
     row.bounce_impulse = 0.0;
     row.friction = std::sqrt(std::max(0.0, ba.material.friction * bb.material.friction));
@@ -595,18 +597,53 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
   return passes;
 }
 
+// Shock propagation at the position level (Guendelman et al. process contacts
+// from the ground up): with few position passes (a tick budget leaves one) a
+// rock at the bottom of a pile took the pile's push down as much as the
+// floor's push up, and sank through the floor over a few seconds
+// (corner_drift under a 16.7 ms budget). Held from below, it cannot be pushed
+// into what supports it; what rests on it moves instead.
+void ContactSolver::propagatePositionShock(const ResponseOptions& options) {
+  const bool turns = options.position_turns;
+  const auto shockPush = [&](std::size_t r, Motion& pair_a, Motion& pair_b) {
+    const Row& row = rows_[r];
+    RowInfo& info = info_[r];
+    Motion held_a = pair_a, held_b = pair_b;  // the held body's part goes to a copy, dropped
+    Motion& a = info.move_a ? pair_a : held_a;
+    Motion& b = info.move_b ? pair_b : held_b;
+    const double vn = turns ? relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n) : (b.v - a.v).dot(row.n);
+    const double unclamped =
+        info.lambda_push + (turns ? info.shock_mass[0] : info.shock_push_mass) * (info.push - vn);
+    const double normal = info.bounced && info.push < 0.0 ? unclamped : std::max(0.0, unclamped);
+    const double delta = normal - info.lambda_push;
+    info.lambda_push = normal;
+    if (turns) {
+      applyNormal(row, delta, a, b);
+    } else {
+      a.v -= row.inv_ma * delta * row.n;
+      b.v += row.inv_mb * delta * row.n;
+    }
+  };
+  for (std::size_t level = 0; level < shockLevels(); ++level) {
+    forEachColourOfLevel(level, [&](std::size_t first, std::size_t end) {
+      overManifolds(first, end, pseudo_, shockPush);
+    });
+  }
+}
+
 // The most iterations (<= cap) that fit in seconds_left with everything that
 // follows them, costed in passes over the rows at the price of the first
 // velocity pass: per iteration beyond the first one velocity pass and one
 // position pass (when any contact needs correcting); then shock propagation's
-// max(2, n / 2) passes, and one more for restitution and storing the result.
+// max(2, n / 2) passes (and its one position sweep), and one more for
+// restitution and storing the result.
 int ContactSolver::affordableIterations(const ResponseOptions& options, int cap, double pass_seconds,
                                         double seconds_left) const {
   if (!(pass_seconds > 0.0)) return cap;
   bool corrects = false;
   for (const RowInfo& info : info_) corrects = corrects || info.push != 0.0;
   const auto passes_after_the_first = [&](int n) {
-    const int shock = options.shock_propagation ? std::max(2, n / 2) : 0;
+    const int shock = options.shock_propagation ? std::max(2, n / 2) + (corrects ? 1 : 0) : 0;
     return (n - 1) + (corrects ? n : 0) + shock + 1;
   };
   int n = 1;
@@ -744,6 +781,7 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
   if (!jacobi) keepMainImpulses();
   const double t_positions = deadline.isSet() ? deadline.now() : 0.0;
   stats.position_passes = solvePositions(run, deadline);
+  if (options.shock_propagation && stats.position_passes > 0) propagatePositionShock(run);
   if (deadline.isSet()) {
     const double positions = deadline.now() - t_positions;
     const int extra = std::max(0, stats.position_passes - 1);

