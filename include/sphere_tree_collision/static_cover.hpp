@@ -14,6 +14,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace stc {
@@ -24,6 +25,9 @@ inline std::uint8_t faceBit(int axis, bool positive) {
   return static_cast<std::uint8_t>(1u << (2 * axis + (positive ? 0 : 1)));
 }
 constexpr std::uint8_t kAllFaces = 63;
+// "+x", "-x", "+y", "-y", "+z", "-z" (body frame) -> their faceBits OR'ed;
+// throws InputError("closed_faces") naming an unknown face.
+std::uint8_t parseFaces(const std::vector<std::string>& names);
 
 // What the cover needs of a shape: its grid, the grid point the body frame is
 // centred on (ShapeInfo::body_origin) and its node boxes.

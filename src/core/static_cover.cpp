@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <iterator>
 
 namespace stc {
 namespace {
@@ -65,6 +66,19 @@ std::uint8_t nodeMask(const Placed& body, std::int32_t node, const std::vector<c
 }
 
 }  // namespace
+
+std::uint8_t parseFaces(const std::vector<std::string>& names) {
+  static const char* const kNames[] = {"+x", "-x", "+y", "-y", "+z", "-z"};  // faceBit order
+  std::uint8_t mask = 0;
+  for (const std::string& name : names) {
+    const auto* found = std::find(std::begin(kNames), std::end(kNames), name);
+    if (found == std::end(kNames)) {
+      throw InputError("closed_faces", "unknown face '" + name + "' (expected +x, -x, +y, -y, +z or -z)");
+    }
+    mask |= static_cast<std::uint8_t>(1u << (found - std::begin(kNames)));
+  }
+  return mask;
+}
 
 void StaticCover::add(const BodyState& body, std::uint8_t closed_faces) {
   masks_.emplace_back();

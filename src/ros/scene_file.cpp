@@ -1,5 +1,7 @@
 #include "sphere_tree_collision/ros/scene_file.hpp"
 
+#include "sphere_tree_collision/static_cover.hpp"
+
 #include "sphere_tree_collision/ros/conversions.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -117,7 +119,7 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   checkKeys(node, p,
             {"name", "preset", "resolution", "voxel_size", "seed", "position", "orientation", "velocity",
              "angular_velocity", "density", "restitution", "friction", "color", "static", "box_mode",
-             "repeat", "mesh_resource", "scale", "strength", "rolling_resistance", "up_axis"});
+             "repeat", "mesh_resource", "scale", "strength", "rolling_resistance", "up_axis", "closed_faces"});
   EntityRequest r;
   if (node["mesh_resource"]) {
     r.mesh_resource = readString(node["mesh_resource"], p + "mesh_resource");
@@ -155,6 +157,17 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   }
   if (node["color"]) r.color = readColor(node["color"], p + "color");
   if (node["static"]) r.spec.is_static = readBool(node["static"], p + "static");
+  if (node["closed_faces"]) {
+    const YAML::Node faces = node["closed_faces"];
+    if (!faces.IsSequence()) throw InputError(p + "closed_faces", "expected a list of faces, e.g. [-z]");
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < faces.size(); ++i) names.push_back(readString(faces[i], p + "closed_faces"));
+    try {
+      r.spec.closed_faces = stc::parseFaces(names);
+    } catch (const InputError& e) {
+      throw InputError(p + "closed_faces", reasonOf(e));
+    }
+  }
   if (node["box_mode"]) {
     try {
       r.spec.box_mode = stc::parseBoxMode(readString(node["box_mode"], p + "box_mode"));

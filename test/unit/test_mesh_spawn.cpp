@@ -87,6 +87,31 @@ TEST_F(MeshSpawn, SceneFileRejectsAMeshWithAPresetOrAScaleWithoutAMesh) {
   }
 }
 
+// Not a mesh feature, but a scene file's: a one-sided static floor
+// (static_cover.hpp), its closed faces named in the body frame.
+TEST(SceneFileClosedFaces, AStaticEntryClosesTheNamedFacesAndBadOnesAreRejectedByName) {
+  const Scene scene = parseSceneYaml(
+      "entities:\n  - {preset: plate, static: true, closed_faces: [-z, +x], position: [0, 0, -0.1]}\n");
+  stc::World world;
+  ASSERT_EQ(addScene(world, scene).size(), 1u);
+  EXPECT_EQ(scene.entities[0].request.spec.closed_faces, stc::faceBit(2, false) | stc::faceBit(0, true));
+  const auto field_of = [](const std::string& yaml) -> std::string {
+    try {
+      stc::World w;
+      addScene(w, parseSceneYaml(yaml));
+    } catch (const stc::InputError& e) {
+      return e.field();
+    }
+    return "accepted";
+  };
+  EXPECT_EQ(field_of("entities:\n  - {preset: plate, static: true, closed_faces: [down]}\n"),
+            "entities[0].closed_faces");
+  EXPECT_EQ(field_of("entities:\n  - {preset: plate, static: true, closed_faces: -z}\n"),
+            "entities[0].closed_faces");
+  EXPECT_EQ(field_of("entities:\n  - {preset: cube, closed_faces: [-z]}\n"), "entities[0].closed_faces")
+      << "a movable body's faces move apart: only static bodies close faces";
+}
+
 TEST_F(MeshSpawn, SpawnMessageWithAMeshAddsItScaled) {
   sphere_tree_collision::SpawnEntity msg;
   msg.mesh_resource = path_;
