@@ -210,6 +210,11 @@ class ContactSolver {
   void propagateShock(const ResponseOptions& options);
   void collide(const ResponseOptions& options, SolveStats& stats);
   int solvePositions(const ResponseOptions& options, const Deadline& deadline);
+  // One split-impulse step of a row: its pseudo-impulse towards info.push,
+  // the relative motion read from a and b, `mass` along n, applied to out_a
+  // and out_b (by translation alone unless `turns`).
+  static void pushStep(const Row& row, RowInfo& info, const Motion& a, const Motion& b, double mass, bool turns,
+                       Motion& out_a, Motion& out_b);
   // After the position passes, one sweep up the levels with the supporting
   // body of each row held: what they left of a pile's overlap goes upward.
   void propagatePositionShock(const ResponseOptions& options);

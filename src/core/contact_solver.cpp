@@ -570,22 +570,7 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
     RowInfo& info = info_[r];
     const Motion& a = jacobi ? pseudo_[row.a] : out_a;  // Jacobi: pseudo_ untouched until the commit
     const Motion& b = jacobi ? pseudo_[row.b] : out_b;
-    // Translation alone (the default): the pass never turns a body, so it
-    // cannot set a resting one rocking (docs/sleeping.md).
-    const double vn = turns ? relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n) : (b.v - a.v).dot(row.n);
-    // A contact that bounced across a speculative gap also closes the gap
-    // (may pull): the bounce starts at the surface, not where the gap
-    // was seen, so the rebound height does not gain up to |v| dt.
-    const double unclamped = info.lambda_push + (turns ? row.mass[0] : info.push_mass) * (info.push - vn);
-    const double normal = info.bounced && info.push < 0.0 ? unclamped : std::max(0.0, unclamped);
-    const double delta = normal - info.lambda_push;
-    info.lambda_push = normal;
-    if (turns) {
-      applyNormal(row, delta, out_a, out_b);
-    } else {
-      out_a.v -= row.inv_ma * delta * row.n;
-      out_b.v += row.inv_mb * delta * row.n;
-    }
+    pushStep(row, info, a, b, turns ? row.mass[0] : info.push_mass, turns, out_a, out_b);
   };
   int passes = 0;
   for (int it = 0; it < options.iterations; ++it, ++passes) {
@@ -595,6 +580,26 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
     if (jacobi) commitJacobi(pseudo_);
   }
   return passes;
+}
+
+void ContactSolver::pushStep(const Row& row, RowInfo& info, const Motion& a, const Motion& b, double mass,
+                             bool turns, Motion& out_a, Motion& out_b) {
+  // Translation alone (the default): the pass never turns a body, so it
+  // cannot set a resting one rocking (docs/sleeping.md).
+  const double vn = turns ? relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n) : (b.v - a.v).dot(row.n);
+  // A contact that bounced across a speculative gap also closes the gap
+  // (may pull): the bounce starts at the surface, not where the gap
+  // was seen, so the rebound height does not gain up to |v| dt.
+  const double unclamped = info.lambda_push + mass * (info.push - vn);
+  const double normal = info.bounced && info.push < 0.0 ? unclamped : std::max(0.0, unclamped);
+  const double delta = normal - info.lambda_push;
+  info.lambda_push = normal;
+  if (turns) {
+    applyNormal(row, delta, out_a, out_b);
+  } else {
+    out_a.v -= row.inv_ma * delta * row.n;
+    out_b.v += row.inv_mb * delta * row.n;
+  }
 }
 
 // Shock propagation at the position level (Guendelman et al. process contacts
@@ -611,18 +616,7 @@ void ContactSolver::propagatePositionShock(const ResponseOptions& options) {
     Motion held_a = pair_a, held_b = pair_b;  // the held body's part goes to a copy, dropped
     Motion& a = info.move_a ? pair_a : held_a;
     Motion& b = info.move_b ? pair_b : held_b;
-    const double vn = turns ? relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n) : (b.v - a.v).dot(row.n);
-    const double unclamped =
-        info.lambda_push + (turns ? info.shock_mass[0] : info.shock_push_mass) * (info.push - vn);
-    const double normal = info.bounced && info.push < 0.0 ? unclamped : std::max(0.0, unclamped);
-    const double delta = normal - info.lambda_push;
-    info.lambda_push = normal;
-    if (turns) {
-      applyNormal(row, delta, a, b);
-    } else {
-      a.v -= row.inv_ma * delta * row.n;
-      b.v += row.inv_mb * delta * row.n;
-    }
+    pushStep(row, info, a, b, turns ? info.shock_mass[0] : info.shock_push_mass, turns, a, b);
   };
   for (std::size_t level = 0; level < shockLevels(); ++level) {
     forEachColourOfLevel(level, [&](std::size_t first, std::size_t end) {
