@@ -62,10 +62,10 @@ class PairGeometry {
   double supportA(std::int32_t node, const Vec3& dir) const { return localSupportA(node, rot_a_.transpose() * dir); }
   double supportB(std::int32_t node, const Vec3& dir) const { return localSupportB(node, rot_b_.transpose() * dir); }
   Vec3 faceContactPoint(const ContactCandidate& c) const;
-  // Whether n (a -> b) points through a face of a's node, or -n through one of
-  // b's node, that another static body covers; and n with those parts removed.
-  bool intoCover(const ContactCandidate& c, const Vec3& n) const;
-  Vec3 awayFromCover(const ContactCandidate& c, const Vec3& n) const;
+  // Whether n (a -> b) points through a covered face of a's node (mask_a),
+  // or -n through one of b's node; and n with those parts removed.
+  bool intoCover(std::uint8_t mask_a, std::uint8_t mask_b, const Vec3& n) const;
+  Vec3 awayFromCover(std::uint8_t mask_a, std::uint8_t mask_b, const Vec3& n) const;
 
   const SphereTree& tree_a_;
   const SphereTree& tree_b_;

@@ -135,21 +135,15 @@ Vec3 clipCovered(std::uint8_t mask, Vec3 outward) {
 
 }  // namespace
 
-bool PairGeometry::intoCover(const ContactCandidate& c, const Vec3& n) const {
-  const std::uint8_t mask_a = covered_a_ != nullptr ? covered_a_[static_cast<std::size_t>(c.node_a)] : 0;
-  const std::uint8_t mask_b = covered_b_ != nullptr ? covered_b_[static_cast<std::size_t>(c.node_b)] : 0;
+bool PairGeometry::intoCover(std::uint8_t mask_a, std::uint8_t mask_b, const Vec3& n) const {
   return (mask_a != 0 && throughCovered(mask_a, rot_a_.transpose() * n)) ||
          (mask_b != 0 && throughCovered(mask_b, -(rot_b_.transpose() * n)));
 }
 
-Vec3 PairGeometry::awayFromCover(const ContactCandidate& c, const Vec3& n) const {
+Vec3 PairGeometry::awayFromCover(std::uint8_t mask_a, std::uint8_t mask_b, const Vec3& n) const {
   Vec3 open = n;
-  if (covered_a_ != nullptr && covered_a_[static_cast<std::size_t>(c.node_a)] != 0) {
-    open = rot_a_ * clipCovered(covered_a_[static_cast<std::size_t>(c.node_a)], rot_a_.transpose() * open);
-  }
-  if (covered_b_ != nullptr && covered_b_[static_cast<std::size_t>(c.node_b)] != 0) {
-    open = -(rot_b_ * clipCovered(covered_b_[static_cast<std::size_t>(c.node_b)], -(rot_b_.transpose() * open)));
-  }
+  if (mask_a != 0) open = rot_a_ * clipCovered(mask_a, rot_a_.transpose() * open);
+  if (mask_b != 0) open = -(rot_b_ * clipCovered(mask_b, -(rot_b_.transpose() * open)));
   const double length = open.norm();
   return length > 1e-9 ? Vec3(open / length) : n;
 }
@@ -157,8 +151,11 @@ Vec3 PairGeometry::awayFromCover(const ContactCandidate& c, const Vec3& n) const
 void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
   // A normal through a face another static body covers would push b into
   // that body (a tile's rim, into the next tile): its part along the face goes.
-  const bool covered = intoCover(c, c.normal);
-  if (covered) c.normal = awayFromCover(c, c.normal);
+  const std::uint8_t mask_a = covered_a_ != nullptr ? covered_a_[static_cast<std::size_t>(c.node_a)] : 0;
+  const std::uint8_t mask_b = covered_b_ != nullptr ? covered_b_[static_cast<std::size_t>(c.node_b)] : 0;
+  const bool any_cover = (mask_a | mask_b) != 0;
+  const bool covered = any_cover && intoCover(mask_a, mask_b, c.normal);
+  if (covered) c.normal = awayFromCover(mask_a, mask_b, c.normal);
   c.separation = gapAlong(c, c.normal);
   c.refined = true;
   if (!face_normals || (bounds_a_ == nullptr && bounds_b_ == nullptr)) return;
@@ -166,7 +163,6 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
   // line of centres is the better normal (separating-axis rule): face-on,
   // the line of centres of two voxel spheres tilts by up to 45 deg.
   bool face = false;
-  const bool any_cover = covered_a_ != nullptr || covered_b_ != nullptr;
   const Vec3 delta = c.cb - c.ca;
   const Vec3 delta_a = rot_a_.transpose() * delta;
   const Vec3 delta_b = b_in_a_.transpose() * delta_a;
@@ -177,12 +173,12 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
     const double along = of_a ? delta_a[axis] : delta_b[axis];
     double sign = along < 0.0 ? -1.0 : 1.0;
     Vec3 normal = sign * (of_a ? Vec3(rot_a_.col(axis)) : Vec3(rot_b_.col(axis)));
-    if (any_cover && intoCover(c, normal)) {
+    if (any_cover && intoCover(mask_a, mask_b, normal)) {
       // b's node lies beyond the covered side (deeper than a one-sided
       // wall's middle): the open side of the axis is the way out, however deep.
       sign = -sign;
       normal = -normal;
-      if (intoCover(c, normal)) continue;
+      if (intoCover(mask_a, mask_b, normal)) continue;
     }
     const Vec3 dir_a = sign * (of_a ? Vec3(Vec3::Unit(axis)) : Vec3(b_in_a_.col(axis)));
     const Vec3 dir_b = sign * (of_a ? Vec3(b_in_a_.row(axis).transpose()) : Vec3(Vec3::Unit(axis)));
