@@ -42,15 +42,16 @@ struct CoverShape {
 // just outside it, one per voxel of the face (at most 16 x 16), all lie in
 // occupied voxels of the body or of another static body. A body's closed
 // faces (EntitySpec::closed_faces) are covered on every node. Movable bodies
-// have no mask: their faces move apart.
-// Rebuilt only when a static body is added, removed or moved.
+// have no mask: their faces move apart. An update measures again only the
+// static bodies added or moved since the last one and those near them or
+// near where one was removed.
 class StaticCover {
  public:
   void add(const BodyState& body, std::uint8_t closed_faces = 0);  // a body appended at the end
   void remove(std::size_t index, std::size_t last);  // swap-remove, as the World's arrays
   void clear();
-  // Rebuilds the masks when a static body came, went or moved since the last
-  // call. shapes: by the bodies' shape ids. Returns whether it rebuilt.
+  // Measures the masks again where a static body came, went or moved since
+  // the last call (never per tick otherwise). shapes: by the bodies' shape ids. Returns whether it rebuilt.
   bool update(const std::vector<BodyState>& bodies, const std::vector<std::uint32_t>& body_shapes,
               const std::vector<CoverShape>& shapes);
   // The node masks of body `index` (faceBit per node), nullptr when none of
@@ -65,6 +66,8 @@ class StaticCover {
   std::vector<Pose> poses_;                       // static poses the masks were built for
   std::vector<std::uint8_t> is_static_;
   std::vector<std::uint8_t> closed_;              // EntitySpec::closed_faces
+  std::vector<std::uint8_t> dirty_;               // static, added or moved since the last update
+  std::vector<Vec3> removed_;                     // where static bodies left from since then
   bool stale_ = false;
 };
 

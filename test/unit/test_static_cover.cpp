@@ -118,6 +118,68 @@ TEST(StaticCover, MarksFacesInsideTheTileAndAgainstAFlushNeighbourOnly) {
   for (const std::uint8_t m : masksOfFirstTile(one_sided, faceBit(2, false))) EXPECT_NE(m & faceBit(2, false), 0);
 }
 
+// Masks of every body as a cover built at once from `bodies` gives them.
+std::vector<std::vector<std::uint8_t>> maskTable(const StaticCover& cover, const std::vector<BodyState>& bodies,
+                                                 const World& world, const std::vector<std::uint32_t>& shapes_of) {
+  std::vector<std::vector<std::uint8_t>> table;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const std::uint8_t* m = cover.of(i);
+    const std::size_t nodes = world.shape(shapes_of[i]).tree.nodes().size();
+    table.push_back(m == nullptr ? std::vector<std::uint8_t>{} : std::vector<std::uint8_t>(m, m + nodes));
+  }
+  return table;
+}
+
+// A cover kept up to date tile by tile (spawned, moved, removed) holds the
+// masks one built from scratch would: only the tiles near a change are
+// measured again, and none that should be is missed.
+TEST(StaticCover, KeptUpToDateItEqualsACoverBuiltAtOnce) {
+  World world = gravityWorld();
+  addTiles(world, 1);  // the tile shape; its body is dropped from the lists below
+  std::vector<ShapeBounds> bounds;
+  bounds.push_back(makeShapeBounds(world.shape(0).tree, &world.shape(0).voxels, world.shape(0).body_origin));
+  const std::vector<CoverShape> shapes{CoverShape{&world.shape(0).voxels, world.shape(0).body_origin, &bounds[0]}};
+  std::vector<BodyState> bodies;
+  std::vector<std::uint32_t> shapes_of;
+  StaticCover kept;
+  const auto fresh = [&] {
+    StaticCover built;
+    for (const BodyState& b : bodies) built.add(b);
+    built.update(bodies, shapes_of, shapes);
+    return maskTable(built, bodies, world, shapes_of);
+  };
+  const auto tileAt = [&](double x, double y) {
+    BodyState b = world.bodies()[0];
+    b.pose.position = Vec3(x, y, -0.5 * kCell);
+    bodies.push_back(b);
+    shapes_of.push_back(0);
+    kept.add(b);
+  };
+  // A 3 x 2 floor laid one tile per update, then one far away.
+  for (int j = 0; j < 2; ++j) {
+    for (int i = 0; i < 3; ++i) {
+      tileAt(2.0 * i, 2.0 * j);
+      kept.update(bodies, shapes_of, shapes);
+      ASSERT_EQ(maskTable(kept, bodies, world, shapes_of), fresh()) << "after tile " << bodies.size();
+    }
+  }
+  tileAt(40.0, 0.0);
+  kept.update(bodies, shapes_of, shapes);
+  EXPECT_EQ(maskTable(kept, bodies, world, shapes_of), fresh());
+  // The middle tile of the first row moved away: its neighbours' rims open.
+  bodies[1].pose.position.z() -= 5.0;
+  EXPECT_TRUE(kept.update(bodies, shapes_of, shapes));
+  EXPECT_EQ(maskTable(kept, bodies, world, shapes_of), fresh());
+  // A corner tile removed (swap-remove, as the World does: the far tile takes its place).
+  kept.remove(0, bodies.size() - 1);
+  bodies[0] = bodies.back();
+  bodies.pop_back();
+  shapes_of.pop_back();
+  EXPECT_TRUE(kept.update(bodies, shapes_of, shapes));
+  EXPECT_EQ(maskTable(kept, bodies, world, shapes_of), fresh());
+  EXPECT_FALSE(kept.update(bodies, shapes_of, shapes));
+}
+
 // The bug this fixes: a cube pressed into the seam of two tiles was pushed
 // sideways by both tiles' rims (5.8 cm at 30 % sunk) or, at 50 %, fell through.
 TEST(StaticCover, ACubePressedIntoTheSeamOfTwoTilesRisesStraightUp) {
