@@ -52,6 +52,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     msg.color.r = static_cast<float>(stc_fuzz::pickDouble(in, 0, 1));
     msg.color.a = static_cast<float>(stc_fuzz::pickDouble(in, 0, 1));
     msg.is_static = in.ConsumeIntegralInRange<int>(0, 4) == 0;
+    static const char* const kFaces[] = {"+x", "-x", "+y", "-y", "+z", "-z", "", "z", "-Z", "+x "};
+    for (int f = in.ConsumeIntegralInRange<int>(0, 3); f > 0; --f) {
+      msg.closed_faces.push_back(kFaces[in.ConsumeIntegralInRange<int>(0, 9)]);
+    }
 
     const std::size_t before = world.entityCount();
     try {

@@ -1,5 +1,7 @@
 #include "sphere_tree_collision/ros/conversions.hpp"
 
+#include "sphere_tree_collision/static_cover.hpp"
+
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <Eigen/LU>
@@ -127,6 +129,7 @@ EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg,
   r.spec.material.friction = msg.friction;
   r.spec.material.strength = msg.strength;
   r.spec.is_static = msg.is_static;
+  if (!msg.closed_faces.empty()) r.spec.closed_faces = stc::parseFaces(msg.closed_faces);
   const auto& c = msg.color;
   if (c.r != 0.0f || c.g != 0.0f || c.b != 0.0f || c.a != 0.0f) r.color = Rgba{c.r, c.g, c.b, c.a};
   return r;

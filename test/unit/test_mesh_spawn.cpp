@@ -112,6 +112,34 @@ TEST(SceneFileClosedFaces, AStaticEntryClosesTheNamedFacesAndBadOnesAreRejectedB
       << "a movable body's faces move apart: only static bodies close faces";
 }
 
+TEST(SpawnClosedFaces, AStaticSpawnClosesTheNamedFacesAndBadOnesAreRejectedByName) {
+  sphere_tree_collision::SpawnEntity msg;
+  msg.preset = "plate";
+  msg.voxel_size = 0.05;
+  msg.density = 1000.0;
+  msg.pose.orientation.w = 1.0;
+  msg.is_static = true;
+  msg.closed_faces = {"-z"};
+  stc::World world;
+  EXPECT_EQ(toEntityRequest(msg, 8).spec.closed_faces, stc::faceBit(2, false));
+  ASSERT_NE(addRequest(world, toEntityRequest(msg, 8)), stc::kInvalidEntity);
+  const auto field_of = [&world](const sphere_tree_collision::SpawnEntity& m) -> std::string {
+    try {
+      addRequest(world, toEntityRequest(m, 8));
+    } catch (const stc::InputError& e) {
+      return e.field();
+    }
+    return "accepted";
+  };
+  sphere_tree_collision::SpawnEntity bad = msg;
+  bad.closed_faces = {"-z", "bottom"};
+  EXPECT_EQ(field_of(bad), "closed_faces");
+  bad = msg;
+  bad.is_static = false;
+  EXPECT_EQ(field_of(bad), "closed_faces") << "only static bodies close faces";
+  EXPECT_EQ(world.entityCount(), 1u) << "a rejected spawn adds nothing";
+}
+
 TEST_F(MeshSpawn, SpawnMessageWithAMeshAddsItScaled) {
   sphere_tree_collision::SpawnEntity msg;
   msg.mesh_resource = path_;
