@@ -45,7 +45,7 @@ struct StepContext {
   // solver keeps sleeping pairs' warm-start impulses (respond; nullptr: not).
   const std::vector<EntityId>* ids = nullptr;
   const std::vector<std::uint8_t>* held_asleep = nullptr;
-  // Static bodies' faces other static bodies cover (respond's contacts; nullptr: none).
+  // Static bodies' covered faces, kept out of contact normals (respond's contacts; nullptr: none).
   const StaticCover* static_cover = nullptr;
 };
 

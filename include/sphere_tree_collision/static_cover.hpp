@@ -59,7 +59,6 @@ class StaticCover {
   const std::uint8_t* of(std::size_t index) const {
     return index < masks_.size() && !masks_[index].empty() ? masks_[index].data() : nullptr;
   }
-  std::size_t coveredBodies() const;  // bodies with at least one covered face
 
  private:
   std::vector<std::vector<std::uint8_t>> masks_;  // by dense index; empty: nothing covered

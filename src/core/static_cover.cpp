@@ -119,11 +119,6 @@ void StaticCover::clear() {
   stale_ = false;
 }
 
-std::size_t StaticCover::coveredBodies() const {
-  return static_cast<std::size_t>(
-      std::count_if(masks_.begin(), masks_.end(), [](const auto& m) { return !m.empty(); }));
-}
-
 bool StaticCover::update(const std::vector<BodyState>& bodies, const std::vector<std::uint32_t>& body_shapes,
                          const std::vector<CoverShape>& shapes) {
   assert(bodies.size() == masks_.size());
