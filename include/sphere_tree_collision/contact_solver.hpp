@@ -15,6 +15,7 @@
 #include "sphere_tree_collision/workers.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -226,7 +227,10 @@ class ContactSolver {
   bool any_rolling_ = false;
   std::vector<std::uint32_t> manifold_start_;  // rows of one body pair: [start[m], start[m + 1])
   std::vector<ColourGroup> manifolds_;         // each manifold's movable bodies (kStatic: static)
-  std::vector<std::uint32_t> order_, active_, level_start_, wave_rows_;
+  std::vector<std::uint32_t> order_, active_, level_start_;
+  std::vector<std::uint32_t> wave_rows_, last_wave_rows_, next_wave_rows_;  // collide(): by wave
+  std::vector<std::array<std::uint32_t, 2>> row_bodies_;  // collide(): each row's bodies, compact
+  std::vector<std::uint8_t> moved_;                       // collide(): bodies the last two waves moved
   std::vector<Motion> motion_;  // solver velocities, one per body
   std::vector<Motion> delta_;   // Jacobi: impulses of one iteration, applied together
   std::vector<Motion> pseudo_;  // split-impulse pseudo-velocities

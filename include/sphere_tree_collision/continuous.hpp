@@ -44,6 +44,10 @@ struct SweepScratch {
   std::vector<SweepHit> hits;            // per body: the earliest over all lanes
   std::vector<std::uint32_t> clamped;    // bodies put back this tick
   std::vector<SweepLane> lanes;          // runs of the pairs, in pair order
+  // Node pairs whose leaves' boxes cannot reach a hit are not opened (the
+  // same hits, far fewer leaf tests). false: every node pair the spheres let
+  // through is opened (tests compare the two).
+  bool prune_by_boxes = true;
 };
 
 // Bodies moved from start[i] to bodies[i].pose this tick. A body is fast when

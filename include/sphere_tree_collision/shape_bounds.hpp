@@ -26,6 +26,10 @@ struct ShapeBounds {
   std::vector<Vec3> box_half;    // per node: box half extents
   std::vector<double> reach;     // per node: max over its leaves of |c_leaf - c_node| + r_leaf
   std::vector<double> thinnest;  // per node: least half extent of its leaves' boxes (sweeps)
+  // Per node: the box of its leaves' boxes (body frame, centre and half
+  // extents): a leaf box's extent along any body axis lies within it (sweeps).
+  std::vector<Vec3> leaves_centre;
+  std::vector<Vec3> leaves_half;
   double min_leaf_radius = 0.0;
   double bound_radius = 0.0;     // max over leaves of |c_leaf| + r_leaf (about the body origin)
 

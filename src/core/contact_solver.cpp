@@ -134,7 +134,8 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   // Everything sized by the rows grows with them, in the same tick (no
   // allocation in a later tick whose waves or manifolds happen to be larger;
   // both warm-start buffers, as they swap every tick).
-  wave_rows_.reserve(rows_.size());
+  for (std::vector<std::uint32_t>* v : {&wave_rows_, &last_wave_rows_, &next_wave_rows_}) v->reserve(rows_.size());
+  row_bodies_.reserve(rows_.size());
   for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_, &merged_manifolds_}) {
     v->reserve(rows_.size());
   }
@@ -506,25 +507,28 @@ void ContactSolver::collide(const ResponseOptions& options, SolveStats& stats) {
     const Motion& b = motion_[row.b];
     return relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n);
   };
-  bool any = false;
-  for (std::size_t r = 0; r < rows_.size(); ++r) {
+  wave_rows_.clear();
+  for (std::uint32_t r = 0; r < rows_.size(); ++r) {
     const Row& row = rows_[r];
     RowInfo& info = info_[r];
     info.bounced = info.restitution > 0.0 && info.approach < -std::max(options.restitution_threshold, row.speculative);
     info.wave = info.bounced ? 0 : -1;
     info.bounce_from = info.approach;
-    any = any || info.bounced;
+    if (info.bounced) wave_rows_.push_back(r);
   }
-  if (!any) return;
-  for (int wave = 0; wave < options.iterations; ++wave) {
-    wave_rows_.clear();  // iterated alone: a wave is a few rows of many
-    for (std::uint32_t r = 0; r < info_.size(); ++r) {
-      RowInfo& info = info_[r];
-      if (info.wave == wave) {
-        ++stats.bounced;
-        info.lambda_wave = 0.0;
-        wave_rows_.push_back(r);
-      }
+  if (wave_rows_.empty()) return;
+  // A row whose bodies did not move since it was last looked at still
+  // separates: after each wave only the rows of the bodies it and the wave
+  // before moved are looked at, found in a compact copy of the rows' bodies.
+  last_wave_rows_.clear();
+  row_bodies_.resize(rows_.size());
+  for (std::size_t r = 0; r < rows_.size(); ++r) row_bodies_[r] = {rows_[r].a, rows_[r].b};
+  moved_.assign(motion_.size(), 0);
+  const auto movable = [](double inv_mass, const Vec3& angular) { return inv_mass != 0.0 || !angular.isZero(0.0); };
+  for (int wave = 0; wave < options.iterations && !wave_rows_.empty(); ++wave) {
+    for (const std::uint32_t r : wave_rows_) {
+      ++stats.bounced;
+      info_[r].lambda_wave = 0.0;
     }
     for (int it = 0; it < options.iterations; ++it) {
       for (const std::uint32_t r : wave_rows_) {
@@ -539,20 +543,33 @@ void ContactSolver::collide(const ResponseOptions& options, SolveStats& stats) {
       }
       if (jacobi) commitJacobi(motion_);
     }
-    bool next = false;
-    for (std::size_t r = 0; r < rows_.size(); ++r) {
-      const Row& row = rows_[r];
+    // The last wave's rows too: its own rows were not looked at after it.
+    for (const auto* list : {&wave_rows_, &last_wave_rows_}) {
+      for (const std::uint32_t r : *list) {
+        const Row& row = rows_[r];
+        if (movable(row.inv_ma, row.ang_a[0])) moved_[row.a] = 1;
+        if (movable(row.inv_mb, row.ang_b[0])) moved_[row.b] = 1;
+      }
+    }
+    next_wave_rows_.clear();
+    for (std::uint32_t r = 0; r < row_bodies_.size(); ++r) {
+      if (!moved_[row_bodies_[r][0]] && !moved_[row_bodies_[r][1]]) continue;
       RowInfo& info = info_[r];
       if (info.wave == wave || info.restitution <= 0.0) continue;
+      const Row& row = rows_[r];
       const double vn = normalVelocity(row);
       if (vn < -std::max(options.restitution_threshold, row.speculative)) {
         info.wave = wave + 1;
         info.bounce_from = vn;
         info.bounced = true;
-        next = true;
+        next_wave_rows_.push_back(r);
       }
     }
-    if (!next) break;
+    for (const auto* list : {&wave_rows_, &last_wave_rows_}) {
+      for (const std::uint32_t r : *list) moved_[rows_[r].a] = moved_[rows_[r].b] = 0;
+    }
+    last_wave_rows_.swap(wave_rows_);
+    wave_rows_.swap(next_wave_rows_);
   }
 }
 

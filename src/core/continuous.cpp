@@ -40,18 +40,88 @@ struct Sweeper {
   bool anchor_first = true;  // the contact point is taken below the first body's leaf (else the second's)
   double turn_first = 0.0;   // angle each body turns through this tick (rad)
   double turn_second = 0.0;
+  bool prune_by_boxes = true;  // SweepScratch::prune_by_boxes
   Mat3 relative_abs = (ro1.transpose() * r1).cwiseAbs();  // |cosines| between the end axes
   Vec3 normal = Vec3::UnitZ();  // of the earliest hit, from the first body towards the second
   Vec3 point = Vec3::Zero();
   std::size_t leaf_tests = 0;
 
+  // Two boxes (body-frame centres and half extents, the first's on the first
+  // body), their centres moving along lines through the tick, each kept at
+  // its end orientation: along each of the six face axes the overlap extent,
+  // the centres' offset at the start and its change, and the times (lo, hi)
+  // in which they overlap deeper than `tolerance` on every axis at once.
+  struct BoxMotion {
+    Vec3 d0, d1;  // second's box centre from the first's, at start and end
+    double full[6], offset[6], change[6];  // axes 0-2: the first box's faces, 3-5: the second's
+    double lo = -std::numeric_limits<double>::infinity();
+    double hi = std::numeric_limits<double>::infinity();
+    int entry_axis = 0;  // the axis whose overlap begins last (at lo)
+  };
+  // False when no such time exists.
+  bool overlapInterval(const Vec3& local_f, const Vec3& hf, const Vec3& local_o, const Vec3& ho, double tolerance,
+                       BoxMotion& m) const {
+    m.d0 = ro0 * local_o + xo0 - (r0 * local_f + x0);
+    m.d1 = ro1 * local_o + xo1 - (r1 * local_f + x1);
+    const Vec3 d0_f = r1.transpose() * m.d0, d1_f = r1.transpose() * m.d1;
+    const Vec3 d0_o = ro1.transpose() * m.d0, d1_o = ro1.transpose() * m.d1;
+    for (int k = 0; k < 6; ++k) {
+      if (k < 3) {
+        m.full[k] = hf[k] + ho.dot(relative_abs.col(k));
+        m.offset[k] = d0_f[k];
+        m.change[k] = d1_f[k] - d0_f[k];
+      } else {
+        m.full[k] = hf.dot(relative_abs.row(k - 3)) + ho[k - 3];
+        m.offset[k] = d0_o[k - 3];
+        m.change[k] = d1_o[k - 3] - d0_o[k - 3];
+      }
+      const double reach = m.full[k] - tolerance;
+      if (reach <= 0.0) return false;
+      if (m.change[k] == 0.0) {
+        if (std::abs(m.offset[k]) >= reach) return false;
+        continue;
+      }
+      const double t1 = (-reach - m.offset[k]) / m.change[k];
+      const double t2 = (reach - m.offset[k]) / m.change[k];
+      const double enter = std::min(t1, t2);
+      if (enter > m.lo) {
+        m.lo = enter;
+        m.entry_axis = k;
+      }
+      m.hi = std::min(m.hi, std::max(t1, t2));
+      if (m.lo >= m.hi) return false;
+    }
+    return true;
+  }
+
+  // Whether any leaf pair below nodes nf, no can be a hit (leafEntry): one
+  // needs a time in the tick at which its boxes overlap deeper than the
+  // thinner box's half extent on all six axes. Leaf boxes lie within their
+  // nodes' leaves boxes (same body frame), so along every axis they overlap
+  // no deeper than those do: without such a time for the nodes' boxes, at
+  // the least half extent below them, there is none below. Boxes keep their
+  // end orientation while their centres move on lines from the start pose:
+  // a leaf box's centre strays from its place in the node's box by at most
+  // turn x its distance, so the node's box is grown by that.
+  bool mayHitBelow(std::int32_t nf, std::int32_t no) const {
+    const std::size_t f = static_cast<std::size_t>(nf);
+    const std::size_t o = static_cast<std::size_t>(no);
+    const double thinnest = 0.999 * std::min(first.thinnest[f], second.thinnest[o]);  // rounding: keep more
+    const Vec3& half_f = first.leaves_half[f];
+    const Vec3& half_o = second.leaves_half[o];
+    BoxMotion m;
+    return overlapInterval(first.leaves_centre[f], half_f + Vec3::Constant(turn_first * half_f.norm()),
+                           second.leaves_centre[o], half_o + Vec3::Constant(turn_second * half_o.norm()), thinnest,
+                           m) &&
+           m.hi > 0.0 && m.lo < 1.0;
+  }
+
   // First instant the two leaves' voxel boxes overlap deeper than a quarter
   // of the thinner box's half extent on all six face axes, in their relative
-  // motion (slab test of two boxes moving along lines, each kept at its end
-  // orientation); -1 when they do not, or when they already do at the start
-  // (a resting contact: the solver's). Penetration tested on boxes, not
-  // spheres: a flat leaf's sphere reaches far beyond its voxels, and a body
-  // sliding over a floor would keep running into the spheres ahead.
+  // motion (overlapInterval); -1 when they do not, or when they already do
+  // at the start (a resting contact: the solver's). Penetration tested on
+  // boxes, not spheres: a flat leaf's sphere reaches far beyond its voxels,
+  // and a body sliding over a floor would keep running into the spheres ahead.
   // A hit that the discrete step handles is not one: while the boxes overlap
   // this tick they never get deeper than the thinner box's half extent (its
   // centre does not cross the other box's face). A body grazing a wall or
@@ -69,58 +139,25 @@ struct Sweeper {
     const std::size_t o = static_cast<std::size_t>(no);
     const Vec3 local_f = first.tree->node(nf).centre + first.box_offset[f];
     const Vec3 local_o = second.tree->node(no).centre + second.box_offset[o];
-    const Vec3 d0 = ro0 * local_o + xo0 - (r0 * local_f + x0);  // second's box centre from the first's
-    const Vec3 d1 = ro1 * local_o + xo1 - (r1 * local_f + x1);
     const Vec3& hf = first.box_half[f];
     const Vec3& ho = second.box_half[o];
     const double thinner = std::min(hf.minCoeff(), ho.minCoeff());
-    const double tolerance = 0.25 * thinner;
-    // Axes 0-2: the first box's faces, 3-5: the second's; offsets along them.
-    const Vec3 d0_f = r1.transpose() * d0, d1_f = r1.transpose() * d1;
-    const Vec3 d0_o = ro1.transpose() * d0, d1_o = ro1.transpose() * d1;
-    double lo = -std::numeric_limits<double>::infinity();
-    double hi = std::numeric_limits<double>::infinity();
-    double full[6], offset[6], change[6];  // per axis: overlap extent, centre offset at start, its change
-    int entry_axis = 0;
-    for (int k = 0; k < 6; ++k) {
-      if (k < 3) {
-        full[k] = hf[k] + ho.dot(relative_abs.col(k));
-        offset[k] = d0_f[k];
-        change[k] = d1_f[k] - d0_f[k];
-      } else {
-        full[k] = hf.dot(relative_abs.row(k - 3)) + ho[k - 3];
-        offset[k] = d0_o[k - 3];
-        change[k] = d1_o[k - 3] - d0_o[k - 3];
-      }
-      const double reach = full[k] - tolerance;
-      if (reach <= 0.0) return -1.0;
-      if (change[k] == 0.0) {
-        if (std::abs(offset[k]) >= reach) return -1.0;
-        continue;
-      }
-      const double t1 = (-reach - offset[k]) / change[k];
-      const double t2 = (reach - offset[k]) / change[k];
-      const double enter = std::min(t1, t2);
-      if (enter > lo) {
-        lo = enter;
-        entry_axis = k;
-      }
-      hi = std::min(hi, std::max(t1, t2));
-      if (lo >= hi) return -1.0;
-    }
+    BoxMotion m;
+    if (!overlapInterval(local_f, hf, local_o, ho, 0.25 * thinner, m)) return -1.0;
+    const double lo = m.lo;
     if (lo <= 0.0 || lo > best) return -1.0;  // overlapping at the start, never, or later
     const auto depth = [&](double t) {
       double d = std::numeric_limits<double>::infinity();
-      for (int k = 0; k < 6; ++k) d = std::min(d, full[k] - std::abs(offset[k] + t * change[k]));
+      for (int k = 0; k < 6; ++k) d = std::min(d, m.full[k] - std::abs(m.offset[k] + t * m.change[k]));
       return d;
     };
-    const double last = std::min(hi, 1.0);
+    const double last = std::min(m.hi, 1.0);
     if (std::max(depth(0.5 * (lo + last)), depth(last)) <= thinner) return -1.0;  // a graze
-    const Mat3& frame = entry_axis < 3 ? r1 : ro1;  // the box whose face it is
-    const int k = entry_axis % 3;
-    n = offset[entry_axis] + lo * change[entry_axis] >= 0.0 ? Vec3(frame.col(k)) : Vec3(-frame.col(k));
+    const Mat3& frame = m.entry_axis < 3 ? r1 : ro1;  // the box whose face it is
+    const int k = m.entry_axis % 3;
+    n = m.offset[m.entry_axis] + lo * m.change[m.entry_axis] >= 0.0 ? Vec3(frame.col(k)) : Vec3(-frame.col(k));
     const Vec3 ca = r0 * local_f + x0 + lo * (r1 * local_f + x1 - (r0 * local_f + x0));  // box centres at the hit
-    const Vec3 cb = ca + d0 + lo * (d1 - d0);
+    const Vec3 cb = ca + m.d0 + lo * (m.d1 - m.d0);
     const auto extent = [&](const Vec3& u, const Vec3& h, const Mat3& r) { return h.dot((r.transpose() * u).cwiseAbs()); };
     p = 0.5 * (ca.dot(n) + extent(n, hf, r1) + cb.dot(n) - extent(n, ho, ro1)) * n;
     const Vec3& anchor = anchor_first ? ca : cb;
@@ -173,6 +210,7 @@ struct Sweeper {
       }
       const double bound = first.reach[fi] + second.reach[oi];
       if (firstTouch(a0 - b0, (a1 - b1) - (a0 - b0), bound, best) < 0.0) continue;
+      if (prune_by_boxes && !mayHitBelow(nf, no)) continue;
       // Open the node with the larger reach (a leaf cannot be opened).
       const bool open_first = !f_leaf && (o_leaf || first.reach[fi] >= second.reach[oi]);
       if (open_first) {
@@ -221,6 +259,7 @@ struct SweepInput {
   const std::vector<std::array<std::uint32_t, 2>>& pairs;
   const std::vector<std::uint8_t>& fast;
   double threshold;
+  bool prune_by_boxes;
 };
 
 // Sweeps pairs [begin, end) in order into the lane's hits.
@@ -254,6 +293,7 @@ void sweepPairs(const SweepInput& in, std::size_t begin, std::size_t end, SweepL
     s.anchor_first = fast[a] != 0;
     s.turn_first = turn_a;
     s.turn_second = turn_b;
+    s.prune_by_boxes = in.prune_by_boxes;
     ++lane.stats.pairs;
     const bool found = s.run();
     lane.stats.leaf_tests += s.leaf_tests;
@@ -304,7 +344,7 @@ SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pos
     lane.touched.reserve(bodies.size());
     lane.stats = SweepStats{};
   }
-  const SweepInput in{bodies, start, shapes, pairs, scratch.fast, threshold};
+  const SweepInput in{bodies, start, shapes, pairs, scratch.fast, threshold, scratch.prune_by_boxes};
   const auto run = [&](std::size_t l, std::size_t) {
     const auto [begin, end] = chunkRange(pair_count, l, lanes);
     sweepPairs(in, begin, end, scratch.lanes[l]);

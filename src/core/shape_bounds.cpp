@@ -16,6 +16,8 @@ ShapeBounds makeShapeBounds(const SphereTree& tree, const VoxelShape* voxels, co
   bounds.box_half.resize(count);
   bounds.reach.assign(count, 0.0);
   bounds.thinnest.assign(count, 0.0);
+  bounds.leaves_centre.assign(count, Vec3::Zero());
+  bounds.leaves_half.assign(count, Vec3::Zero());
   bounds.min_leaf_radius = std::numeric_limits<double>::infinity();
 
   for (std::size_t n = 0; n < count; ++n) {
@@ -58,17 +60,25 @@ ShapeBounds makeShapeBounds(const SphereTree& tree, const VoxelShape* voxels, co
       bounds.min_leaf_radius = std::min(bounds.min_leaf_radius, n.radius);
       bounds.bound_radius = std::max(bounds.bound_radius, n.centre.norm() + bounds.reach[i]);
       bounds.thinnest[i] = bounds.box_half[i].minCoeff();
+      bounds.leaves_centre[i] = n.centre + bounds.box_offset[i];
+      bounds.leaves_half[i] = bounds.box_half[i];
       continue;
     }
     double reach = 0.0;
     double thinnest = std::numeric_limits<double>::infinity();
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 hi = -lo;
     for (std::int32_t c = n.first_child; c < n.first_child + n.child_count; ++c) {
       const std::size_t ci = static_cast<std::size_t>(c);
       reach = std::max(reach, (nodes[ci].centre - n.centre).norm() + bounds.reach[ci]);
       thinnest = std::min(thinnest, bounds.thinnest[ci]);
+      lo = lo.cwiseMin(bounds.leaves_centre[ci] - bounds.leaves_half[ci]);
+      hi = hi.cwiseMax(bounds.leaves_centre[ci] + bounds.leaves_half[ci]);
     }
     bounds.reach[i] = reach;
     bounds.thinnest[i] = thinnest;
+    bounds.leaves_centre[i] = 0.5 * (lo + hi);
+    bounds.leaves_half[i] = 0.5 * (hi - lo);
   }
   if (!std::isfinite(bounds.min_leaf_radius)) bounds.min_leaf_radius = 0.0;
   return bounds;

@@ -4,13 +4,17 @@
 // motion; it sweeps only the broad phase's pairs.
 #include "stability_scenes.hpp"
 
+#include "sphere_tree_collision/continuous.hpp"
 #include "sphere_tree_collision/dynamics.hpp"
+#include "sphere_tree_collision/shape_bounds.hpp"
+#include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 namespace stc {
 namespace {
@@ -223,6 +227,80 @@ TEST(Continuous, AHitWithoutANarrowPhaseContactIsTheContact) {
   EXPECT_NEAR(w.bodies()[ball].linear_velocity.z(), 50.0, 0.5);
   EXPECT_LT(w.bodies()[ball].angular_velocity.norm(), 1e-6);  // pushed through its centre, not spun
   EXPECT_GT(w.bodies()[ball].pose.position.z(), 1.0);  // and flew back up
+}
+
+// The sweep skips node pairs whose leaves' boxes cannot reach a hit. Two
+// shapes thrown at each other from random poses, moving and turning (up to
+// 0.8 rad a tick): with and without the pruning, the same bodies are put
+// back at the same instant and place, bit for bit, with fewer leaf pairs
+// tested (bench: 3 to 30 times fewer in cube_box). Without growing the
+// boxes by the turn, hits of turning bodies were lost.
+TEST(Continuous, PruningByBoxesKeepsEveryHit) {
+  const std::vector<std::pair<std::string, std::uint32_t>> kinds = {{"rock", 3}, {"cube", 1}, {"rod", 1}, {"L", 1}};
+  std::vector<VoxelShape> voxels;
+  std::vector<SphereTree> trees;
+  for (const auto& [name, seed] : kinds) {
+    PresetParams p;
+    p.resolution = 8;
+    p.voxel_size = kVoxel;
+    p.seed = seed;
+    voxels.push_back(makePreset(name, p));
+  }
+  trees.reserve(voxels.size());
+  std::vector<ShapeBounds> bounds;
+  for (const VoxelShape& v : voxels) {
+    const Vec3 origin = computeMassProperties(v, 1.0).centre_of_mass;
+    trees.push_back(SphereTree::build(v, origin));
+    bounds.push_back(makeShapeBounds(trees.back(), &v, origin));
+  }
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto direction = [&] {
+    Vec3 d(unit(rng), unit(rng), unit(rng));
+    return d.norm() > 1e-3 ? Vec3(d.normalized()) : Vec3(Vec3::UnitX());
+  };
+  const auto turn = [&](double most) { return Quat(Eigen::AngleAxisd(most * 0.5 * (1.0 + unit(rng)), direction())); };
+  int hits = 0;
+  std::size_t pruned_tests = 0, full_tests = 0;
+  const std::vector<std::array<std::uint32_t, 2>> pairs = {{0u, 1u}};
+  for (int trial = 0; trial < 6000; ++trial) {
+    const std::size_t ka = static_cast<std::size_t>(trial) % bounds.size();
+    const std::size_t kb = static_cast<std::size_t>(trial / 3) % bounds.size();
+    std::vector<Pose> start(2);
+    std::vector<BodyState> bodies(2);
+    const double reach = bounds[ka].bound_radius + bounds[kb].bound_radius;
+    start[0].orientation = turn(M_PI);
+    start[1].orientation = turn(M_PI);
+    start[1].position = direction() * reach * (0.6 + 0.5 * (1.0 + unit(rng)));
+    for (std::size_t i = 0; i < 2; ++i) {
+      bodies[i].inv_mass = 1.0;
+      bodies[i].inv_inertia_body = Mat3::Identity();
+      const Vec3 towards = (i == 0 ? 1.0 : -1.0) * start[1].position.normalized();
+      const Vec3 move = 0.15 * (1.0 + unit(rng)) * (towards + 0.5 * direction());
+      bodies[i].pose.position = start[i].position + move;
+      bodies[i].pose.orientation = (turn(0.8) * start[i].orientation).normalized();
+    }
+    const std::vector<const ShapeBounds*> shapes = {&bounds[ka], &bounds[kb]};
+    std::vector<BodyState> pruned = bodies, full = bodies;
+    SweepScratch with, without;
+    without.prune_by_boxes = false;
+    markFastBodies(pruned, start, shapes, 0.5, with.fast);
+    markFastBodies(full, start, shapes, 0.5, without.fast);
+    const SweepStats a = sweepFastBodies(pruned, start, shapes, pairs, 1, 0.5, with);
+    const SweepStats b = sweepFastBodies(full, start, shapes, pairs, 1, 0.5, without);
+    pruned_tests += a.leaf_tests;
+    full_tests += b.leaf_tests;
+    ASSERT_EQ(a.clamped, b.clamped) << "trial " << trial;
+    hits += a.clamped > 0;
+    for (std::size_t i = 0; i < 2; ++i) {
+      EXPECT_EQ(with.hits[i].t, without.hits[i].t) << "trial " << trial;
+      EXPECT_EQ(with.hits[i].point, without.hits[i].point) << "trial " << trial;
+      EXPECT_EQ(with.hits[i].normal, without.hits[i].normal) << "trial " << trial;
+      EXPECT_EQ(pruned[i].pose.position, full[i].pose.position) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(hits, 50);  // the trials do hit
+  EXPECT_LT(pruned_tests, full_tests);
 }
 
 }  // namespace
