@@ -194,7 +194,8 @@ int PairTest::step() {
   return tests;
 }
 
-// Chosen on first use after a step (most pair tests are never asked).
+// Chosen on first use after a step (most pair tests are never asked), with
+// the centres compared in B's body frame, as the steps tested them.
 SpherePair PairTest::lastPair() const {
   const SpherePairSpan last = lastPairs();
   if (!best_valid_) {
@@ -202,7 +203,7 @@ SpherePair PairTest::lastPair() const {
     for (std::size_t i = 0; i < last.size(); ++i) {
       const SphereNode& na = a_.tree->node(last[i].a);
       const SphereNode& nb = b_.tree->node(last[i].b);
-      const double distance_sq = (b_.pose->apply(nb.centre) - a_.pose->apply(na.centre)).squaredNorm();
+      const double distance_sq = (rot_to_other_[0] * na.centre + pos_to_other_[0] - nb.centre).squaredNorm();
       deepest.offer(na.radius + nb.radius, distance_sq, i);
     }
     best_last_ = deepest.index;
