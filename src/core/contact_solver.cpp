@@ -573,6 +573,26 @@ void ContactSolver::collide(const ResponseOptions& options, SolveStats& stats) {
   }
 }
 
+STC_HOT_INLINE void ContactSolver::pushStep(const Row& row, RowInfo& info, const Motion& a, const Motion& b,
+                                           double mass, bool turns, Motion& out_a, Motion& out_b) {
+  // Translation alone (the default): the pass never turns a body, so it
+  // cannot set a resting one rocking (docs/sleeping.md).
+  const double vn = turns ? relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n) : (b.v - a.v).dot(row.n);
+  // A contact that bounced across a speculative gap also closes the gap
+  // (may pull): the bounce starts at the surface, not where the gap
+  // was seen, so the rebound height does not gain up to |v| dt.
+  const double unclamped = info.lambda_push + mass * (info.push - vn);
+  const double normal = info.bounced && info.push < 0.0 ? unclamped : std::max(0.0, unclamped);
+  const double delta = normal - info.lambda_push;
+  info.lambda_push = normal;
+  if (turns) {
+    applyNormal(row, delta, out_a, out_b);
+  } else {
+    out_a.v -= row.inv_ma * delta * row.n;
+    out_b.v += row.inv_mb * delta * row.n;
+  }
+}
+
 // Returns the passes run: options.iterations, fewer when the deadline
 // passes first (never fewer than one when anything needs correcting).
 int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline& deadline) {
@@ -597,26 +617,6 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
     if (jacobi) commitJacobi(pseudo_);
   }
   return passes;
-}
-
-void ContactSolver::pushStep(const Row& row, RowInfo& info, const Motion& a, const Motion& b, double mass,
-                             bool turns, Motion& out_a, Motion& out_b) {
-  // Translation alone (the default): the pass never turns a body, so it
-  // cannot set a resting one rocking (docs/sleeping.md).
-  const double vn = turns ? relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n) : (b.v - a.v).dot(row.n);
-  // A contact that bounced across a speculative gap also closes the gap
-  // (may pull): the bounce starts at the surface, not where the gap
-  // was seen, so the rebound height does not gain up to |v| dt.
-  const double unclamped = info.lambda_push + mass * (info.push - vn);
-  const double normal = info.bounced && info.push < 0.0 ? unclamped : std::max(0.0, unclamped);
-  const double delta = normal - info.lambda_push;
-  info.lambda_push = normal;
-  if (turns) {
-    applyNormal(row, delta, out_a, out_b);
-  } else {
-    out_a.v -= row.inv_ma * delta * row.n;
-    out_b.v += row.inv_mb * delta * row.n;
-  }
 }
 
 // Shock propagation at the position level (Guendelman et al. process contacts
