@@ -137,10 +137,10 @@ struct Sweeper {
   double leafEntry(std::int32_t nf, std::int32_t no, Vec3& n, Vec3& p) const {
     const std::size_t f = static_cast<std::size_t>(nf);
     const std::size_t o = static_cast<std::size_t>(no);
-    const Vec3 local_f = first.tree->node(nf).centre + first.box_offset[f];
-    const Vec3 local_o = second.tree->node(no).centre + second.box_offset[o];
-    const Vec3& hf = first.box_half[f];
-    const Vec3& ho = second.box_half[o];
+    const Vec3& local_f = first.leaves_centre[f];  // a leaf's leaves box is its own voxel box
+    const Vec3& local_o = second.leaves_centre[o];
+    const Vec3& hf = first.leaves_half[f];
+    const Vec3& ho = second.leaves_half[o];
     const double thinner = std::min(hf.minCoeff(), ho.minCoeff());
     BoxMotion m;
     if (!overlapInterval(local_f, hf, local_o, ho, 0.25 * thinner, m)) return -1.0;
