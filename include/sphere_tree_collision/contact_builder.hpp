@@ -26,6 +26,7 @@ struct ContactCandidate {
   double separation = 0.0;     // gap between the surfaces along normal (once refined)
   std::int32_t node_a = 0, node_b = 0;
   int cluster = 0;             // position of its representative among the picked ones
+  double nearest = 0.0;        // squared distance to that representative's point
   bool refined = false;        // separation and face normal evaluated (deep enough)
 };
 
@@ -47,8 +48,15 @@ class PairGeometry {
   // Paper Fig. 4: normal along the line of centres a -> b (coincident: the
   // body centres, then +Z), point dividing the centres in proportion to the radii.
   ContactCandidate candidate(std::int32_t node_a, std::int32_t node_b) const;
+  // A unit direction (world, a -> b) as the gaps along it read it: in A's
+  // frame, and reversed in B's. Made once, it serves every candidate.
+  struct Axis {
+    Vec3 world, in_a, reversed_in_b;
+  };
+  Axis axis(const Vec3& n) const { return Axis{n, rot_a_.transpose() * n, rot_b_.transpose() * (-n)}; }
   // Gap between the two nodes' surfaces along unit n (world, a -> b).
-  double gapAlong(const ContactCandidate& c, const Vec3& n) const;
+  double gapAlong(const ContactCandidate& c, const Axis& n) const;
+  double gapAlong(const ContactCandidate& c, const Vec3& n) const { return gapAlong(c, axis(n)); }
   // Separation along the candidate's normal; with face_normals and bounds, a
   // face axis of either voxel box that separates the nodes more becomes the
   // normal, and the point moves to the middle of the faces' overlap. A face
@@ -56,12 +64,22 @@ class PairGeometry {
   void refine(ContactCandidate& c, bool face_normals) const;
 
  private:
-  // Surface of a node towards a direction in its own body frame / the world.
+  // Surface of a node towards a direction in its own body frame.
   double localSupportA(std::int32_t node, const Vec3& dir_a) const;
   double localSupportB(std::int32_t node, const Vec3& dir_b) const;
-  double supportA(std::int32_t node, const Vec3& dir) const { return localSupportA(node, rot_a_.transpose() * dir); }
-  double supportB(std::int32_t node, const Vec3& dir) const { return localSupportB(node, rot_b_.transpose() * dir); }
+  double axisSupportA(std::int32_t node, int axis, double sign) const;  // along sign x A's axis
+  double axisSupportB(std::int32_t node, int axis, double sign) const;  // along sign x B's axis
   Vec3 faceContactPoint(const ContactCandidate& c) const;
+  // A face normal's tangents and its directions in both body frames. A
+  // pair's face candidates mostly share one normal: the last one is kept.
+  struct FaceFrame {
+    bool valid = false;
+    Vec3 normal;
+    Vec3 tangent[2];
+    Axis across;
+    Vec3 tangent_in_a[2], tangent_in_b[2];
+  };
+  const FaceFrame& faceFrame(const Vec3& normal) const;
   // Whether n (a -> b) points through a covered face of a's node (mask_a),
   // or -n through one of b's node; and n with those parts removed.
   bool intoCover(std::uint8_t mask_a, std::uint8_t mask_b, const Vec3& n) const;
@@ -76,6 +94,7 @@ class PairGeometry {
   Mat3 rot_a_, rot_b_;
   Mat3 b_in_a_;  // B's axes in A's frame (columns)
   Vec3 pos_a_, pos_b_;
+  mutable FaceFrame face_frame_;  // faceFrame's last: a cache, not state
 };
 
 // The steps of ContactBuilder::append, each usable alone.
@@ -96,10 +115,13 @@ constexpr int kMaxRepresentatives = 16;
 // refined candidates: first the deepest (within 1e-3 times the smallest reach)
 // farthest from the centroid, then the farthest from it, then the largest
 // triangle, then the farthest from all picked; points closer than 1e-6 times the
-// smallest reach count as one. Fills `reps` with candidate indices.
-void pickRepresentatives(const std::vector<ContactCandidate>& candidates, double deepest, int limit,
+// smallest reach count as one. Fills `reps` with candidate indices. Each
+// candidate keeps its distance to the nearest picked one as they are picked,
+// so it leaves every candidate in its cluster, as assignClusters does.
+void pickRepresentatives(std::vector<ContactCandidate>& candidates, double deepest, int limit,
                          std::vector<int>& reps);
-// 4. Every candidate joins its nearest representative (cluster = position in reps).
+// 4. Every candidate joins its nearest representative (cluster = position in
+// reps; a tie goes to the earlier one).
 void assignClusters(std::vector<ContactCandidate>& candidates, const std::vector<int>& reps);
 // 5. Each cluster's normal (normals[r] for reps[r]): the mean over its
 // refined members with sphere overlap within 10% of its deepest (the pairs
@@ -138,7 +160,7 @@ class ContactBuilder {
   // Appends the contacts of one test (none when Separate, or Unresolved and not accepted).
   // bounds_a/bounds_b: of the test's trees, or nullptr (surface at the spheres).
   // The steps, in order: gatherCandidates, refineDeepCandidates,
-  // pickRepresentatives, assignClusters, then one contact per cluster
+  // pickRepresentatives (which assigns the clusters), then one contact per cluster
   // (clusterNormals, clusterSeparations).
   void append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b, double priority,
               const BodySurface& a, const BodySurface& b, const ContactBuildOptions& options,

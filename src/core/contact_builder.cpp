@@ -40,10 +40,10 @@ Vec3 boxCentre(const ShapeBounds* bounds, const Mat3& rot, const Vec3& centre, s
   return bounds != nullptr ? Vec3(centre + rot * bounds->box_offset[static_cast<std::size_t>(node)]) : centre;
 }
 
-double boxExtent(const ShapeBounds* bounds, const SphereTree& tree, const Mat3& rot, std::int32_t node,
-                 const Vec3& dir) {
+// Extent of a node's voxel box along a direction given in its body frame.
+double boxExtent(const ShapeBounds* bounds, const SphereTree& tree, std::int32_t node, const Vec3& dir_body) {
   if (bounds == nullptr) return tree.node(node).radius;
-  return bounds->box_half[static_cast<std::size_t>(node)].dot((rot.transpose() * dir).cwiseAbs());
+  return bounds->box_half[static_cast<std::size_t>(node)].dot(dir_body.cwiseAbs());
 }
 
 }  // namespace
@@ -61,12 +61,22 @@ PairGeometry::PairGeometry(const PairTest& test, const BodySurface& a, const Bod
       pos_a_(test.bodyA().pose->position),
       pos_b_(test.bodyB().pose->position) {}
 
-double PairGeometry::localSupportA(std::int32_t node, const Vec3& dir_a) const {
+inline double PairGeometry::localSupportA(std::int32_t node, const Vec3& dir_a) const {
   return bounds_a_ != nullptr ? bounds_a_->support(node, dir_a) : tree_a_.node(node).radius;
 }
 
-double PairGeometry::localSupportB(std::int32_t node, const Vec3& dir_b) const {
+inline double PairGeometry::localSupportB(std::int32_t node, const Vec3& dir_b) const {
   return bounds_b_ != nullptr ? bounds_b_->support(node, dir_b) : tree_b_.node(node).radius;
+}
+
+// localSupportA/B along sign x body axis `axis`: the box's extent that way,
+// the same value as the dot products give a unit axis.
+inline double PairGeometry::axisSupportA(std::int32_t node, int axis, double sign) const {
+  return bounds_a_ != nullptr ? bounds_a_->axisSupport(node, axis, sign) : tree_a_.node(node).radius;
+}
+
+inline double PairGeometry::axisSupportB(std::int32_t node, int axis, double sign) const {
+  return bounds_b_ != nullptr ? bounds_b_->axisSupport(node, axis, sign) : tree_b_.node(node).radius;
 }
 
 ContactCandidate PairGeometry::candidate(std::int32_t node_a, std::int32_t node_b) const {
@@ -85,24 +95,40 @@ ContactCandidate PairGeometry::candidate(std::int32_t node_a, std::int32_t node_
   return c;
 }
 
-double PairGeometry::gapAlong(const ContactCandidate& c, const Vec3& n) const {
-  return (c.cb - c.ca).dot(n) - supportA(c.node_a, n) - supportB(c.node_b, -n);
+double PairGeometry::gapAlong(const ContactCandidate& c, const Axis& n) const {
+  return (c.cb - c.ca).dot(n.world) - localSupportA(c.node_a, n.in_a) - localSupportB(c.node_b, n.reversed_in_b);
 }
 
 // Face-on, the contact is where the two boxes' faces overlap: the middle of
 // their projections on the face plane, halfway between the surfaces (the
 // Fig. 4 point would sit off to the side of a ball resting on a large leaf).
+const PairGeometry::FaceFrame& PairGeometry::faceFrame(const Vec3& normal) const {
+  if (face_frame_.valid && face_frame_.normal == normal) return face_frame_;
+  FaceFrame& f = face_frame_;
+  f.valid = true;
+  f.normal = normal;
+  tangentBasis(normal, f.tangent[0], f.tangent[1]);
+  f.across = axis(normal);
+  for (int k = 0; k < 2; ++k) {
+    f.tangent_in_a[k] = rot_a_.transpose() * f.tangent[k];
+    f.tangent_in_b[k] = rot_b_.transpose() * f.tangent[k];
+  }
+  return f;
+}
+
 Vec3 PairGeometry::faceContactPoint(const ContactCandidate& c) const {
   const Vec3 ba = boxCentre(bounds_a_, rot_a_, c.ca, c.node_a);
   const Vec3 bb = boxCentre(bounds_b_, rot_b_, c.cb, c.node_b);
-  Vec3 t1, t2;
-  tangentBasis(c.normal, t1, t2);
-  Vec3 point = 0.5 * ((c.ca + supportA(c.node_a, c.normal) * c.normal) +
-                      (c.cb - supportB(c.node_b, -c.normal) * c.normal));
+  const FaceFrame& f = faceFrame(c.normal);
+  const Vec3& t1 = f.tangent[0];
+  const Vec3& t2 = f.tangent[1];
+  Vec3 point = 0.5 * ((c.ca + localSupportA(c.node_a, f.across.in_a) * c.normal) +
+                      (c.cb - localSupportB(c.node_b, f.across.reversed_in_b) * c.normal));
   point -= point.dot(t1) * t1 + point.dot(t2) * t2;
-  for (const Vec3& t : {t1, t2}) {
-    const double ea = boxExtent(bounds_a_, tree_a_, rot_a_, c.node_a, t);
-    const double eb = boxExtent(bounds_b_, tree_b_, rot_b_, c.node_b, t);
+  for (int k = 0; k < 2; ++k) {
+    const Vec3& t = f.tangent[k];
+    const double ea = boxExtent(bounds_a_, tree_a_, c.node_a, f.tangent_in_a[k]);
+    const double eb = boxExtent(bounds_b_, tree_b_, c.node_b, f.tangent_in_b[k]);
     const double lo = std::max(ba.dot(t) - ea, bb.dot(t) - eb);
     const double hi = std::min(ba.dot(t) + ea, bb.dot(t) + eb);
     point += 0.5 * (lo + hi) * t;
@@ -166,27 +192,29 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
   const Vec3 delta = c.cb - c.ca;
   const Vec3 delta_a = rot_a_.transpose() * delta;
   const Vec3 delta_b = b_in_a_.transpose() * delta_a;
+  const double better_by = 1e-12 * std::abs(c.overlap + delta.norm());  // more than rounding
   for (int k = 0; k < 6; ++k) {
     // Axis k of A (k < 3) or of B, pointing from a to b, in both frames.
     const bool of_a = k < 3;
     const int axis = of_a ? k : k - 3;
     const double along = of_a ? delta_a[axis] : delta_b[axis];
     double sign = along < 0.0 ? -1.0 : 1.0;
-    Vec3 normal = sign * (of_a ? Vec3(rot_a_.col(axis)) : Vec3(rot_b_.col(axis)));
-    if (any_cover && intoCover(mask_a, mask_b, normal)) {
+    const auto normalOf = [&] { return Vec3(sign * (of_a ? Vec3(rot_a_.col(axis)) : Vec3(rot_b_.col(axis)))); };
+    if (any_cover && intoCover(mask_a, mask_b, normalOf())) {
       // b's node lies beyond the covered side (deeper than a one-sided
       // wall's middle): the open side of the axis is the way out, however deep.
       sign = -sign;
-      normal = -normal;
-      if (intoCover(mask_a, mask_b, normal)) continue;
+      if (intoCover(mask_a, mask_b, normalOf())) continue;
     }
-    const Vec3 dir_a = sign * (of_a ? Vec3(Vec3::Unit(axis)) : Vec3(b_in_a_.col(axis)));
-    const Vec3 dir_b = sign * (of_a ? Vec3(b_in_a_.row(axis).transpose()) : Vec3(Vec3::Unit(axis)));
-    const double g = sign * along - localSupportA(c.node_a, dir_a) - localSupportB(c.node_b, -dir_b);
+    // The node whose own axis this is reads its support straight off its box.
+    const double g = of_a ? sign * along - axisSupportA(c.node_a, axis, sign) -
+                                localSupportB(c.node_b, -sign * Vec3(b_in_a_.row(axis).transpose()))
+                          : sign * along - localSupportA(c.node_a, sign * Vec3(b_in_a_.col(axis))) -
+                                axisSupportB(c.node_b, axis, -sign);
     // Under cover the line of centres was bent: any open face axis is the better normal.
-    if (g > c.separation + 1e-12 * std::abs(c.overlap + delta.norm()) || (covered && !face)) {
+    if (g > c.separation + better_by || (covered && !face)) {
       c.separation = g;
-      c.normal = normal;
+      c.normal = normalOf();
       face = true;
     }
   }
@@ -218,16 +246,31 @@ void refineDeepCandidates(std::vector<ContactCandidate>& candidates, double deep
   }
 }
 
-void pickRepresentatives(const std::vector<ContactCandidate>& candidates, double deepest, int limit,
+// Candidate `rep` becomes representative number `cluster`: every candidate
+// nearer to it than to the representatives before it joins its cluster (a
+// tie stays with the earlier one).
+void joinRepresentative(std::vector<ContactCandidate>& candidates, int rep, int cluster) {
+  const Vec3 at = candidates[static_cast<std::size_t>(rep)].point;
+  for (ContactCandidate& c : candidates) {
+    const double d = (c.point - at).squaredNorm();
+    if (d < c.nearest) {
+      c.nearest = d;
+      c.cluster = cluster;
+    }
+  }
+}
+
+void pickRepresentatives(std::vector<ContactCandidate>& candidates, double deepest, int limit,
                          std::vector<int>& reps) {
   reps.clear();
   if (candidates.empty()) return;
   limit = std::clamp(limit, 1, kMaxRepresentatives);
   Vec3 centroid = Vec3::Zero();
   double scale = std::numeric_limits<double>::infinity();  // smallest reach: the length unit
-  for (const ContactCandidate& c : candidates) {
+  for (ContactCandidate& c : candidates) {
     centroid += c.point;
     scale = std::min(scale, c.overlap + (c.cb - c.ca).norm());
+    c.nearest = std::numeric_limits<double>::infinity();
   }
   centroid /= static_cast<double>(candidates.size());
   const double tie = 1e-3 * scale;      // overlaps this close count as equal
@@ -249,8 +292,10 @@ void pickRepresentatives(const std::vector<ContactCandidate>& candidates, double
     }
     if (best < 0) return;  // `deepest` is not of these candidates
     reps.push_back(best);
+    joinRepresentative(candidates, best, 0);
   }
-  // Then: farthest from the first; largest triangle; then farthest from all chosen.
+  // Then: farthest from the first; largest triangle; then farthest from all
+  // chosen. `nearest` is each candidate's squared distance to the chosen ones.
   while (static_cast<int>(reps.size()) < limit) {
     int best = -1;
     double best_score = distinct * distinct;
@@ -262,13 +307,8 @@ void pickRepresentatives(const std::vector<ContactCandidate>& candidates, double
     }
     for (std::size_t i = 0; i < candidates.size(); ++i) {
       const ContactCandidate& c = candidates[i];
-      if (!c.refined) continue;
-      double nearest = std::numeric_limits<double>::infinity();
-      for (int r : reps) nearest = std::min(nearest, (c.point - candidates[r].point).squaredNorm());
-      if (nearest <= distinct * distinct) continue;
-      double score = nearest;
-      if (reps.size() == 1) score = (c.point - p0).squaredNorm();
-      if (reps.size() == 2) score = (c.point - p0).cross(axis).squaredNorm();
+      if (!c.refined || c.nearest <= distinct * distinct) continue;
+      const double score = reps.size() == 2 ? (c.point - p0).cross(axis).squaredNorm() : c.nearest;
       if (score > best_score) {
         best_score = score;
         best = static_cast<int>(i);
@@ -276,20 +316,13 @@ void pickRepresentatives(const std::vector<ContactCandidate>& candidates, double
     }
     if (best < 0) break;
     reps.push_back(best);
+    joinRepresentative(candidates, best, static_cast<int>(reps.size()) - 1);
   }
 }
 
 void assignClusters(std::vector<ContactCandidate>& candidates, const std::vector<int>& reps) {
-  for (ContactCandidate& c : candidates) {
-    double nearest = std::numeric_limits<double>::infinity();
-    for (std::size_t r = 0; r < reps.size(); ++r) {
-      const double d = (c.point - candidates[reps[r]].point).squaredNorm();
-      if (d < nearest) {
-        nearest = d;
-        c.cluster = static_cast<int>(r);
-      }
-    }
-  }
+  for (ContactCandidate& c : candidates) c.nearest = std::numeric_limits<double>::infinity();
+  for (std::size_t r = 0; r < reps.size(); ++r) joinRepresentative(candidates, reps[r], static_cast<int>(r));
 }
 
 void clusterNormals(const std::vector<ContactCandidate>& candidates, const std::vector<int>& reps,
@@ -326,10 +359,12 @@ void clusterSeparations(const std::vector<ContactCandidate>& candidates, const s
                         std::vector<double>& separations) {
   const std::size_t count = reps.size();
   separations.assign(count, std::numeric_limits<double>::infinity());
+  PairGeometry::Axis axes[kMaxRepresentatives];
+  for (std::size_t r = 0; r < count; ++r) axes[r] = geometry.axis(normals[r]);
   for (const ContactCandidate& c : candidates) {
     const std::size_t r = static_cast<std::size_t>(c.cluster);
     if (c.normal.dot(normals[r]) < kAlignedCosine) continue;
-    separations[r] = std::min(separations[r], geometry.gapAlong(c, normals[r]));
+    separations[r] = std::min(separations[r], geometry.gapAlong(c, axes[r]));
   }
   for (std::size_t r = 0; r < count; ++r) {
     if (!std::isfinite(separations[r])) separations[r] = candidates[static_cast<std::size_t>(reps[r])].separation;
@@ -347,8 +382,7 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
   gatherCandidates(test, geometry, candidates_);
   const double deepest = deepestOverlap(candidates_);
   refineDeepCandidates(candidates_, deepest, geometry, options.face_normals);
-  pickRepresentatives(candidates_, deepest, options.max_contacts_per_pair, reps_);
-  assignClusters(candidates_, reps_);
+  pickRepresentatives(candidates_, deepest, options.max_contacts_per_pair, reps_);  // and assigns the clusters
 
   clusterNormals(candidates_, reps_, normals_);
   clusterSeparations(candidates_, reps_, normals_, geometry, separations_);

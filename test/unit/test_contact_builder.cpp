@@ -191,7 +191,8 @@ TEST(ContactSteps, RepresentativesAreTheCornersOfAFaceAndNeverTwoAtOnePoint) {
   for (ContactCandidate& c : shallow) c.refined = false;
   pickRepresentatives(shallow, deepestOverlap(shallow), 4, reps);
   EXPECT_EQ(reps.size(), 1u);
-  pickRepresentatives({}, deepestOverlap({}), 4, reps);
+  std::vector<ContactCandidate> none;
+  pickRepresentatives(none, deepestOverlap(none), 4, reps);
   EXPECT_TRUE(reps.empty());
 }
 
@@ -209,6 +210,27 @@ TEST(ContactSteps, EveryCandidateJoinsItsNearestRepresentative) {
   EXPECT_EQ(grid[24].cluster, 1);
   EXPECT_EQ(grid[1].cluster, 0);   // (-0.2, -0.1)
   EXPECT_EQ(grid[23].cluster, 1);  // (0.2, 0.1)
+  // The middle row is as far from both corners: a tie stays with the first.
+  EXPECT_EQ(grid[4].cluster, 0);   // (-0.2, 0.2)
+  EXPECT_EQ(grid[20].cluster, 0);  // (0.2, -0.2)
+}
+
+TEST(ContactSteps, PickingRepresentativesLeavesTheClustersAssignClustersGives) {
+  std::vector<ContactCandidate> picked = faceGrid();
+  picked[7].overlap = 0.02;  // an inner deepest: the clusters are not the corners' quarters
+  std::vector<int> reps;
+  for (int limit = 1; limit <= 5; ++limit) {
+    for (ContactCandidate& c : picked) c.cluster = -1;
+    pickRepresentatives(picked, deepestOverlap(picked), limit, reps);
+    ASSERT_EQ(reps.size(), static_cast<std::size_t>(limit));
+    std::vector<ContactCandidate> assigned = picked;
+    for (ContactCandidate& c : assigned) c.cluster = -1;
+    assignClusters(assigned, reps);
+    for (std::size_t i = 0; i < picked.size(); ++i) {
+      EXPECT_EQ(picked[i].cluster, assigned[i].cluster) << "limit " << limit << ", candidate " << i;
+      EXPECT_EQ(picked[i].nearest, (picked[i].point - picked[reps[picked[i].cluster]].point).squaredNorm());
+    }
+  }
 }
 
 TEST(ContactSteps, ClusterNormalAveragesTheDeepestMembersOnly) {
