@@ -99,9 +99,6 @@ double PairGeometry::gapAlong(const ContactCandidate& c, const Axis& n) const {
   return (c.cb - c.ca).dot(n.world) - localSupportA(c.node_a, n.in_a) - localSupportB(c.node_b, n.reversed_in_b);
 }
 
-// Face-on, the contact is where the two boxes' faces overlap: the middle of
-// their projections on the face plane, halfway between the surfaces (the
-// Fig. 4 point would sit off to the side of a ball resting on a large leaf).
 const PairGeometry::FaceFrame& PairGeometry::faceFrame(const Vec3& normal) const {
   if (face_frame_.valid && face_frame_.normal == normal) return face_frame_;
   FaceFrame& f = face_frame_;
@@ -116,6 +113,9 @@ const PairGeometry::FaceFrame& PairGeometry::faceFrame(const Vec3& normal) const
   return f;
 }
 
+// Face-on, the contact is where the two boxes' faces overlap: the middle of
+// their projections on the face plane, halfway between the surfaces (the
+// Fig. 4 point would sit off to the side of a ball resting on a large leaf).
 Vec3 PairGeometry::faceContactPoint(const ContactCandidate& c) const {
   const Vec3 ba = boxCentre(bounds_a_, rot_a_, c.ca, c.node_a);
   const Vec3 bb = boxCentre(bounds_b_, rot_b_, c.cb, c.node_b);
@@ -246,6 +246,8 @@ void refineDeepCandidates(std::vector<ContactCandidate>& candidates, double deep
   }
 }
 
+namespace {
+
 // Candidate `rep` becomes representative number `cluster`: every candidate
 // nearer to it than to the representatives before it joins its cluster (a
 // tie stays with the earlier one).
@@ -259,6 +261,8 @@ void joinRepresentative(std::vector<ContactCandidate>& candidates, int rep, int 
     }
   }
 }
+
+}  // namespace
 
 void pickRepresentatives(std::vector<ContactCandidate>& candidates, double deepest, int limit,
                          std::vector<int>& reps) {
