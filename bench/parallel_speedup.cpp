@@ -62,7 +62,7 @@ struct Options {
 // Per-tick samples of one run, seconds.
 struct Run {
   std::vector<double> wall, cpu, integrate, broad, sweep, narrow, response, other;
-  double contacts = 0.0, colours = 0.0;  // sums over the ticks
+  double contacts = 0.0, manifolds = 0.0, crossing = 0.0, slabs = 0.0;  // sums over the ticks
 };
 
 SceneWorld makeWorld(const Case& c, int threads) {
@@ -86,7 +86,9 @@ void timedTicks(World& world, double dt, int ticks, Run& run) {
     run.response.push_back(r.response_s);
     run.other.push_back(r.total_s - r.integrate_s - r.broad_s - r.sweep_s - r.narrow_s - r.response_s);
     run.contacts += static_cast<double>(r.contacts);
-    run.colours += world.physicsReport().solve.colours;
+    run.slabs += world.physicsReport().solve.slabs;
+    run.crossing += static_cast<double>(world.physicsReport().solve.crossing_manifolds);
+    run.manifolds += static_cast<double>(world.physicsReport().solve.manifolds);
   }
 }
 
@@ -127,7 +129,8 @@ double runCase(const Case& c, const Options& opt) {
 
   std::printf("\n## %s: %d ticks timed after %d, threads 1 vs %d (load average %.2f -> %.2f)\n\n",
               name(c).c_str(), ticks, settle, opt.threads, load_before, load_after);
-  std::printf("contacts %.0f, solver colours %.0f a tick (mean)\n\n", r1.contacts / ticks, r1.colours / ticks);
+  std::printf("contacts %.0f, manifolds %.0f, solver slabs %.1f, manifolds across slabs %.0f a tick (mean)\n\n",
+              r1.contacts / ticks, r1.manifolds / ticks, r1.slabs / ticks, r1.crossing / ticks);
   std::printf("| phase | 1 thread ms | %d threads ms | speed-up |\n|---|---|---|---|\n", opt.threads);
   const auto row = [&](const char* label, const std::vector<double>& a, const std::vector<double>& b) {
     std::printf("| %s | %.3f | %.3f | %.2f |\n", label, ms(meanOf(a)), ms(meanOf(b)), ratio(meanOf(a), meanOf(b)));

@@ -9,7 +9,7 @@
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
-#include "sphere_tree_collision/contact_colouring.hpp"
+#include "sphere_tree_collision/contact_partition.hpp"
 #include "sphere_tree_collision/response_options.hpp"
 #include "sphere_tree_collision/types.hpp"
 #include "sphere_tree_collision/workers.hpp"
@@ -37,7 +37,8 @@ struct SolveStats {
   int velocity_passes = 0;          // velocity iterations run (>= 1 with contacts)
   int position_passes = 0;          // split-impulse iterations run (>= 1 with penetration)
   double refinement_seconds = 0.0;  // spent in the iterations a deadline may cut (set with one)
-  std::uint32_t colours = 0;        // colours of the manifolds (contact_colouring.hpp): passes' sync points
+  std::uint32_t slabs = 1;          // slabs of the manifolds' blocks (contact_partition.hpp)
+  std::size_t crossing_manifolds = 0;  // manifolds in the stages after the first (across slabs)
 };
 
 // What the tick lets the solver spend: the response is refineable (paper 3.5
@@ -64,7 +65,7 @@ struct SolveBudget {
 // kinetic energy is added. Contacts' normal_impulse/friction_impulse are
 // filled in. The contacts of one body pair (its manifold: consecutive in the
 // array, as ContactBuilder emits them) are solved together, and the manifolds
-// colour by colour (contact_colouring.hpp: any threads, the same bits). Warm starting
+// block by block (contact_partition.hpp: any threads, the same bits). Warm starting
 // keeps each pair's manifold from tick to tick: a point takes the impulse of
 // last tick's point with the same feature id (Contact::node_a/node_b, the
 // leaf sphere pair it was built from), else of the nearest one in body A's
@@ -82,7 +83,7 @@ class ContactSolver {
   }
   // Threads of the velocity, shock and position iterations (nullptr: the
   // caller's alone); the result is the same whatever they are
-  // (contact_colouring.hpp: a body pair's manifold is one group). A colour
+  // (contact_partition.hpp: a body pair's manifold is one group). A stage
   // of fewer than `task_manifolds` manifolds is solved on the calling thread
   // (ResponseOptions::solver_task_manifolds).
   void setWorkers(const Workers* workers, std::size_t task_manifolds) {
@@ -102,7 +103,9 @@ class ContactSolver {
   }
 
   // A body's velocities as the solver sees them: one cache line per body.
-  struct Motion {
+  // A cache line each: bodies next to each other in the array may belong to
+  // blocks that two threads solve at once.
+  struct alignas(64) Motion {
     Vec3 v = Vec3::Zero();
     Vec3 w = Vec3::Zero();
   };
@@ -178,21 +181,28 @@ class ContactSolver {
                const ResponseOptions& options, double dt, SolveStats& stats);
   void orderFromTheGround(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
   int levelOf(const Contact& c) const;  // after orderFromTheGround: min of the bodies' depths
-  // After orderFromTheGround: order_ regrouped colour by colour, manifold by
-  // manifold; manifold_start_, manifolds_, the colours' and the shock
-  // levels' runs of manifolds (contact_solver_colours.cpp).
-  void colourManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
-  // manifolds(first, end) over every colour's manifolds in turn, a colour's
-  // manifolds split over the workers.
-  void forEachColour(RangeFn manifolds);
+  // After orderFromTheGround: order_ regrouped block by block, manifold by
+  // manifold; manifold_start_, manifolds_, a pass's and the shock levels'
+  // runs of manifolds (contact_solver_blocks.cpp).
+  void blockManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
+  struct ManifoldRun {
+    std::uint32_t first = 0, end = 0;
+  };
+  // manifolds(first, end) over every block's manifolds, stage by stage, a
+  // stage's blocks on the workers, each block's manifolds by one thread.
+  void forEachStage(RangeFn manifolds);
   // Shock propagation's order: the levels from the ground (unreached rows
-  // aside), and a level's manifolds colour by colour, as forEachColour.
-  std::size_t shockLevels() const { return level_segment_start_.empty() ? 0 : level_segment_start_.size() - 1; }
-  void forEachColourOfLevel(std::size_t level, RangeFn manifolds);
-  void forEachManifoldRun(std::uint32_t first, std::uint32_t end, RangeFn manifolds) const;
+  // aside), and a level's manifolds stage by stage, as forEachStage.
+  std::size_t shockLevels() const {
+    return level_stage_start_.empty() ? 0 : (level_stage_start_.size() - 1) / ContactPartition::kStages;
+  }
+  void forEachStageOfLevel(std::size_t level, RangeFn manifolds);
+  // The blocks runs[0, count) of one stage: on the team when there are two
+  // or more and they hold task_manifolds_ or more, else in turn here.
+  void runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds) const;
   // step(r, a, b) over the rows r of manifolds [first, end), a and b the
   // pair's entries of `motion` copied in, then written back (a static body's
-  // never is: colours do not hold it apart).
+  // never is: blocks do not hold it apart).
   template <typename Step>
   void overManifolds(std::size_t first, std::size_t end, std::vector<Motion>& motion, Step&& step);
   // The same, then after(m, a, b) once a manifold m's rows are done.
@@ -205,6 +215,10 @@ class ContactSolver {
   void warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
                  SolveStats& stats);
   void commitJacobi(std::vector<Motion>& motion);
+  // The refineable passes after the warm start: the velocity iterations
+  // (the first timed, pricing the rest against the deadline), shock
+  // propagation, the position passes and their shock sweep.
+  void iterate(const ResponseOptions& options, const SolveBudget& budget, SolveStats& stats);
   void solveVelocities(const ResponseOptions& options, int passes);
   int affordableIterations(const ResponseOptions& options, int cap, double pass_seconds,
                            double seconds_left) const;
@@ -226,7 +240,7 @@ class ContactSolver {
   std::vector<Rolling> rolling_;  // by manifold (filled only when any_rolling_)
   bool any_rolling_ = false;
   std::vector<std::uint32_t> manifold_start_;  // rows of one body pair: [start[m], start[m + 1])
-  std::vector<ColourGroup> manifolds_;         // each manifold's movable bodies (kStatic: static)
+  std::vector<SolverGroup> manifolds_;         // each manifold's movable bodies (kStatic: static)
   std::vector<std::uint32_t> order_, active_, level_start_;
   std::vector<std::uint32_t> wave_rows_, last_wave_rows_, next_wave_rows_;  // collide(): by wave
   std::vector<std::array<std::uint32_t, 2>> row_bodies_;  // collide(): each row's bodies, compact
@@ -240,23 +254,22 @@ class ContactSolver {
   std::vector<CachedPoint> cache_, next_cache_;
   std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // sorted by pair
   std::vector<CachedManifold> merged_manifolds_;  // keepHeldManifolds' merge (swapped with next_manifolds_)
-  // Colouring (contact_solver_colours.cpp): the manifolds in the order from
-  // the ground (groups_, each one's first place in order_), their colours,
-  // and in colour order where each colour's manifolds start.
   const std::vector<EntityId>* held_ids_ = nullptr;
   const std::vector<std::uint8_t>* held_ = nullptr;
   const Workers* workers_ = nullptr;
   std::size_t task_manifolds_ = 1;  // read only with workers_
-  ContactColouring colouring_;
-  std::vector<ColourGroup> groups_;
-  std::vector<std::uint32_t> group_first_, group_order_, colour_order_, colour_manifold_start_;
-  // Per level from the ground: its runs of manifolds, one per colour
-  // (positions in colour order); the levels' first runs.
-  struct ManifoldRun {
-    std::uint32_t first = 0, end = 0;
-  };
-  std::vector<ManifoldRun> level_runs_;
-  std::vector<std::uint32_t> level_segment_start_, cursor_;
+  Team* team_ = nullptr;  // while the passes run on workers_ (solve)
+  // Blocks (contact_solver_blocks.cpp): the manifolds in the order from the
+  // ground (groups_, each one's first place in order_), their blocks, and in
+  // block order where each block's manifolds start.
+  ContactPartition partition_;
+  std::vector<SolverGroup> groups_;
+  std::vector<std::uint32_t> group_first_, group_order_, block_order_, block_manifold_start_;
+  // A pass's non-empty blocks (positions in block order) and each stage's
+  // first; per level from the ground and stage, its runs of manifolds, one
+  // per block, and each (level, stage)'s first run.
+  std::vector<ManifoldRun> pass_runs_, level_runs_;
+  std::vector<std::uint32_t> pass_stage_start_, level_stage_start_, cursor_;
   std::vector<int> levels_;
 };
 

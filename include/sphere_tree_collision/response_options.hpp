@@ -45,10 +45,10 @@ struct ResponseOptions {
   // than this fraction of its smallest leaf radius in one tick.
   double sweep_threshold = 0.5;
   bool gyroscopic = true;               // implicit-midpoint w x Iw (see dynamics.hpp)
-  // With threads > 1: a solver colour of fewer manifolds than this is solved
-  // on the calling thread, a bigger one split in tasks of at least this many
-  // (each hand-off wakes a worker, 40+ times a tick; docs/architecture.md). >= 1.
-  int solver_task_manifolds = 512;
+  // With threads > 1: a solver stage (contact_partition.hpp) of fewer
+  // manifolds than this runs on the calling thread, a bigger one's blocks on
+  // the workers (each hand-off may wake a worker; docs/architecture.md). >= 1.
+  int solver_task_manifolds = 32;
 };
 // Throws InputError naming the field ("response.iterations", ...).
 void validateResponseOptions(const ResponseOptions& options);

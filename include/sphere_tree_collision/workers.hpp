@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <type_traits>
 #include <utility>
@@ -34,6 +35,30 @@ class RangeFn {
   void (*call_)(void*, std::size_t, std::size_t);
 };
 
+// The threads of one Workers::withTeam call: the calling thread (member 0)
+// and the arena's other threads, which stay awake between the stages it
+// posts, so a stage starts within microseconds instead of after a worker's
+// wake-up (0.3-8 ms on this 2-core VM: docs/architecture.md).
+class Team {
+ public:
+  static constexpr std::size_t kMaxBlocks = 64;  // of one forBlocks round
+  int members() const { return members_; }
+  // fn(k, k + 1) once for each block k in [0, count), each by one member, who
+  // first takes the blocks of its own share (the k with k * members / count
+  // == member: the same bodies stage after stage), then any left; returns
+  // when all are done. Only the thread that called withTeam may call it.
+  void forBlocks(std::size_t count, RangeFn fn);
+
+ private:
+  friend class Workers;
+  struct State;
+  explicit Team(State* state, int members) : state_(state), members_(members) {}
+  void take(int member, std::uint64_t stage, const RangeFn* fn, std::size_t count);  // claim and run
+  void serve(int member);  // a worker member: run stages until the team stops
+  State* state_;           // null with one member
+  int members_;
+};
+
 class Workers {
  public:
   // Throws InputError("threads") as validateThreads.
@@ -48,8 +73,20 @@ class Workers {
   void forEach(std::size_t n, std::size_t grain, RangeFn fn) const;
   // fn(k, k + 1) for each chunk k in [0, chunks), each one task.
   void forChunks(std::size_t chunks, RangeFn fn) const;
+  // body(team) on the calling thread while the arena's other threads serve
+  // as team members, spinning between stages; returns when body has. Within
+  // body, forEach and forChunks run on the team too, and a nested withTeam
+  // gets the same team. (A task loop there would let a waiting thread take a
+  // member's task, which never hears of the stages: so none is started.)
+  template <typename Body>
+  void withTeam(Body&& body) const {
+    runTeam([](void* b, Team& team) { (*static_cast<std::remove_reference_t<Body>*>(b))(team); },
+            const_cast<void*>(static_cast<const void*>(&body)));
+  }
 
  private:
+  void runTeam(void (*call)(void*, Team&), void* body) const;
+
   struct Arena;
   std::unique_ptr<Arena> arena_;  // null with one thread
   int threads_ = 1;

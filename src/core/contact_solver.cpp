@@ -126,8 +126,9 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     active_.push_back(ci);
   }
   orderFromTheGround(bodies, contacts);
-  colourManifolds(bodies, contacts);  // order_ now colour by colour, manifold by manifold
-  stats.colours = colouring_.colourCount();
+  blockManifolds(bodies, contacts);  // order_ now block by block, manifold by manifold
+  stats.slabs = partition_.slabs();
+  stats.crossing_manifolds = partition_.crossing();
 
   rows_.resize(order_.size());
   info_.resize(order_.size());
@@ -319,8 +320,8 @@ void ContactSolver::overManifolds(std::size_t first, std::size_t end, std::vecto
     Motion b = motion[ib];
     for (std::uint32_t r = begin; r < stop; ++r) step(r, a, b);
     after(m, a, b);
-    if (manifolds_[m].a != ColourGroup::kStatic) motion[ia] = a;
-    if (manifolds_[m].b != ColourGroup::kStatic) motion[ib] = b;
+    if (manifolds_[m].a != SolverGroup::kStatic) motion[ia] = a;
+    if (manifolds_[m].b != SolverGroup::kStatic) motion[ib] = b;
   }
 }
 
@@ -346,10 +347,10 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
     applyNormal(row, normal - row.lambda[0], a, b);
     row.lambda[0] = normal;
   };
-  // Level by level; a level's manifolds colour by colour.
+  // Level by level; a level's manifolds stage by stage.
   for (std::size_t level = 0; level < shockLevels(); ++level) {
     for (int pass = 0; pass < passes; ++pass) {
-      forEachColourOfLevel(level, [&](std::size_t first, std::size_t end) {
+      forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) {
         overManifolds(first, end, motion_, shockStep);
       });
     }
@@ -431,7 +432,7 @@ void ContactSolver::commitJacobi(std::vector<Motion>& motion) {
   }
 }
 
-// Colour by colour; a colour's manifolds share no movable body (any split).
+// Stage by stage; a stage's blocks share no movable body (any threads).
 void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) {
   if (options.solver == SolverKind::Jacobi) {
     // Friction and non-penetration from the same state (motion_ is untouched
@@ -454,7 +455,7 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
       rollingStep(roll, normalImpulse(m), motion_[rows_[begin].a].w, motion_[rows_[begin].b].w, delta_a, delta_b);
     };
     for (int it = 0; it < passes; ++it) {
-      forEachColour([&](std::size_t first, std::size_t end) {
+      forEachStage([&](std::size_t first, std::size_t end) {
         if (any_rolling_) {
           overManifolds(first, end, delta_, jacobiStep, jacobiRolling);
         } else {
@@ -473,7 +474,7 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
     if (roll.per_normal != 0.0) rollingStep(roll, normalImpulse(m), a.w, b.w, a, b);
   };
   for (int it = 0; it < passes; ++it) {
-    forEachColour([&](std::size_t first, std::size_t end) {
+    forEachStage([&](std::size_t first, std::size_t end) {
       if (any_rolling_) {
         overManifolds(first, end, motion_, relaxStep, relaxRolling);
       } else {
@@ -612,8 +613,8 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
   int passes = 0;
   for (int it = 0; it < options.iterations; ++it, ++passes) {
     if (it > 0 && deadline.passed()) break;
-    // Colour by colour, as the velocity passes.
-    forEachColour([&](std::size_t first, std::size_t end) { overManifolds(first, end, out, positionStep); });
+    // Stage by stage, as the velocity passes.
+    forEachStage([&](std::size_t first, std::size_t end) { overManifolds(first, end, out, positionStep); });
     if (jacobi) commitJacobi(pseudo_);
   }
   return passes;
@@ -636,7 +637,7 @@ void ContactSolver::propagatePositionShock(const ResponseOptions& options) {
     pushStep(row, info, a, b, turns ? info.shock_mass[0] : info.shock_push_mass, turns, a, b);
   };
   for (std::size_t level = 0; level < shockLevels(); ++level) {
-    forEachColourOfLevel(level, [&](std::size_t first, std::size_t end) {
+    forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) {
       overManifolds(first, end, pseudo_, shockPush);
     });
   }
@@ -771,6 +772,22 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
   // Refineable: the first velocity pass always runs; timed, it prices the
   // further iterations against the deadline. `run` carries the iterations
   // afforded to every later stage.
+  // The passes run on a team: the workers stay awake from stage to stage.
+  if (workers_ != nullptr) {
+    workers_->withTeam([&](Team& team) {
+      team_ = &team;
+      iterate(options, budget, stats);
+      team_ = nullptr;
+    });
+  } else {
+    iterate(options, budget, stats);
+  }
+  store(bodies, contacts, dt);
+  if (!options.warm_starting) forget();
+  return stats;
+}
+
+void ContactSolver::iterate(const ResponseOptions& options, const SolveBudget& budget, SolveStats& stats) {
   const Deadline& deadline = budget.deadline;
   ResponseOptions run = options;
   run.iterations = std::max(1, std::min(options.iterations, budget.max_iterations));
@@ -798,10 +815,8 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
     const int extra = std::max(0, stats.position_passes - 1);
     stats.refinement_seconds = (t_rest - t_more) + positions * extra / std::max(1, stats.position_passes);
   }
-  store(bodies, contacts, dt);
-  if (!options.warm_starting) forget();
-  return stats;
 }
+
 
 SolveStats solveContacts(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
                          const ResponseOptions& options, double dt) {

@@ -305,19 +305,24 @@ TickReport World::step(double dt, const Budget& budget) {
   const bool timed_tick = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
   const Deadline tick_end = timed_tick ? Deadline(&clock_, t0 + std::max(budget.tick_seconds, 0.0)) : Deadline();
   if (timed_tick) report.tick_budget_s = std::max(budget.tick_seconds, 0.0);
-  const double t0i = breakPending(t0, tick_end, report);  // splits the last tick had no time for
-  integrate(dt, report);
-  const double t1 = clock_();
-  broadPhase(report);
-  const double t2 = clock_();
-  continuousCollision(report);
-  const double t2s = clock_();
-  const double scheduled = narrowPhase(budget, tick_end, t2s, report);
-  const double t3 = clock_();
-  if (timed_tick) report.response_budget_s = std::max(tick_end.at() - t3, 0.0);
-  response(dt, budget, tick_end, report);
-  const double t4 = clock_();
-  const double t5 = fracture(t4, tick_end, report);
+  double t0i = 0.0, t1 = 0.0, t2 = 0.0, t2s = 0.0, t3 = 0.0, t4 = 0.0, t5 = 0.0, scheduled = 0.0;
+  // One team for the phases: the workers stay awake from loop to loop
+  // (waking one costs more than many a loop here: docs/architecture.md).
+  workers_.withTeam([&](Team&) {
+    t0i = breakPending(t0, tick_end, report);  // splits the last tick had no time for
+    integrate(dt, report);
+    t1 = clock_();
+    broadPhase(report);
+    t2 = clock_();
+    continuousCollision(report);
+    t2s = clock_();
+    scheduled = narrowPhase(budget, tick_end, t2s, report);
+    t3 = clock_();
+    if (timed_tick) report.response_budget_s = std::max(tick_end.at() - t3, 0.0);
+    response(dt, budget, tick_end, report);
+    t4 = clock_();
+    t5 = fracture(t4, tick_end, report);
+  });
   report.integrate_s = t1 - t0i;
   report.broad_s = t2 - t1;
   report.sweep_s = t2s - t2;

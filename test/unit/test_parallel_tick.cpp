@@ -4,7 +4,9 @@
 // phase runs the scheduler over its pairs under its share of the budget; the
 // deadline stops every worker. No timing is asserted: budgets are counts, and
 // the deadline runs on a fake clock.
+#include "sphere_tree_collision/contact_partition.hpp"
 #include "sphere_tree_collision/scenes.hpp"
+#include "sphere_tree_collision/workers.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <gtest/gtest.h>
@@ -208,6 +210,143 @@ TEST(ParallelTick, TheDeadlineStopsEveryWorker) {
     for (std::size_t i = first; i < last; ++i) unresolved += !w.pairTests()[i].resolved();
     EXPECT_GT(unresolved, 0u) << "chunk " << k << " ran on past the deadline";
   }
+}
+
+
+// The solver's blocks (contact_partition.hpp): bodies on a grid of nx x ny x
+// nz at unit spacing, a group between each pair of neighbours along x, y and
+// z, and one from each body of the bottom layer to a static floor.
+struct GridGroups {
+  std::vector<BodyState> bodies;
+  std::vector<SolverGroup> groups;
+};
+
+GridGroups gridGroups(int nx, int ny, int nz) {
+  GridGroups g;
+  const auto index = [&](int x, int y, int z) { return static_cast<std::uint32_t>((z * ny + y) * nx + x); };
+  g.bodies.resize(static_cast<std::size_t>(nx * ny * nz) + 1);
+  for (int z = 0; z < nz; ++z) {
+    for (int y = 0; y < ny; ++y) {
+      for (int x = 0; x < nx; ++x) {
+        g.bodies[index(x, y, z)].pose.position = Vec3(x, y, z);
+        if (x > 0) g.groups.push_back({index(x - 1, y, z), index(x, y, z)});
+        if (y > 0) g.groups.push_back({index(x, y - 1, z), index(x, y, z)});
+        if (z > 0) g.groups.push_back({index(x, y, z - 1), index(x, y, z)});
+        if (z == 0) g.groups.push_back({SolverGroup::kStatic, index(x, y, z)});
+      }
+    }
+  }
+  g.bodies.back().is_static = true;  // the floor (never named: groups say kStatic)
+  return g;
+}
+
+TEST(ContactPartition, BlocksOfOneStageShareNoMovableBody) {
+  for (const auto& [nx, ny, nz] : {std::array<int, 3>{64, 4, 3}, std::array<int, 3>{12, 12, 12}, std::array<int, 3>{5, 30, 2}}) {
+    const GridGroups g = gridGroups(nx, ny, nz);
+    ContactPartition partition;
+    partition.assign(g.groups, g.bodies);
+    ASSERT_GT(partition.slabs(), 1u) << nx << "x" << ny << "x" << nz;
+    const std::vector<std::uint32_t>& block = partition.blocks();
+    ASSERT_EQ(block.size(), g.groups.size());
+    // Per stage, the block that last wrote each body: another block of the
+    // same stage must not touch it.
+    std::vector<std::int64_t> owner(g.bodies.size());
+    std::size_t crossing = 0;
+    for (std::uint32_t stage = 0; stage < ContactPartition::kStages; ++stage) {
+      std::fill(owner.begin(), owner.end(), -1);
+      for (std::size_t k = 0; k < g.groups.size(); ++k) {
+        ASSERT_LT(block[k], partition.blockCount());
+        if (partition.stageOf(block[k]) != stage) continue;
+        if (stage > 0) ++crossing;
+        for (const std::uint32_t body : {g.groups[k].a, g.groups[k].b}) {
+          if (body == SolverGroup::kStatic) continue;
+          if (owner[body] == -1) owner[body] = block[k];
+          EXPECT_EQ(owner[body], block[k]) << "body " << body << " in two blocks of stage " << stage;
+        }
+      }
+    }
+    EXPECT_EQ(crossing, partition.crossing());
+    EXPECT_LE(static_cast<double>(crossing), ContactPartition::kMaxCrossingShare * static_cast<double>(g.groups.size()));
+  }
+}
+
+TEST(ContactPartition, SlabsFollowTheLongAxisAndStayThickEnough) {
+  // A long row: the most slabs; within a slab the groups keep their order.
+  const GridGroups row = gridGroups(400, 2, 2);
+  ContactPartition partition;
+  partition.assign(row.groups, row.bodies);
+  EXPECT_EQ(partition.slabs(), ContactPartition::kMaxSlabs);
+  for (std::size_t k = 0; k < row.groups.size(); ++k) {
+    if (partition.stageOf(partition.blocks()[k]) != 0) continue;
+    const double x = row.bodies[row.groups[k].b].pose.position.x();
+    const std::uint32_t slab = partition.blocks()[k];
+    EXPECT_NEAR(x, (slab + 0.5) * 400.0 / ContactPartition::kMaxSlabs, 400.0 / ContactPartition::kMaxSlabs) << k;
+  }
+  // A cube 8 bodies wide (1,408 groups): 16 or 8 slabs would be a body
+  // thick or less and put the 448 groups along x (32 %) across the cuts; 4
+  // slabs of two bodies put the 3 x 64 groups at their cuts.
+  const GridGroups cube = gridGroups(8, 8, 8);
+  partition.assign(cube.groups, cube.bodies);
+  EXPECT_EQ(partition.slabs(), 4u);
+  EXPECT_EQ(partition.crossing(), 3u * 64u);
+  // Too few groups for two slabs, and bodies all at one point: one block.
+  const GridGroups few = gridGroups(4, 4, 1);
+  ASSERT_LT(few.groups.size(), 2 * ContactPartition::kMinGroupsPerSlab);
+  partition.assign(few.groups, few.bodies);
+  EXPECT_EQ(partition.slabs(), 1u);
+  GridGroups point = gridGroups(30, 30, 1);
+  for (BodyState& b : point.bodies) b.pose.position = Vec3(1.0, 2.0, 3.0);
+  partition.assign(point.groups, point.bodies);
+  EXPECT_EQ(partition.slabs(), 1u);
+  for (const std::uint32_t b : partition.blocks()) EXPECT_EQ(b, 0u);
+}
+
+
+// Team (workers.hpp): each block of a loop runs exactly once, on some member;
+// the workers' own loops and a nested withTeam use the running team; a throw
+// leaves the workers usable. Counts only, no timing.
+TEST(Team, EveryBlockRunsOnceAndTheWorkersLoopsJoinTheTeam) {
+  for (const int threads : {2, 4}) {
+    Workers workers(threads);
+    const std::vector<std::size_t> counts = {0, 1, 2, 3, 17, Team::kMaxBlocks, 150};  // 150: three rounds
+    std::vector<int> runs(150, 0);  // block k writes only runs[k]
+    std::vector<int> indices(1000, 0);
+    constexpr int kCalls = 50;
+    for (int call = 0; call < kCalls; ++call) {
+      workers.withTeam([&](Team& team) {
+        EXPECT_EQ(team.members(), threads);
+        for (const std::size_t count : counts) {
+          team.forBlocks(count, [&](std::size_t k, std::size_t end) {
+            EXPECT_EQ(end, k + 1);
+            ++runs[k];
+          });
+        }
+        workers.forEach(indices.size(), 10, [&](std::size_t begin, std::size_t end) {
+          for (std::size_t i = begin; i < end; ++i) ++indices[i];
+        });
+        workers.forChunks(5, [&](std::size_t k, std::size_t) { ++runs[k]; });
+        workers.withTeam([&](Team& inner) { EXPECT_EQ(&inner, &team); });
+      });
+    }
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      const int loops = static_cast<int>(std::count_if(counts.begin(), counts.end(), [&](std::size_t c) { return c > k; }));
+      EXPECT_EQ(runs[k], kCalls * (loops + (k < 5 ? 1 : 0))) << "block " << k << ", " << threads << " threads";
+    }
+    for (const int n : indices) EXPECT_EQ(n, kCalls);
+  }
+}
+
+TEST(Team, AThrowLeavesTheWorkersUsable) {
+  Workers workers(2);
+  std::vector<int> runs(8, 0);
+  EXPECT_THROW(workers.withTeam([&](Team& team) {
+    team.forBlocks(runs.size(), [&](std::size_t k, std::size_t) { ++runs[k]; });
+    throw InputError("test", "thrown inside the team");
+  }),
+               InputError);
+  workers.withTeam([&](Team& team) { team.forBlocks(runs.size(), [&](std::size_t k, std::size_t) { ++runs[k]; }); });
+  workers.forChunks(runs.size(), [&](std::size_t k, std::size_t) { ++runs[k]; });  // outside a team: TBB
+  for (const int n : runs) EXPECT_EQ(n, 3);
 }
 
 }  // namespace

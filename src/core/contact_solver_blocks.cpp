@@ -1,0 +1,117 @@
+// The solver's manifolds in block order (contact_partition.hpp) and the loop
+// that runs a pass over them stage by stage, each stage's blocks in parallel.
+#include "sphere_tree_collision/contact_solver.hpp"
+
+#include <limits>
+
+namespace stc {
+
+void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts) {
+  // Groups: the manifolds, runs of one body pair in order_ (a pair's contacts
+  // are adjacent, as ContactBuilder emits them, and stay so in the order from
+  // the ground, which is stable).
+  groups_.clear();
+  group_first_.clear();
+  levels_.clear();  // the levels met, in that order
+  // Sized by the contacts, in the tick they grow (no allocation in a later
+  // tick with more manifolds or levels and no more contacts).
+  for (std::vector<std::uint32_t>* v : {&group_first_, &group_order_, &block_order_, &manifold_start_, &cursor_}) {
+    v->reserve(order_.size() + 1);
+  }
+  groups_.reserve(order_.size());
+  manifolds_.reserve(order_.size());
+  levels_.reserve(order_.size());
+  for (std::size_t p = 0; p < order_.size(); ++p) {
+    const Contact& c = contacts[order_[p]];
+    const int level = levelOf(c);
+    if (levels_.empty() || levels_.back() != level) levels_.push_back(level);
+    if (p > 0) {
+      const Contact& previous = contacts[order_[p - 1]];
+      if (c.index_a == previous.index_a && c.index_b == previous.index_b) continue;
+    }
+    SolverGroup group;
+    group.a = bodies[c.index_a].is_static ? SolverGroup::kStatic : c.index_a;
+    group.b = bodies[c.index_b].is_static ? SolverGroup::kStatic : c.index_b;
+    groups_.push_back(group);
+    group_first_.push_back(static_cast<std::uint32_t>(p));
+  }
+  group_first_.push_back(static_cast<std::uint32_t>(order_.size()));
+  partition_.assign(groups_, bodies);
+
+  // Manifolds by block, stable (counting sort), then their contacts in that order.
+  const std::vector<std::uint32_t>& block = partition_.blocks();
+  const std::uint32_t block_count = partition_.blockCount();
+  block_manifold_start_.assign(block_count + 1, 0);
+  for (std::size_t g = 0; g < groups_.size(); ++g) ++block_manifold_start_[block[g] + 1];
+  for (std::size_t b = 1; b < block_manifold_start_.size(); ++b) block_manifold_start_[b] += block_manifold_start_[b - 1];
+  cursor_.assign(block_manifold_start_.begin(), block_manifold_start_.end() - 1);  // fill positions
+  group_order_.resize(groups_.size());
+  for (std::uint32_t g = 0; g < groups_.size(); ++g) group_order_[cursor_[block[g]]++] = g;
+  block_order_.clear();
+  manifold_start_.clear();
+  manifolds_.clear();
+  for (const std::uint32_t g : group_order_) {
+    manifold_start_.push_back(static_cast<std::uint32_t>(block_order_.size()));
+    manifolds_.push_back(groups_[g]);
+    for (std::uint32_t p = group_first_[g]; p < group_first_[g + 1]; ++p) block_order_.push_back(order_[p]);
+  }
+  manifold_start_.push_back(static_cast<std::uint32_t>(block_order_.size()));
+  order_.swap(block_order_);
+
+  // A pass's runs: the non-empty blocks, stage by stage.
+  const std::uint32_t slabs = partition_.slabs();
+  pass_runs_.clear();
+  pass_stage_start_.clear();
+  for (std::uint32_t b = 0; b < block_count; ++b) {
+    if (b % slabs == 0) pass_stage_start_.push_back(static_cast<std::uint32_t>(pass_runs_.size()));
+    if (block_manifold_start_[b + 1] > block_manifold_start_[b]) {
+      pass_runs_.push_back(ManifoldRun{block_manifold_start_[b], block_manifold_start_[b + 1]});
+    }
+  }
+  pass_stage_start_.push_back(static_cast<std::uint32_t>(pass_runs_.size()));
+
+  // Shock propagation's runs: within a block the manifolds are in the order
+  // from the ground, so each level takes the next run of every block, stage
+  // by stage. Restricted to one level, the blocks of a stage still share no
+  // movable body.
+  constexpr int kUnreached = std::numeric_limits<int>::max();
+  level_runs_.clear();
+  level_stage_start_.clear();
+  cursor_.assign(block_manifold_start_.begin(), block_manifold_start_.end() - 1);
+  for (const int level : levels_) {
+    if (level == kUnreached) break;  // nothing static below: no shock to pass on
+    for (std::uint32_t b = 0; b < block_count; ++b) {
+      if (b % slabs == 0) level_stage_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
+      std::uint32_t end = cursor_[b];
+      while (end < block_manifold_start_[b + 1] && levelOf(contacts[order_[manifold_start_[end]]]) == level) ++end;
+      if (end > cursor_[b]) level_runs_.push_back(ManifoldRun{cursor_[b], end});
+      cursor_[b] = end;
+    }
+  }
+  if (!level_stage_start_.empty()) level_stage_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
+}
+
+void ContactSolver::runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds) const {
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < count; ++k) total += runs[k].end - runs[k].first;
+  if (team_ == nullptr || count < 2 || total < task_manifolds_) {
+    for (std::size_t k = 0; k < count; ++k) manifolds(runs[k].first, runs[k].end);
+    return;
+  }
+  team_->forBlocks(count, [&](std::size_t k, std::size_t) { manifolds(runs[k].first, runs[k].end); });
+}
+
+void ContactSolver::forEachStage(RangeFn manifolds) {
+  for (std::size_t s = 0; s + 1 < pass_stage_start_.size(); ++s) {
+    runStage(pass_runs_.data() + pass_stage_start_[s], pass_stage_start_[s + 1] - pass_stage_start_[s], manifolds);
+  }
+}
+
+void ContactSolver::forEachStageOfLevel(std::size_t level, RangeFn manifolds) {
+  const std::size_t first = level * ContactPartition::kStages;
+  for (std::size_t s = first; s < first + ContactPartition::kStages; ++s) {
+    runStage(level_runs_.data() + level_stage_start_[s], level_stage_start_[s + 1] - level_stage_start_[s], manifolds);
+  }
+}
+
+}  // namespace stc
