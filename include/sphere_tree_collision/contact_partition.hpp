@@ -4,7 +4,7 @@
 //
 // The unit is a group: the contacts of one body pair, solved one after the
 // other by one thread. The movable bodies are cut into slabs along the widest
-// axis of their centres, each slab touching about as many groups. A group
+// axis of their centres, each slab touching about as many contacts. A group
 // whose movable bodies lie in one slab s goes to block s of stage 0; a group
 // across the cut between slabs s and s + 1 to block s of stage 1 (s even) or
 // of stage 2 (s odd); any other group to stage 3's single block. The blocks
@@ -28,6 +28,7 @@ namespace stc {
 struct SolverGroup {
   static constexpr std::uint32_t kStatic = std::numeric_limits<std::uint32_t>::max();
   std::uint32_t a = kStatic, b = kStatic;  // dense body indices; kStatic: a body that never moves
+  std::uint32_t rows = 1;                  // its contacts: the work it costs a pass
 };
 
 class ContactPartition {

@@ -28,17 +28,18 @@ void ContactPartition::assign(const std::vector<SolverGroup>& groups, const std:
   const double extent = (hi - lo).maxCoeff(&axis);
   if (!(extent > 0.0) || !std::isfinite(extent)) return;
 
-  // Each body's bin along it, and the groups each bin touches (a group
-  // counts once for each of its movable bodies).
+  // Each body's bin along it, and the work in each bin: a group's contacts,
+  // shared by its movable bodies (twice its contacts in all, so no halves).
   bin_.resize(bodies.size());
   bin_weight_.assign(kBins, 0);
   const double per_bin = kBins / extent;
   for (const SolverGroup& g : groups) {
+    const std::uint32_t share = (g.a == SolverGroup::kStatic || g.b == SolverGroup::kStatic) ? 2 * g.rows : g.rows;
     for (const std::uint32_t body : {g.a, g.b}) {
       if (body == SolverGroup::kStatic) continue;
       const double at = (bodies[body].pose.position[axis] - lo[axis]) * per_bin;
       bin_[body] = std::min<std::uint32_t>(kBins - 1, static_cast<std::uint32_t>(std::max(0.0, at)));
-      ++bin_weight_[bin_[body]];
+      bin_weight_[bin_[body]] += share;
     }
   }
   for (std::uint32_t slabs = most; slabs >= 2; slabs /= 2) {

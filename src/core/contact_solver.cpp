@@ -25,6 +25,7 @@ namespace {
 #endif
 
 constexpr int kUnreached = std::numeric_limits<int>::max();
+constexpr std::size_t kRowsPerTask = 256;  // rows prepared by one task, at least
 
 std::uint64_t pairKey(EntityId a, EntityId b) { return (std::uint64_t{a} << 32) | std::uint64_t{b}; }
 
@@ -141,7 +142,8 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     v->reserve(rows_.size());
   }
   for (std::vector<CachedPoint>* v : {&cache_, &next_cache_}) v->reserve(rows_.size());
-  for (std::size_t r = 0; r < order_.size(); ++r) {
+  // Each row from its contact alone: in pieces on the workers.
+  const auto prepareRow = [&](std::size_t r) {
     const std::uint32_t ci = order_[r];
     const Contact& c = contacts[ci];
     const BodyState& ba = bodies[c.index_a];
@@ -199,8 +201,11 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     } else {
       info.push = s > 0.0 ? -s / dt : 0.0;  // pseudo-velocities may close a gap, never open one
     }
-    stats.max_penetration = std::max(stats.max_penetration, -s);
-  }
+  };
+  forEachIndex(workers_, order_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) prepareRow(r);
+  });
+  for (const std::uint32_t ci : order_) stats.max_penetration = std::max(stats.max_penetration, -contacts[ci].separation);
   stats.contacts = rows_.size();
   stats.manifolds = manifold_start_.size() - 1;
   prepareRolling(bodies, jacobi);

@@ -36,6 +36,7 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const s
     group_first_.push_back(static_cast<std::uint32_t>(p));
   }
   group_first_.push_back(static_cast<std::uint32_t>(order_.size()));
+  for (std::size_t g = 0; g < groups_.size(); ++g) groups_[g].rows = group_first_[g + 1] - group_first_[g];
   partition_.assign(groups_, bodies);
 
   // Manifolds by block, stable (counting sort), then their contacts in that order.

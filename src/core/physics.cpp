@@ -15,6 +15,7 @@ constexpr double kRestingFallTicks = 4.0;
 constexpr std::size_t kBodiesPerTask = 256;
 // Below this many pairs the contacts are built on the calling thread.
 constexpr std::size_t kPairsPerTask = 64;
+constexpr std::size_t kChunksPerThread = 4;  // contact building
 
 }  // namespace
 
@@ -108,7 +109,9 @@ void Physics::respond(const StepContext& step) {
   // Each pair's contacts depend on that pair alone: chunks of the pairs in
   // parallel, each with its own builder, joined in pair order (the same
   // contacts, in the same order, whatever the thread count).
-  const std::size_t chunks = step.workers != nullptr ? static_cast<std::size_t>(step.workers->threads()) : 1;
+  // A few chunks a thread: a pile's colliding pairs bunch in the pair list.
+  const std::size_t threads = step.workers != nullptr ? static_cast<std::size_t>(step.workers->threads()) : 1;
+  const std::size_t chunks = threads > 1 ? kChunksPerThread * threads : 1;
   if (chunks == 1 || count < kPairsPerTask) {
     appendContacts(step, 0, count, builders_.empty() ? builders_.emplace_back() : builders_[0], contacts);
   } else {
