@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <cassert>
 #include <chrono>
 #include <string>
 #include <thread>
@@ -233,13 +232,11 @@ void Workers::runTeam(void (*call)(void*, Team&), void* body) const {
   Team::State& state = a.state;
   a.running = true;
   state.open.store(true);
-  a.arena.execute([&] {
-    for (int m = 1; m < threads_; ++m) {
-      if (state.present[static_cast<std::size_t>(m)].load()) continue;
-      state.present[static_cast<std::size_t>(m)].store(true);
-      a.members.run([&a, m] { a.team.serve(m); });
-    }
-  });
+  for (int m = 1; m < threads_; ++m) {
+    if (state.present[static_cast<std::size_t>(m)].load()) continue;  // still there from the last call
+    state.present[static_cast<std::size_t>(m)].store(true);
+    a.arena.execute([&a, m] { a.members.run([&a, m] { a.team.serve(m); }); });
+  }
   const auto close = [&] {
     state.open.store(false, std::memory_order_release);
     a.running = false;

@@ -131,8 +131,8 @@ TEST(WorldAllocations, SteadyStateTicksDoNotAllocate) {
   }
 }
 
-// Two threads: the chunks' schedulers, arenas and contact builders and the
-// solver's colours keep their capacity too. The fake clock is read by both
+// Two threads: the chunks' schedulers, arenas and contact builders, the
+// solver's blocks and the team keep their capacity too. The fake clock is read by both
 // threads: an atomic count of 10 us steps.
 TEST(WorldAllocations, ParallelTicksDoNotAllocate) {
   World w = movingWorld(7, SchedulerKind::PriorityQueues, 2);
