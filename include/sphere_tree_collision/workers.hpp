@@ -44,9 +44,10 @@ class Team {
   static constexpr std::size_t kMaxBlocks = 64;  // of one forBlocks round
   int members() const { return members_; }
   // fn(k, k + 1) once for each block k in [0, count), each by one member, who
-  // first takes the blocks of its own share (the k with k * members / count
-  // == member: the same bodies stage after stage), then any left; returns
-  // when all are done. Only the thread that called withTeam may call it.
+  // first claims its whole own share (the k with k * members / count ==
+  // member: the same bodies stage after stage) and runs it, then takes any
+  // block left; returns when all are done. Only the thread that called
+  // withTeam may call it.
   void forBlocks(std::size_t count, RangeFn fn);
 
  private:

@@ -143,17 +143,31 @@ void Workers::forChunks(std::size_t chunks, RangeFn fn) const {
 }
 
 void Team::take(int member, std::uint64_t stage, const RangeFn* fn, std::size_t count) {
-  const std::size_t first = (static_cast<std::size_t>(member) * count + members_ - 1) / members_;
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::size_t k = (first + i) % count;
+  const auto claim = [&](std::size_t k) {
     std::uint64_t was = state_->taken[k].load(std::memory_order_relaxed);
-    bool mine = false;
-    while (was < stage && !mine) {
-      mine = state_->taken[k].compare_exchange_weak(was, stage, std::memory_order_acq_rel);
+    while (was < stage) {
+      if (state_->taken[k].compare_exchange_weak(was, stage, std::memory_order_acq_rel)) return true;
     }
-    if (!mine) continue;
+    return false;
+  };
+  const auto run = [&](std::size_t k) {
     (*fn)(k, k + 1);
     state_->done.fetch_add(1, std::memory_order_release);
+  };
+  // The own share is claimed whole before any of it runs: a busy member's
+  // next block stays its own (taking it would move its data between cores).
+  const std::size_t first = (static_cast<std::size_t>(member) * count + members_ - 1) / members_;
+  const std::size_t last = (static_cast<std::size_t>(member + 1) * count + members_ - 1) / members_;
+  std::uint64_t own = 0;  // bit k - first: claimed (at most kMaxBlocks)
+  for (std::size_t k = first; k < last; ++k) {
+    if (claim(k)) own |= std::uint64_t{1} << (k - first);
+  }
+  for (std::size_t k = first; k < last; ++k) {
+    if ((own >> (k - first)) & 1u) run(k);
+  }
+  for (std::size_t i = last - first; i < count; ++i) {  // then what the others have not claimed
+    const std::size_t k = (first + i) % count;
+    if (claim(k)) run(k);
   }
 }
 
