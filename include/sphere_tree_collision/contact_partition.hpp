@@ -35,8 +35,8 @@ class ContactPartition {
  public:
   static constexpr std::uint32_t kStages = 4;
   static constexpr std::uint32_t kMaxSlabs = 16;
-  // A slab touches at least this many groups: fewer, and its block costs
-  // more to hand to a thread than it saves.
+  // At most groups / this many slabs: a smaller block costs more to hand to
+  // a thread than it saves.
   static constexpr std::size_t kMinGroupsPerSlab = 32;
   // Fewer slabs are taken while more of the groups than these shares cross
   // a cut (stages 1-2) or span more than one (stage 3): slabs thinner than
@@ -49,7 +49,8 @@ class ContactPartition {
   std::uint32_t slabs() const { return slabs_; }
   // Block of each group: stage * slabs() + slab (stage 3: 3 * slabs()).
   const std::vector<std::uint32_t>& blocks() const { return block_; }
-  std::uint32_t blockCount() const { return kStages * slabs_; }  // ids are below this (stage 3's above 3 * slabs: unused)
+  // Block ids are below this (stage 3 uses only 3 * slabs()).
+  std::uint32_t blockCount() const { return kStages * slabs_; }
   std::uint32_t stageOf(std::uint32_t block) const { return block / slabs_; }
   // Groups of stages 1 to 3 after the last assign.
   std::size_t crossing() const { return crossing_; }
