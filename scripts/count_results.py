@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
 """Count test cases in the JUnit result files of `make run_tests`.
 
-Prints every failing case, then one line `N passed, N failed`; exits 1 unless
+Prints every failing case with the first lines of its message, then one line
+`N passed, N failed`; exits 1 unless
 at least one test ran and none failed. A result file that cannot be parsed, or
 a test binary that crashed (catkin writes a MISSING-... file), counts as failed.
 """
 import pathlib
 import sys
 import xml.etree.ElementTree as ET
+
+MESSAGE_LINES = 6
 
 
 def main(root: str) -> int:
@@ -22,8 +25,16 @@ def main(root: str) -> int:
             continue
         for case in tree.iter("testcase"):
             name = f"{case.get('classname', '')}.{case.get('name', '')}"
-            if case.find("failure") is not None or case.find("error") is not None:
+            problem = case.find("failure")
+            if problem is None:
+                problem = case.find("error")
+            if problem is not None:
                 print(f"FAILED {f.name}: {name}")
+                # The message says which assert and with what values: a CI log that
+                # keeps only its tail still shows why.
+                text = (problem.get("message") or problem.text or "").strip().splitlines()
+                for line in text[:MESSAGE_LINES]:
+                    print(f"    {line[:300]}")
                 failed += 1
             elif case.find("skipped") is not None or case.get("status") == "notrun":
                 skipped += 1

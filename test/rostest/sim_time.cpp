@@ -22,15 +22,18 @@ TEST(SimTime, TicksFollowTheClock) {
   std::set<std::uint64_t> published;
   rosgraph_msgs::Clock clock;
   clock.clock = ros::Time(1000, 0);
-  const auto publish = [&] {
+  const ros::Duration step(kDt / 4);
+  // Every value of the clock is published, in steps, with none skipped: a tick
+  // is due at a whole period after the last, and that instant must be one the
+  // test published (the node stamps a tick with the time it was due).
+  const auto publishNext = [&] {
+    clock.clock += step;
     clock_pub.publish(clock);
     published.insert(clock.clock.toNSec());
   };
-  const ros::Duration step(kDt / 4);
   // Until the node listens and ticks (it starts at the first /clock, ticks when it moves).
   ASSERT_TRUE(stc_test::spinUntil([&] {
-    publish();
-    clock.clock += step;
+    publishNext();
     return stats.count() > 0;
   }, stc_test::kLivenessSeconds));
   // Then 6 s of sim time in quarter ticks, each published once the node has
@@ -41,8 +44,7 @@ TEST(SimTime, TicksFollowTheClock) {
   const ros::Time paced_from = clock.clock;
   const ros::Time end = clock.clock + ros::Duration(6.0);
   while (clock.clock < end) {
-    clock.clock += step;
-    publish();
+    publishNext();
     ASSERT_TRUE(stc_test::spinUntil([&] { return stats.last.header.stamp + ros::Duration(kDt) >= clock.clock; },
                                     stc_test::kLivenessSeconds))
         << "last tick stamped " << stats.last.header.stamp << ", clock at " << clock.clock;
