@@ -11,6 +11,12 @@
 // that s predicts for 8 and 16 cores. The load average is printed with the
 // figures: on a busy machine the parallel run waits for cores.
 //
+// Before each turn of the two runs, two threads pass one cache line back and
+// forth: the round trip between two cores. On this VM it is 100-200 ns in
+// some hours and 450-500 ns in others (the host places the two virtual CPUs
+// nearer or farther apart), and the speed-up follows it. The turns are split
+// by it, and the speed-up given for each class.
+//
 // Usage: bench_parallel_speedup [--scenes corner_drift:500,rockfall:1000,packed_box:500,cube_box:10000]
 //          [--threads 2] [--seconds 6] [--cube-seconds 1.5] [--settle 1]
 //   --seconds: simulated time timed per scene (cube_box: --cube-seconds);
@@ -22,11 +28,14 @@
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -92,6 +101,31 @@ void timedTicks(World& world, double dt, int ticks, Run& run) {
   }
 }
 
+// Mean round trip of one cache line between this thread and another, seconds.
+// Measured after a pause longer than the team's linger (2 ms), so that no
+// member of the last turn still spins on a core.
+double coreRoundTrip() {
+  constexpr int kTrips = 20000;
+  std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  alignas(64) std::atomic<int> ball{0};
+  std::thread other([&] {
+    for (int i = 0; i < kTrips; ++i) {
+      while (ball.load(std::memory_order_acquire) != 2 * i + 1) {
+      }
+      ball.store(2 * i + 2, std::memory_order_release);
+    }
+  });
+  const double t0 = wallSeconds();
+  for (int i = 0; i < kTrips; ++i) {
+    ball.store(2 * i + 1, std::memory_order_release);
+    while (ball.load(std::memory_order_acquire) != 2 * i + 2) {
+    }
+  }
+  const double t = wallSeconds() - t0;
+  other.join();
+  return t / kTrips;
+}
+
 double ms(double s) { return 1e3 * s; }
 double ratio(double a, double b) { return b > 0.0 ? a / b : NAN; }
 
@@ -119,11 +153,26 @@ double runCase(const Case& c, const Options& opt) {
   const int ticks = std::max(1, static_cast<int>(std::lround(seconds / spec.dt)));
   const int block = 30;  // ticks per turn: the two runs take turns
   Run r1, rn;
+  // Wall time of the turns by the round trip measured before them: near
+  // (under kFarRoundTrip) and far.
+  constexpr double kFarRoundTrip = 300e-9;
+  double wall_one[2] = {0.0, 0.0}, wall_many[2] = {0.0, 0.0};
+  int turns[2] = {0, 0};
+  std::vector<double> round_trips;
   const double load_before = loadAverage();
   for (int done = 0; done < ticks; done += block) {
     const int n = std::min(block, ticks - done);
+    const double trip = coreRoundTrip();
+    round_trips.push_back(trip);
+    const int far = trip >= kFarRoundTrip ? 1 : 0;
+    const std::size_t from = r1.wall.size();
     timedTicks(one, spec.dt, n, r1);
     timedTicks(many, spec.dt, n, rn);
+    for (std::size_t t = from; t < r1.wall.size(); ++t) {
+      wall_one[far] += r1.wall[t];
+      wall_many[far] += rn.wall[t];
+    }
+    ++turns[far];
   }
   const double load_after = loadAverage();
 
@@ -150,6 +199,13 @@ double runCase(const Case& c, const Options& opt) {
   const double s = serialFraction(meanOf(r1.wall), meanOf(rn.wall), opt.threads);
   std::printf("\nserial fraction (Amdahl fit, 1 vs %d threads): %.3f; model: 8 cores %.2fx, 16 cores %.2fx\n",
               opt.threads, s, amdahl(std::max(s, 0.0), 8), amdahl(std::max(s, 0.0), 16));
+  std::printf("core-to-core round trip before each turn: p50 %.0f ns (%.0f-%.0f)\n",
+              1e9 * percentile(round_trips, 0.5), 1e9 * percentile(round_trips, 0.0), 1e9 * percentile(round_trips, 1.0));
+  for (int far = 0; far < 2; ++far) {
+    if (turns[far] == 0) continue;
+    std::printf("  turns with a round trip %s %.0f ns: %d, whole-tick wall speed-up %.2f\n", far ? ">=" : "<",
+                1e9 * kFarRoundTrip, turns[far], ratio(wall_one[far], wall_many[far]));
+  }
   std::fflush(stdout);
   return x;
 }
