@@ -5,6 +5,7 @@
 #include "sphere_tree_collision/dynamics.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -25,7 +26,8 @@ namespace {
 #endif
 
 constexpr int kUnreached = std::numeric_limits<int>::max();
-constexpr std::size_t kRowsPerTask = 256;  // rows prepared by one task, at least
+constexpr std::size_t kRowsPerTask = 256;       // rows prepared by one task, at least
+constexpr std::size_t kManifoldsPerTask = 128;  // manifolds' rolling resistance, at least
 
 std::uint64_t pairKey(EntityId a, EntityId b) { return (std::uint64_t{a} << 32) | std::uint64_t{b}; }
 
@@ -216,10 +218,10 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
 // point to the nearer centre of mass of a movable body (a ball's radius; a
 // rock's, where it touches). Box2D v3 takes the larger coefficient too.
 void ContactSolver::prepareRolling(const std::vector<BodyState>& bodies, bool jacobi) {
-  any_rolling_ = false;
   const std::size_t manifolds = manifold_start_.size() - 1;
   if (rolling_.size() < manifolds) rolling_.resize(manifolds);
-  for (std::size_t m = 0; m < manifolds; ++m) {
+  std::atomic<bool> any{false};
+  const auto prepareManifold = [&](std::size_t m) {
     Rolling& roll = rolling_[m];
     roll.lambda.setZero();
     roll.per_normal = 0.0;
@@ -227,14 +229,14 @@ void ContactSolver::prepareRolling(const std::vector<BodyState>& bodies, bool ja
     const BodyState& ba = bodies[rows_[begin].a];
     const BodyState& bb = bodies[rows_[begin].b];
     const double coefficient = std::max(ba.material.rolling_resistance, bb.material.rolling_resistance);
-    if (!(coefficient > 0.0)) continue;
+    if (!(coefficient > 0.0)) return;
     roll.inv_ia = ba.is_static ? Mat3::Zero() : ba.inv_inertia_world;
     roll.inv_ib = bb.is_static ? Mat3::Zero() : bb.inv_inertia_world;
     // Mass splitting (Jacobi), as the rows: each body counts once per contact on it.
     const double split_a = jacobi ? std::max(1, contact_count_[rows_[begin].a]) : 1.0;
     const double split_b = jacobi ? std::max(1, contact_count_[rows_[begin].b]) : 1.0;
     const Mat3 k = split_a * roll.inv_ia + split_b * roll.inv_ib;
-    if (!(std::abs(k.determinant()) > 0.0)) continue;
+    if (!(std::abs(k.determinant()) > 0.0)) return;
     roll.mass = k.inverse();
     double radius = 0.0;
     for (std::uint32_t r = begin; r < stop; ++r) {
@@ -244,8 +246,12 @@ void ContactSolver::prepareRolling(const std::vector<BodyState>& bodies, bool ja
       radius += nearer;
     }
     roll.per_normal = coefficient * radius / (stop - begin);
-    any_rolling_ = any_rolling_ || roll.per_normal > 0.0;
-  }
+    if (roll.per_normal > 0.0) any.store(true, std::memory_order_relaxed);
+  };
+  forEachIndex(workers_, manifolds, kManifoldsPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t m = begin; m < end; ++m) prepareManifold(m);
+  });
+  any_rolling_ = any.load();
 }
 
 // Gauss-Seidel converges fastest on a stack when the support is solved
@@ -368,64 +374,77 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
 void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
                               SolveStats& stats) {
   if (cache_manifolds_.empty()) return;
-  for (std::size_t m = 0; m + 1 < manifold_start_.size(); ++m) {
-    const std::uint32_t first = manifold_start_[m];
-    const std::uint32_t last = manifold_start_[m + 1];
-    const Contact& c0 = contacts[info_[first].contact];
-    const std::uint64_t key = pairKey(c0.a, c0.b);
-    const auto found = std::lower_bound(cache_manifolds_.begin(), cache_manifolds_.end(), key,
-                                        [](const CachedManifold& x, std::uint64_t k) { return x.pair < k; });
-    if (found == cache_manifolds_.end() || found->pair != key) continue;
-    if (any_rolling_ && rolling_[m].per_normal > 0.0) {
-      Rolling& roll = rolling_[m];
-      roll.lambda = found->rolling;
-      motion_[rows_[first].a].w -= roll.inv_ia * roll.lambda;
-      motion_[rows_[first].b].w += roll.inv_ib * roll.lambda;
-    }
-    const CachedPoint* old = cache_.data() + found->first;
-    const std::uint32_t old_count = found->count;
-    std::uint32_t used = 0;  // bit j: old point j taken (at most 16 points a pair)
-    const BodyState& ba = bodies[rows_[first].a];
-    const Quat to_a = ba.pose.orientation.conjugate();
-    for (std::uint32_t r = first; r < last; ++r) {
-      const Contact& c = contacts[info_[r].contact];
-      int best = -1;
-      for (std::uint32_t j = 0; j < old_count && best < 0; ++j) {
-        if (!(used >> j & 1u) && old[j].node_a == c.node_a && old[j].node_b == c.node_b) best = static_cast<int>(j);
+  std::atomic<std::size_t> by_feature{0}, started{0};
+  // Stage by stage, as a pass: each body meets its manifolds in the same
+  // order whatever the thread count, and a block's bodies stay on its thread.
+  forEachStage([&](std::size_t first_manifold, std::size_t end_manifold) {
+    std::size_t feature_hits = 0, warm = 0;
+    for (std::size_t m = first_manifold; m < end_manifold; ++m) {
+      const std::uint32_t first = manifold_start_[m];
+      const std::uint32_t last = manifold_start_[m + 1];
+      const Contact& c0 = contacts[info_[first].contact];
+      const std::uint64_t key = pairKey(c0.a, c0.b);
+      const auto found = std::lower_bound(cache_manifolds_.begin(), cache_manifolds_.end(), key,
+                                          [](const CachedManifold& x, std::uint64_t k) { return x.pair < k; });
+      if (found == cache_manifolds_.end() || found->pair != key) continue;
+      Motion a = motion_[rows_[first].a];
+      Motion b = motion_[rows_[first].b];
+      if (any_rolling_ && rolling_[m].per_normal > 0.0) {
+        Rolling& roll = rolling_[m];
+        roll.lambda = found->rolling;
+        a.w -= roll.inv_ia * roll.lambda;
+        b.w += roll.inv_ib * roll.lambda;
       }
-      if (best >= 0) {
-        ++stats.warm_by_feature;
-      } else {
-        const Vec3 local = to_a * (c.point - ba.pose.position);
-        const double tolerance = std::max(0.5 * c.gap_bound, 1e-12);
-        double best_d = tolerance * tolerance;
-        for (std::uint32_t j = 0; j < old_count; ++j) {
-          if (used >> j & 1u) continue;
-          const double d = (old[j].local_a - local).squaredNorm();
-          if (d <= best_d) {
-            best_d = d;
-            best = static_cast<int>(j);
-          }
+      const CachedPoint* old = cache_.data() + found->first;
+      const std::uint32_t old_count = found->count;
+      std::uint32_t used = 0;  // bit j: old point j taken (at most 16 points a pair)
+      const BodyState& ba = bodies[rows_[first].a];
+      const Quat to_a = ba.pose.orientation.conjugate();
+      for (std::uint32_t r = first; r < last; ++r) {
+        const Contact& c = contacts[info_[r].contact];
+        int best = -1;
+        for (std::uint32_t j = 0; j < old_count && best < 0; ++j) {
+          if (!(used >> j & 1u) && old[j].node_a == c.node_a && old[j].node_b == c.node_b) best = static_cast<int>(j);
         }
-        if (best < 0) continue;
+        if (best >= 0) {
+          ++feature_hits;
+        } else {
+          const Vec3 local = to_a * (c.point - ba.pose.position);
+          const double tolerance = std::max(0.5 * c.gap_bound, 1e-12);
+          double best_d = tolerance * tolerance;
+          for (std::uint32_t j = 0; j < old_count; ++j) {
+            if (used >> j & 1u) continue;
+            const double d = (old[j].local_a - local).squaredNorm();
+            if (d <= best_d) {
+              best_d = d;
+              best = static_cast<int>(j);
+            }
+          }
+          if (best < 0) continue;
+        }
+        used |= 1u << best;
+        Row& row = rows_[r];
+        row.lambda[0] = old[best].normal;
+        row.lambda[1] = old[best].friction.dot(row.t1);
+        row.lambda[2] = old[best].friction.dot(row.t2);
+        const Vec3 p = row.lambda[0] * row.n + row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
+        a.v -= row.inv_ma * p;
+        b.v += row.inv_mb * p;
+        for (int k = 0; k < 3; ++k) {
+          a.w -= row.lambda[k] * row.ang_a[k];
+          b.w += row.lambda[k] * row.ang_b[k];
+        }
+        ++warm;
       }
-      used |= 1u << best;
-      Row& row = rows_[r];
-      row.lambda[0] = old[best].normal;
-      row.lambda[1] = old[best].friction.dot(row.t1);
-      row.lambda[2] = old[best].friction.dot(row.t2);
-      const Vec3 p = row.lambda[0] * row.n + row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
-      Motion& a = motion_[row.a];
-      Motion& b = motion_[row.b];
-      a.v -= row.inv_ma * p;
-      b.v += row.inv_mb * p;
-      for (int k = 0; k < 3; ++k) {
-        a.w -= row.lambda[k] * row.ang_a[k];
-        b.w += row.lambda[k] * row.ang_b[k];
-      }
-      ++stats.warm_started;
+      // A static body's motion is never written: two blocks may share it.
+      if (manifolds_[m].a != SolverGroup::kStatic) motion_[rows_[first].a] = a;
+      if (manifolds_[m].b != SolverGroup::kStatic) motion_[rows_[first].b] = b;
     }
-  }
+    by_feature.fetch_add(feature_hits, std::memory_order_relaxed);
+    started.fetch_add(warm, std::memory_order_relaxed);
+  });
+  stats.warm_by_feature += by_feature.load();
+  stats.warm_started += started.load();
 }
 
 // Jacobi: the impulses of one iteration, computed from one state, applied together.
@@ -773,19 +792,23 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
     return stats;
   }
   collide(options, stats);
-  if (options.warm_starting) warmStart(contacts, bodies, stats);
   // Refineable: the first velocity pass always runs; timed, it prices the
   // further iterations against the deadline. `run` carries the iterations
   // afforded to every later stage.
-  // The passes run on a team: the workers stay awake from stage to stage.
+  // The warm start and the passes run on a team: the workers stay awake
+  // from stage to stage.
+  const auto warmAndIterate = [&] {
+    if (options.warm_starting) warmStart(contacts, bodies, stats);
+    iterate(options, budget, stats);
+  };
   if (workers_ != nullptr) {
     workers_->withTeam([&](Team& team) {
       team_ = &team;
-      iterate(options, budget, stats);
+      warmAndIterate();
       team_ = nullptr;
     });
   } else {
-    iterate(options, budget, stats);
+    warmAndIterate();
   }
   store(bodies, contacts, dt);
   if (!options.warm_starting) forget();
