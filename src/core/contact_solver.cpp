@@ -27,7 +27,8 @@ namespace {
 
 constexpr int kUnreached = std::numeric_limits<int>::max();
 constexpr std::size_t kRowsPerTask = 256;       // rows prepared by one task, at least
-constexpr std::size_t kManifoldsPerTask = 128;  // manifolds' rolling resistance, at least
+constexpr std::size_t kManifoldsPerTask = 128;  // manifolds' rolling resistance or cache, at least
+constexpr std::size_t kBodiesPerTask = 256;     // bodies stored by one task, at least
 
 std::uint64_t pairKey(EntityId a, EntityId b) { return (std::uint64_t{a} << 32) | std::uint64_t{b}; }
 
@@ -689,52 +690,58 @@ int ContactSolver::affordableIterations(const ResponseOptions& options, int cap,
 
 void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
                           double dt) {
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    BodyState& body = bodies[i];
-    if (body.is_static) continue;
-    body.linear_velocity = motion_[i].v;
-    body.angular_velocity = motion_[i].w;
-    const Motion& p = pseudo_[i];
-    if (!p.v.isZero(0.0) || !p.w.isZero(0.0)) {
-      body.pose.position += p.v * dt;
-      if (!p.w.isZero(0.0)) {
-        body.pose.orientation = integrateOrientation(body.pose.orientation, p.w, dt);
-        refreshWorldInertia(body);
+  forEachIndex(workers_, bodies.size(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      BodyState& body = bodies[i];
+      if (body.is_static) continue;
+      body.linear_velocity = motion_[i].v;
+      body.angular_velocity = motion_[i].w;
+      const Motion& p = pseudo_[i];
+      if (!p.v.isZero(0.0) || !p.w.isZero(0.0)) {
+        body.pose.position += p.v * dt;
+        if (!p.w.isZero(0.0)) {
+          body.pose.orientation = integrateOrientation(body.pose.orientation, p.w, dt);
+          refreshWorldInertia(body);
+        }
       }
     }
-  }
+  });
 
   // Report impulses on the contacts and keep each pair's manifold for next
-  // tick's warm start.
-  next_cache_.clear();
-  next_manifolds_.clear();
-  for (std::size_t m = 0; m + 1 < manifold_start_.size(); ++m) {
-    CachedManifold manifold;
-    manifold.first = static_cast<std::uint32_t>(next_cache_.size());
-    for (std::uint32_t r = manifold_start_[m]; r < manifold_start_[m + 1]; ++r) {
-      const Row& row = rows_[r];
-      Contact& c = contacts[info_[r].contact];
-      c.normal_impulse = row.lambda[0] + row.bounce_impulse;
-      c.friction_impulse = row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
-      if (r == manifold_start_[m]) {
-        manifold.pair = pairKey(c.a, c.b);
-        manifold.index_a = row.a;
-        manifold.index_b = row.b;
+  // tick's warm start. A manifold's points go where its rows are (at most
+  // 32 of them, warmStart's bit set), so manifolds fill in parallel.
+  const std::size_t manifolds = manifold_start_.size() - 1;
+  next_cache_.resize(rows_.size());
+  next_manifolds_.resize(manifolds);
+  forEachIndex(workers_, manifolds, kManifoldsPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t m = begin; m < end; ++m) {
+      CachedManifold manifold;
+      manifold.first = manifold_start_[m];
+      const std::uint32_t stop = std::min(manifold_start_[m + 1], manifold_start_[m] + 32);
+      for (std::uint32_t r = manifold_start_[m]; r < manifold_start_[m + 1]; ++r) {
+        const Row& row = rows_[r];
+        Contact& c = contacts[info_[r].contact];
+        c.normal_impulse = row.lambda[0] + row.bounce_impulse;
+        c.friction_impulse = row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
+        if (r == manifold_start_[m]) {
+          manifold.pair = pairKey(c.a, c.b);
+          manifold.index_a = row.a;
+          manifold.index_b = row.b;
+        }
+        if (r >= stop) continue;
+        CachedPoint& point = next_cache_[r];
+        point.node_a = c.node_a;
+        point.node_b = c.node_b;
+        const BodyState& ba = bodies[row.a];
+        point.local_a = ba.pose.orientation.conjugate() * (c.point - ba.pose.position);
+        point.normal = info_[r].lambda_main;
+        point.friction = c.friction_impulse;
       }
-      if (r - manifold_start_[m] >= 32) continue;  // warmStart's bit set
-      CachedPoint point;
-      point.node_a = c.node_a;
-      point.node_b = c.node_b;
-      const BodyState& ba = bodies[row.a];
-      point.local_a = ba.pose.orientation.conjugate() * (c.point - ba.pose.position);
-      point.normal = info_[r].lambda_main;
-      point.friction = c.friction_impulse;
-      next_cache_.push_back(point);
+      manifold.count = stop - manifold.first;
+      if (any_rolling_) manifold.rolling = rolling_[m].lambda;
+      next_manifolds_[m] = manifold;
     }
-    manifold.count = static_cast<std::uint32_t>(next_cache_.size()) - manifold.first;
-    if (any_rolling_) manifold.rolling = rolling_[m].lambda;
-    next_manifolds_.push_back(manifold);
-  }
+  });
   std::sort(next_manifolds_.begin(), next_manifolds_.end(), byPair);
   keepHeldManifolds(bodies);
 }
