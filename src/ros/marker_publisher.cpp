@@ -40,7 +40,9 @@ MarkerPublisher::MarkerPublisher(ros::NodeHandle& nh, const NodeParams& params, 
   }
   bound_options_.frame = params.world_frame;
   bound_options_.max_bounds = options_.max_contacts;
-  bounds_pub_ = nh.advertise<visualization_msgs::MarkerArray>("error_bounds", 2);
+  // Each array deletes only the bounds beyond its own count: one dropped array
+  // would leave stale spheres drawn, so none is dropped under a slow reader.
+  bounds_pub_ = nh.advertise<visualization_msgs::MarkerArray>("error_bounds", 100);
 }
 
 void MarkerPublisher::onTick(std::uint64_t tick, const stc::TickReport& report, const ros::Time& stamp) {

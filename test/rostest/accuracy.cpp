@@ -44,7 +44,7 @@ using stc::truth::FclMesh;
 constexpr int kTicksToCheck = 60;
 constexpr double kStartTimeout = 40.0;   // s: node start-up on a busy machine
 constexpr double kSpawnTimeout = 15.0;   // s per entity
-constexpr double kRecordTimeout = 40.0;  // s
+constexpr double kRecordTimeout = 120.0;  // s: a liveness bound; recording ends at kTicksToCheck matched ticks
 // FCL's mesh distance is exact up to rounding; poses travel as doubles.
 constexpr double kGapTolerance = 1e-6;
 

@@ -210,7 +210,10 @@ TEST_F(BadInput, EveryMalformedKindIsRejectedByFieldAndNothingChanges) {
   // Good input still works afterwards.
   spawn_.publish(spawnWith([](SpawnEntity& m) { m.name = "late"; }));
   ASSERT_TRUE(stc_test::spinUntil([&] { return stats_.last.entities == entities + 1; }, stc_test::kLivenessSeconds));
-  gaze_.publish(gaze(640, 360, 0.0));
+  sphere_tree_collision::GazePoint good;  // stamp 0: "now" to the node, never stale however late it arrives
+  good.x = 640;
+  good.y = 360;
+  gaze_.publish(good);
   EXPECT_TRUE(stc_test::spinUntil([&] { return stats_.last.gaze_active; }, stc_test::kLivenessSeconds));
   clicked_.publish(clicked(0.0, 0.0, 0.5));
   EXPECT_TRUE(stc_test::spinUntil([&] { return stats_.last.gaze_active; }, stc_test::kLivenessSeconds));

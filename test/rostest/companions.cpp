@@ -141,7 +141,7 @@ TEST(Companions, FollowGazeTracksTheEntitysProjection) {
   int checked = 0;
   ASSERT_TRUE(stc_test::spinUntil(
       [&] {
-        while (!gaze.all.empty()) {
+        while (checked < 10 && !gaze.all.empty()) {  // two may come in one spin
           const GazePoint g = gaze.all.front();
           gaze.all.erase(gaze.all.begin());
           if (!tf.canTransform("world", "probe", g.header.stamp)) continue;  // not yet in our buffer
@@ -156,7 +156,6 @@ TEST(Companions, FollowGazeTracksTheEntitysProjection) {
         return checked >= 10;
       },
       stc_test::kLivenessSeconds));
-  EXPECT_EQ(checked, 10);
 }
 
 TEST(Companions, RockfallDropsValidRocksAndKeepsAtMostMaxRocks) {

@@ -76,7 +76,9 @@ TEST(DemoPictures, MovingEntitiesInViewAt10sAnd60s) {
     ASSERT_TRUE(rviz.running()) << "rviz exited (log: " << dir << "/rviz.log)";
     const std::string ppm = dir + "/demo_" + std::to_string(static_cast<int>(seconds)) + "s.ppm";
     ViewContent view;
-    // rviz may still be starting at the first picture: retake until it draws.
+    // rviz may still be starting at the first picture: retake until it draws
+    // the movers (frame-locked markers wait for tf, so the contacts and the
+    // gaze may show first).
     const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(kRenderTimeout);
     std::uint64_t shot_tick = 0;
     do {
@@ -84,7 +86,7 @@ TEST(DemoPictures, MovingEntitiesInViewAt10sAnd60s) {
       if (const auto shot = stc_rviz::takeScreenshot(*import_exe, display, ppm)) {
         view = stc_rviz::analyse(*shot, *background, moverColour);
       }
-      if (view.coloured_pixels > 0) break;
+      if (view.coloured_pixels > 0 && view.selected_pixels >= kMinMoverPixels) break;
       stc_test::spinFor(2.0);
     } while (ros::ok() && ros::WallTime::now() < end);
     std::printf("[demo_pictures] %.0f s: tick %llu, 3D view from (%d, %d), %ld pixels in moving entities' colours; %s\n",

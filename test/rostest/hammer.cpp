@@ -224,8 +224,7 @@ TEST(Hammer, MalformedFloodIsRejectedByTopicWhileTheWorldRuns) {
       spawned.erase(spawned.begin());
       ++valid_despawns;
     }
-    GazePoint g;
-    g.header.stamp = ros::Time::now();
+    GazePoint g;  // stamp 0: "now" to the node, so a late arrival is not a stale rejection
     g.x = 320 + 10 * batch;
     g.y = 360;
     gaze.publish(g);

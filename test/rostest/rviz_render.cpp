@@ -21,7 +21,7 @@
 namespace {
 
 constexpr double kMarkersTimeout = 30.0;  // s: node start-up on a busy machine
-constexpr double kRenderTimeout = 45.0;   // s: rviz start-up and first frames (software GL)
+constexpr double kRenderTimeout = 120.0;   // s: rviz start-up and first frames (software GL)
 // Share of the 3D view that must be in colour. With the default scene about
 // 10% is; the grid and background alone give 0.
 constexpr double kMinColouredShare = 0.005;

@@ -76,8 +76,7 @@ TEST(Smoke, MarkersEveryFewTicks) {
   // frame-locked and carries no stamp).
   ros::Publisher gaze = nh.advertise<sphere_tree_collision::GazePoint>("/collision_world/gaze", 10);
   ros::SteadyTimer gazer = nh.createSteadyTimer(ros::WallDuration(0.05), [&](const ros::SteadyTimerEvent&) {
-    sphere_tree_collision::GazePoint g;
-    g.header.stamp = ros::Time::now();
+    sphere_tree_collision::GazePoint g;  // stamp 0: "now" to the node, never stale however late it arrives
     g.x = 640;
     g.y = 360;
     gaze.publish(g);

@@ -39,7 +39,11 @@ class SpawnAndGaze : public testing::Test {
         markers_(nh_, "/collision_world/markers"),
         listener_(tf_, nh_, false) {
     EXPECT_TRUE(stc_test::spinUntil(
-        [&] { return spawn_.getNumSubscribers() > 0 && clear_.getNumSubscribers() > 0 && stats_.count() > 0; }, stc_test::kLivenessSeconds));
+        [&] {
+          return spawn_.getNumSubscribers() > 0 && despawn_.getNumSubscribers() > 0 &&
+                 clear_.getNumSubscribers() > 0 && gaze_.getNumSubscribers() > 0 && stats_.count() > 0;
+        },
+        stc_test::kLivenessSeconds));
     // Start empty. Topics are not ordered against each other, so a clear is
     // sent only when there is something to clear, and awaited.
     if (stats_.last.entities > 0) {
@@ -184,6 +188,9 @@ TEST_F(SpawnAndGaze, ContactsNearTheGazeReachDeeperLevels) {
     for (const auto& [pair, level] : deepest) {
       if (pair != target) EXPECT_GE(deepest.at(target), level) << "pair " << pair << " vs gazed pair " << target;
     }
+    // Until this gaze has expired, so that the next target's gaze is the one
+    // the node reports active (a late message of this one is stale by then).
+    ASSERT_TRUE(stc_test::spinUntil([&] { return !stats_.last.gaze_active; }, stc_test::kLivenessSeconds));
   }
 
   // Without gaze the scheduler says so, and no pair is favoured by position.
