@@ -41,6 +41,16 @@ class PublishClock : public testing::Test {
     for (const auto& c : clock_.all) out.insert(c.clock.toNSec());
     return out;
   }
+  // Whether `stamp` is a clock time the test had the chance to hear: the
+  // topics connect one by one, so a tick before /clock's link came up (or
+  // whose /clock is still on its way) is not judged.
+  static bool heard(const std::set<std::uint64_t>& clock, const ros::Time& stamp) {
+    return !clock.empty() && stamp.toNSec() >= *clock.begin() && stamp.toNSec() <= *clock.rbegin();
+  }
+  // 1 when `stamp` is one of the clock times heard (or could not have been heard).
+  static std::size_t onClock(const std::set<std::uint64_t>& clock, const ros::Time& stamp) {
+    return heard(clock, stamp) ? clock.count(stamp.toNSec()) : 1u;
+  }
   std::map<std::uint32_t, std::string> framesById() const {
     std::map<std::uint32_t, std::string> out;
     for (const auto& e : list_.last.entities) out[e.id] = e.frame;
@@ -77,8 +87,10 @@ TEST_F(PublishClock, EveryMessageOfATickCarriesItsClockTime) {
   ASSERT_FALSE(clock.empty());
 
   std::uint64_t previous = 0;
+  std::size_t judged = 0;
   for (const auto& s : stats_.all) {
-    EXPECT_EQ(clock.count(s.header.stamp.toNSec()), 1u) << "tick " << s.tick << " stamp " << s.header.stamp;
+    judged += heard(clock, s.header.stamp) ? 1 : 0;
+    EXPECT_EQ(onClock(clock, s.header.stamp), 1u) << "tick " << s.tick << " stamp " << s.header.stamp;
     EXPECT_NEAR(s.physics_time, s.tick * kDt, 1e-9 * s.tick);
     EXPECT_NEAR(s.header.stamp.toSec(), s.physics_time, 1e-9);
     EXPECT_GT(s.tick, previous);
@@ -89,10 +101,12 @@ TEST_F(PublishClock, EveryMessageOfATickCarriesItsClockTime) {
     }
   }
 
+  EXPECT_GE(judged, stats_.all.size() / 2) << "most ticks fall within the clock times heard";
+
   const auto frames = framesById();
   std::size_t named_contacts = 0;
   for (const auto& array : contacts_.all) {
-    EXPECT_EQ(clock.count(array.header.stamp.toNSec()), 1u) << array.header.stamp;
+    EXPECT_EQ(onClock(clock, array.header.stamp), 1u) << array.header.stamp;
     for (const auto& c : array.contacts) {
       EXPECT_EQ(c.name_a, frames.at(c.entity_a));
       EXPECT_EQ(c.name_b, frames.at(c.entity_b));
@@ -111,7 +125,7 @@ TEST_F(PublishClock, EntityStatesAgreeWithPhysicsTimeAndTf) {
     ASSERT_EQ(m.poses.size(), m.ids.size());
     ASSERT_EQ(m.twists.size(), m.ids.size());
     EXPECT_EQ(m.header.frame_id, "world");
-    EXPECT_EQ(clock.count(m.header.stamp.toNSec()), 1u) << m.header.stamp;
+    EXPECT_EQ(onClock(clock, m.header.stamp), 1u) << m.header.stamp;
     bool found = false;
     for (std::size_t i = 0; i < m.ids.size(); ++i) {
       EXPECT_EQ(m.names[i], frames.at(m.ids[i]));
