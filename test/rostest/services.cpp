@@ -137,7 +137,15 @@ TEST_F(Services, SpawnInAnotherFrameIsResolvedByTf) {
 
   Spawn s = cube("on_shelf", 0.5);  // (0.5, 0, 5) in shelf: (1, 2.5, 8) in the world
   s.request.header.frame_id = "shelf";
-  s = call("spawn", s);
+  // The node waits 1 s for tf to know the frame; its listener is new at the
+  // first such call, and a loaded machine may take longer to connect it. A
+  // refusal changes nothing, so the call is made again until tf knows.
+  Spawn answered = s;
+  ASSERT_TRUE(stc_test::spinUntil([&] {
+    answered = call("spawn", s);
+    return answered.response.success || answered.response.message.rfind("header.frame_id: ", 0) != 0;
+  }, stc_test::kLivenessSeconds)) << answered.response.message;
+  s = answered;
   ASSERT_TRUE(s.response.success) << s.response.message;
   EXPECT_EQ(s.response.frame_id, "on_shelf");
   // Paused, the entity stays where it was put; tf shows it there.
