@@ -174,13 +174,18 @@ TEST(Fracture, MomentumIsKeptThroughABreakAndPiecesDoNotOverlapAtBirth) {
   // soon after birth is deleted, but its marker (sent in its birth tick:
   // ~marker_rate is ~rate) stays here.
   std::map<int, visualization_msgs::Marker> voxel_markers;
+  std::size_t marker_arrays = 0;
   const ros::Subscriber marker_sub = nh.subscribe<visualization_msgs::MarkerArray>(
       kNode + "markers", 1000, [&](const visualization_msgs::MarkerArray::ConstPtr& a) {
+        ++marker_arrays;
         for (const auto& m : a->markers) {
           if (m.ns == "voxels" && m.action == visualization_msgs::Marker::ADD) voxel_markers[m.id] = m;
         }
       });
   ASSERT_TRUE(states.waitFor(1, stc_test::kLivenessSeconds));
+  // The markers' link is up before anything is spawned: a piece's voxels
+  // marker is sent once, in its birth tick.
+  ASSERT_TRUE(stc_test::spinUntil([&] { return marker_arrays > 0; }, stc_test::kLivenessSeconds));
 
   // 30 m from the slab and the first test's pieces; no gravity in this scene.
   const double y = 30.0;
