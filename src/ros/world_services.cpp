@@ -47,6 +47,15 @@ sphere_tree_collision::SpawnEntity WorldServices::inWorldFrame(const sphere_tree
   if (!tf_buffer_) {
     tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
+    tf_since_ = ros::WallTime::now();
+  }
+  // The call runs on the node's spinner, so a wait here holds the ticks. A
+  // frame tf has never heard of is refused at once (a client naming frames
+  // that never come would stop the world for a second a call), except while
+  // a new listener's buffer fills; a known frame may wait for the stamp.
+  const bool filling = (ros::WallTime::now() - tf_since_).toSec() < kTfWaitSeconds;
+  if (!filling && !tf_buffer_->_frameExists(frame)) {
+    throw stc::InputError("header.frame_id", "tf knows no frame \"" + frame + "\"");
   }
   geometry_msgs::TransformStamped t;
   try {

@@ -162,6 +162,14 @@ TEST_F(Services, SpawnInAnotherFrameIsResolvedByTf) {
   unknown = call("spawn", unknown);
   EXPECT_FALSE(unknown.response.success);
   EXPECT_EQ(unknown.response.message.rfind("header.frame_id: ", 0), 0u) << unknown.response.message;
+  // Once the node's listener has had its first second, a frame tf never
+  // heard of is refused by name, without waiting for it on the node's spinner.
+  Spawn refused = unknown;
+  ASSERT_TRUE(stc_test::spinUntil([&] {
+    refused = call("spawn", unknown);
+    return refused.response.message == "header.frame_id: tf knows no frame \"no_such_frame\"";
+  }, stc_test::kLivenessSeconds)) << refused.response.message;
+  EXPECT_FALSE(refused.response.success);
   EXPECT_TRUE(trigger("unpause").response.success);
 }
 

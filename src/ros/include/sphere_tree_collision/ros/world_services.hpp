@@ -42,6 +42,7 @@ class WorldServices {
   // Created at the first spawn in another frame: the node's own /tf is not read otherwise.
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ros::WallTime tf_since_;  // when the listener above started
   std::vector<ros::ServiceServer> servers_;
 };
 
