@@ -13,8 +13,8 @@
 //
 // Before each turn of the two runs, two threads pass one cache line back and
 // forth: the round trip between two cores. On this VM it is 100-200 ns in
-// some hours and 450-500 ns in others (the host places the two virtual CPUs
-// nearer or farther apart), and the speed-up follows it. The turns are split
+// some minutes and 450-550 ns in others (the host seems to place the two
+// virtual CPUs nearer or farther apart), and the speed-up follows it. The turns are split
 // by it, and the speed-up given for each class.
 //
 // Usage: bench_parallel_speedup [--scenes corner_drift:500,rockfall:1000,packed_box:500,cube_box:10000]

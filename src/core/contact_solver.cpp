@@ -29,6 +29,8 @@ constexpr int kUnreached = std::numeric_limits<int>::max();
 constexpr std::size_t kRowsPerTask = 256;       // rows prepared by one task, at least
 constexpr std::size_t kManifoldsPerTask = 128;  // manifolds' rolling resistance or cache, at least
 constexpr std::size_t kBodiesPerTask = 256;     // bodies stored by one task, at least
+// A pair's points kept for the warm start: one bit each in warmStart's `used`.
+constexpr std::uint32_t kCachedPointsPerPair = 32;
 
 std::uint64_t pairKey(EntityId a, EntityId b) { return (std::uint64_t{a} << 32) | std::uint64_t{b}; }
 
@@ -398,7 +400,7 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
       }
       const CachedPoint* old = cache_.data() + found->first;
       const std::uint32_t old_count = found->count;
-      std::uint32_t used = 0;  // bit j: old point j taken (at most 16 points a pair)
+      std::uint32_t used = 0;  // bit j: old point j taken (at most kCachedPointsPerPair)
       const BodyState& ba = bodies[rows_[first].a];
       const Quat to_a = ba.pose.orientation.conjugate();
       for (std::uint32_t r = first; r < last; ++r) {
@@ -709,7 +711,7 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
 
   // Report impulses on the contacts and keep each pair's manifold for next
   // tick's warm start. A manifold's points go where its rows are (at most
-  // 32 of them, warmStart's bit set), so manifolds fill in parallel.
+  // kCachedPointsPerPair of them), so manifolds fill in parallel.
   const std::size_t manifolds = manifold_start_.size() - 1;
   next_cache_.resize(rows_.size());
   next_manifolds_.resize(manifolds);
@@ -717,7 +719,7 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
     for (std::size_t m = begin; m < end; ++m) {
       CachedManifold manifold;
       manifold.first = manifold_start_[m];
-      const std::uint32_t stop = std::min(manifold_start_[m + 1], manifold_start_[m] + 32);
+      const std::uint32_t stop = std::min(manifold_start_[m + 1], manifold_start_[m] + kCachedPointsPerPair);
       for (std::uint32_t r = manifold_start_[m]; r < manifold_start_[m + 1]; ++r) {
         const Row& row = rows_[r];
         Contact& c = contacts[info_[r].contact];
