@@ -196,10 +196,10 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
   for (int k = 0; k < 6; ++k) {
     // Axis k of A (k < 3) or of B, pointing from a to b, in both frames.
     const bool of_a = k < 3;
-    const int axis = of_a ? k : k - 3;
-    const double along = of_a ? delta_a[axis] : delta_b[axis];
+    const int box_axis = of_a ? k : k - 3;
+    const double along = of_a ? delta_a[box_axis] : delta_b[box_axis];
     double sign = along < 0.0 ? -1.0 : 1.0;
-    const auto normalOf = [&] { return Vec3(sign * (of_a ? Vec3(rot_a_.col(axis)) : Vec3(rot_b_.col(axis)))); };
+    const auto normalOf = [&] { return Vec3(sign * (of_a ? Vec3(rot_a_.col(box_axis)) : Vec3(rot_b_.col(box_axis)))); };
     if (any_cover && intoCover(mask_a, mask_b, normalOf())) {
       // b's node lies beyond the covered side (deeper than a one-sided
       // wall's middle): the open side of the axis is the way out, however deep.
@@ -207,10 +207,10 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
       if (intoCover(mask_a, mask_b, normalOf())) continue;
     }
     // The node whose own axis this is reads its support straight off its box.
-    const double g = of_a ? sign * along - axisSupportA(c.node_a, axis, sign) -
-                                localSupportB(c.node_b, -sign * Vec3(b_in_a_.row(axis).transpose()))
-                          : sign * along - localSupportA(c.node_a, sign * Vec3(b_in_a_.col(axis))) -
-                                axisSupportB(c.node_b, axis, -sign);
+    const double g = of_a ? sign * along - axisSupportA(c.node_a, box_axis, sign) -
+                                localSupportB(c.node_b, -sign * Vec3(b_in_a_.row(box_axis).transpose()))
+                          : sign * along - localSupportA(c.node_a, sign * Vec3(b_in_a_.col(box_axis))) -
+                                axisSupportB(c.node_b, box_axis, -sign);
     // Under cover the line of centres was bent: any open face axis is the better normal.
     if (g > c.separation + better_by || (covered && !face)) {
       c.separation = g;
@@ -248,18 +248,20 @@ void refineDeepCandidates(std::vector<ContactCandidate>& candidates, double deep
 
 namespace {
 
-// Candidate `rep` becomes representative number `cluster`: every candidate
-// nearer to it than to the representatives before it joins its cluster (a
-// tie stays with the earlier one).
+// A candidate nearer to a representative `at` (number `cluster`) than to
+// those before it joins its cluster (a tie stays with the earlier one).
+inline void joinIfNearer(ContactCandidate& c, const Vec3& at, int cluster) {
+  const double d = (c.point - at).squaredNorm();
+  if (d < c.nearest) {
+    c.nearest = d;
+    c.cluster = cluster;
+  }
+}
+
+// Candidate `rep` becomes representative number `cluster`.
 void joinRepresentative(std::vector<ContactCandidate>& candidates, int rep, int cluster) {
   const Vec3 at = candidates[static_cast<std::size_t>(rep)].point;
-  for (ContactCandidate& c : candidates) {
-    const double d = (c.point - at).squaredNorm();
-    if (d < c.nearest) {
-      c.nearest = d;
-      c.cluster = cluster;
-    }
-  }
+  for (ContactCandidate& c : candidates) joinIfNearer(c, at, cluster);
 }
 
 }  // namespace
@@ -296,11 +298,13 @@ void pickRepresentatives(std::vector<ContactCandidate>& candidates, double deepe
     }
     if (best < 0) return;  // `deepest` is not of these candidates
     reps.push_back(best);
-    joinRepresentative(candidates, best, 0);
   }
   // Then: farthest from the first; largest triangle; then farthest from all
-  // chosen. `nearest` is each candidate's squared distance to the chosen ones.
+  // chosen. `nearest` is each candidate's squared distance to the chosen ones:
+  // the newest one is joined in the pass that scores the next (a pass less each).
   while (static_cast<int>(reps.size()) < limit) {
+    const Vec3 newest = candidates[static_cast<std::size_t>(reps.back())].point;
+    const int newest_cluster = static_cast<int>(reps.size()) - 1;
     int best = -1;
     double best_score = distinct * distinct;
     const Vec3 p0 = candidates[reps[0]].point;
@@ -310,7 +314,8 @@ void pickRepresentatives(std::vector<ContactCandidate>& candidates, double deepe
       axis.normalize();
     }
     for (std::size_t i = 0; i < candidates.size(); ++i) {
-      const ContactCandidate& c = candidates[i];
+      ContactCandidate& c = candidates[i];
+      joinIfNearer(c, newest, newest_cluster);
       if (!c.refined || c.nearest <= distinct * distinct) continue;
       const double score = reps.size() == 2 ? (c.point - p0).cross(axis).squaredNorm() : c.nearest;
       if (score > best_score) {
@@ -318,10 +323,10 @@ void pickRepresentatives(std::vector<ContactCandidate>& candidates, double deepe
         best = static_cast<int>(i);
       }
     }
-    if (best < 0) break;
+    if (best < 0) return;  // every candidate joined the chosen ones
     reps.push_back(best);
-    joinRepresentative(candidates, best, static_cast<int>(reps.size()) - 1);
   }
+  joinRepresentative(candidates, reps.back(), static_cast<int>(reps.size()) - 1);
 }
 
 void assignClusters(std::vector<ContactCandidate>& candidates, const std::vector<int>& reps) {

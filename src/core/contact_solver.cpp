@@ -28,7 +28,6 @@ namespace {
 constexpr int kUnreached = std::numeric_limits<int>::max();
 constexpr std::size_t kRowsPerTask = 256;       // rows prepared by one task, at least
 constexpr std::size_t kManifoldsPerTask = 128;  // manifolds' rolling resistance or cache, at least
-constexpr std::size_t kBodiesPerTask = 256;     // bodies stored by one task, at least
 // A pair's points kept for the warm start: one bit each in warmStart's `used`.
 constexpr std::uint32_t kCachedPointsPerPair = 32;
 

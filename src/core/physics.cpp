@@ -11,8 +11,6 @@ namespace {
 
 // Approach slower than this many ticks of free fall is resting, not a bounce.
 constexpr double kRestingFallTicks = 4.0;
-// Bodies a task of the parallel integrate takes at least (a body is ~0.1 us).
-constexpr std::size_t kBodiesPerTask = 256;
 // Below this many pairs the contacts are built on the calling thread.
 constexpr std::size_t kPairsPerTask = 64;
 constexpr std::size_t kChunksPerThread = 4;  // contact building

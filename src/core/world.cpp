@@ -26,9 +26,6 @@ constexpr double kReserveMargin = 1.1;
 // resolution 8: rod, plate and the flat L and ring pass; cube, sphere, rock do not.
 constexpr double kElongationRatio = 2.5;
 
-// Bodies a task of the parallel box update takes at least.
-constexpr std::size_t kBoxesPerTask = 256;
-
 // Max distance from `origin` to a corner of an occupied voxel: the radius of
 // a ball about the centre of mass that holds the shape in any orientation.
 double boundingRadius(const VoxelShape& shape, const Vec3& origin) {
@@ -409,7 +406,7 @@ Aabb World::sweptBoxOf(std::size_t index) const {
 void World::broadPhase(TickReport& report) {
   // The boxes in parallel (each body alone), then handed over in order.
   boxes_.resize(ids_.size());
-  workers_.forEach(ids_.size(), kBoxesPerTask, [&](std::size_t begin, std::size_t end) {
+  workers_.forEach(ids_.size(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       if (!bodies_[i].is_static) boxes_[i] = physics_.isFast(i) ? sweptBoxOf(i) : boxOf(i);
     }
