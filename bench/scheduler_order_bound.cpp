@@ -14,6 +14,10 @@
 //   priority_queues the library's scheduler with its defaults
 //   oracle         pairs resolved whole by v / C, highest first: knows each
 //                  pair's outcome and cost in advance, so no scheduler can match it
+//   last tick      pairs resolved whole by v / C of the tick before (the same
+//                  entity pair's, measured as the oracle's; new pairs last):
+//                  what a scheduler that remembered each pair's outcome could
+//                  reach at best, if the tick before had been resolved whole
 // Printed: true P left, summed over the snapshots, over round-robin's.
 //
 // Usage: bench_scheduler_order_bound [--scene packed_box|rockfall] [--snapshots N]
@@ -28,6 +32,7 @@
 #include <array>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <memory>
 #include <random>
 #include <string>
@@ -126,6 +131,26 @@ double oracleLeft(const std::vector<PairFacts>& facts, std::int64_t budget) {
   return left;
 }
 
+// True P left by resolving pairs whole in order of last tick's v / C
+// (`last_value`, `last_cost`, parallel to `facts`; 0 value: unknown) under `budget` tests.
+double lastTickLeft(const std::vector<PairFacts>& facts, const std::vector<double>& last_value,
+                    const std::vector<double>& last_cost, std::int64_t budget, const Perception& perception) {
+  const std::size_t n = facts.size();
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+    return last_value[x] * last_cost[y] > last_value[y] * last_cost[x];
+  });
+  std::vector<PairTest> tests(n);
+  for (std::size_t i = 0; i < n; ++i) tests[i].reset(facts[i].a, facts[i].b);
+  std::int64_t spent = 0;
+  for (std::size_t k = 0; k < n && spent < budget; ++k) {
+    PairTest& test = tests[order[k]];
+    while (!test.resolved() && spent < budget) spent += test.step();
+  }
+  return trueP(tests, facts, perception);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -166,22 +191,19 @@ int main(int argc, char** argv) {
   const Priority by_gap = [](const PairTest& t, const PairFacts& f) {
     return f.weight * f.px_per_metre * (t.stepsDone() > 0 ? t.frontierGap() : 0.5) / t.nextStepTests();
   };
-  std::vector<std::vector<double>> left(5, std::vector<double>(shares.size(), 0.0));
+  constexpr int kOrders = 6;
+  std::vector<std::vector<double>> left(kOrders, std::vector<double>(shares.size(), 0.0));
   std::mt19937 pick(11);  // the gaze targets of bench_error_vs_runtime
   double t = 0.0;
   const int warmup = kind == SceneKind::Rockfall ? 75 : 30;
   for (int i = 0; i < warmup; ++i, t += spec.dt) sim.step(spec.dt, Budget::unlimited());
-  for (int s = 0; s < snapshots; ++s) {
-    for (int i = 0; i < 6; ++i, t += spec.dt) sim.step(spec.dt, Budget::unlimited());
-    GazeParams follow;
-    follow.mode = GazeMode::Follow;
-    follow.target = spec.movers[pick() % spec.movers.size()];
-    GazeModel gaze(follow);
+  // The simulation's poses under a fresh `gaze` at time t: each pair's facts, and the full run's report.
+  const auto measure = [&](GazeModel gaze, std::vector<PairFacts>& facts) {
     for (std::size_t i = 0; i < sim.entityCount(); ++i) eval.bodies()[i].pose = sim.bodies()[i].pose;
     eval.perception().setFixation(gaze.fixationAt(t, sim));
     const TickReport full = eval.step(0.0, Budget::unlimited());
     const Perception& perception = eval.perception();
-    std::vector<PairFacts> facts(eval.pairCount());
+    facts.assign(eval.pairCount(), PairFacts{});
     for (std::size_t i = 0; i < facts.size(); ++i) {
       const PairTest& test = eval.pairTests()[i];
       PairFacts& f = facts[i];
@@ -201,6 +223,30 @@ int main(int argc, char** argv) {
         f.value = perceivedInaccuracy(perception.measure(test).eccentricity_px, f.gap * perception.focalPx() / *depth);
       }
     }
+    return full;
+  };
+  std::vector<PairFacts> facts, before;
+  std::map<std::pair<EntityId, EntityId>, const PairFacts*> last_tick;
+  for (int s = 0; s < snapshots; ++s) {
+    for (int i = 0; i < 5; ++i, t += spec.dt) sim.step(spec.dt, Budget::unlimited());
+    GazeParams follow;
+    follow.mode = GazeMode::Follow;
+    follow.target = spec.movers[pick() % spec.movers.size()];
+    const GazeModel gaze(follow);  // copied fresh into each measure, as one per snapshot before
+    measure(gaze, before);  // the tick before the snapshot
+    last_tick.clear();
+    for (const PairFacts& f : before) last_tick[{f.a.id, f.b.id}] = &f;
+    sim.step(spec.dt, Budget::unlimited());
+    t += spec.dt;
+    const TickReport full = measure(gaze, facts);
+    const Perception& perception = eval.perception();
+    std::vector<double> last_value(facts.size(), 0.0), last_cost(facts.size(), 1.0);
+    for (std::size_t i = 0; i < facts.size(); ++i) {
+      const auto found = last_tick.find({facts[i].a.id, facts[i].b.id});
+      if (found == last_tick.end()) continue;
+      last_value[i] = found->second->value;
+      last_cost[i] = std::max(found->second->cost, 1.0);
+    }
     for (std::size_t b = 0; b < shares.size(); ++b) {
       const auto budget = std::llround(shares[b] * static_cast<double>(full.sphere_tests));
       left[0][b] += pLeft(facts, nullptr, budget, perception);
@@ -208,6 +254,7 @@ int main(int argc, char** argv) {
       left[2][b] += pLeft(facts, by_gap, budget, perception);
       left[3][b] += queuesLeft(facts, eval.bodies().size(), perception, budget);
       left[4][b] += oracleLeft(facts, budget);
+      left[5][b] += lastTickLeft(facts, last_value, last_cost, budget, perception);
     }
     std::fprintf(stderr, "  snapshot %d/%d\n", s + 1, snapshots);
   }
@@ -217,8 +264,8 @@ int main(int argc, char** argv) {
   std::printf("\n|---|");
   for (std::size_t b = 0; b < shares.size(); ++b) std::printf("---|");
   const char* names[] = {"round_robin", "greedy, g = reach", "greedy, g = paper's estimate",
-                         "priority_queues (defaults)", "oracle"};
-  for (int o = 0; o < 5; ++o) {
+                         "priority_queues (defaults)", "oracle", "last tick's v / C, known exactly"};
+  for (int o = 0; o < kOrders; ++o) {
     std::printf("\n| %s |", names[o]);
     for (std::size_t b = 0; b < shares.size(); ++b) std::printf(" %.2f |", left[o][b] / left[0][b]);
   }
