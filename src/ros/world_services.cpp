@@ -3,13 +3,21 @@
 #include "sphere_tree_collision/ros/conversions.hpp"
 #include "sphere_tree_collision/ros/world_node.hpp"
 
+#include <boost/make_shared.hpp>
+
+#include <chrono>
 #include <exception>
+#include <future>
+#include <stdexcept>
 
 namespace stc_ros {
 namespace {
 
-// How long a spawn in another frame waits for tf to know that frame.
-constexpr double kTfWaitSeconds = 1.0;
+// A new tf listener's first second: frames it has not heard of yet may still come.
+constexpr double kTfFillSeconds = 1.0;
+// How long a spawn in another frame waits for tf to reach the request's stamp
+// (on ~spawn's own thread: the world ticks on meanwhile).
+constexpr double kTfStampWaitSeconds = 5.0;
 constexpr std::uint32_t kMaxStepTicks = 100000;
 
 // Runs `action`; a failure becomes success = false and "<field>: <reason>".
@@ -29,16 +37,53 @@ void answer(Response& res, const char* service, F&& action) {
   if (!res.success) ROS_WARN("~%s refused: %s", service, res.message.c_str());
 }
 
+// One piece of work queued on the node's spinner; `done` is kept or broken by it.
+class TickThreadCall final : public ros::CallbackInterface {
+ public:
+  explicit TickThreadCall(std::function<void()> work) : work_(std::move(work)) {}
+  CallResult call() override {
+    try {
+      work_();
+      done_.set_value();
+    } catch (...) {
+      done_.set_exception(std::current_exception());
+    }
+    return Success;
+  }
+  std::future<void> done() { return done_.get_future(); }
+
+ private:
+  std::function<void()> work_;
+  std::promise<void> done_;
+};
+
 }  // namespace
 
-WorldServices::WorldServices(ros::NodeHandle& pnh, WorldNode& node) : node_(node) {
-  servers_.push_back(pnh.advertiseService("spawn", &WorldServices::spawn, this));
+WorldServices::WorldServices(ros::NodeHandle& pnh, WorldNode& node) : node_(node), spawn_spinner_(1, &spawn_queue_) {
+  ros::AdvertiseServiceOptions spawn_options;
+  spawn_options.init<sphere_tree_collision::Spawn::Request, sphere_tree_collision::Spawn::Response>(
+      "spawn", [this](sphere_tree_collision::Spawn::Request& req, sphere_tree_collision::Spawn::Response& res) {
+        return spawn(req, res);
+      });
+  spawn_options.callback_queue = &spawn_queue_;
+  servers_.push_back(pnh.advertiseService(spawn_options));
   servers_.push_back(pnh.advertiseService("despawn", &WorldServices::despawn, this));
   servers_.push_back(pnh.advertiseService("clear", &WorldServices::clear, this));
   servers_.push_back(pnh.advertiseService("pause", &WorldServices::pause, this));
   servers_.push_back(pnh.advertiseService("unpause", &WorldServices::unpause, this));
   servers_.push_back(pnh.advertiseService("reset", &WorldServices::reset, this));
   servers_.push_back(pnh.advertiseService("step", &WorldServices::step, this));
+  spawn_spinner_.start();
+}
+
+void WorldServices::onTickThread(std::function<void()> work) {
+  const auto call = boost::make_shared<TickThreadCall>(std::move(work));
+  std::future<void> done = call->done();
+  ros::getGlobalCallbackQueue()->addCallback(call);
+  while (done.wait_for(std::chrono::milliseconds(100)) != std::future_status::ready) {
+    if (!ros::ok()) throw std::runtime_error("the node is shutting down");
+  }
+  done.get();
 }
 
 sphere_tree_collision::SpawnEntity WorldServices::inWorldFrame(const sphere_tree_collision::Spawn::Request& req) {
@@ -49,17 +94,16 @@ sphere_tree_collision::SpawnEntity WorldServices::inWorldFrame(const sphere_tree
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
     tf_since_ = ros::WallTime::now();
   }
-  // The call runs on the node's spinner, so a wait here holds the ticks. A
-  // frame tf has never heard of is refused at once (a client naming frames
-  // that never come would stop the world for a second a call), except while
-  // a new listener's buffer fills; a known frame may wait for the stamp.
-  const bool filling = (ros::WallTime::now() - tf_since_).toSec() < kTfWaitSeconds;
+  // On ~spawn's own thread: a wait here holds this client's answer, not the
+  // ticks. A frame tf has never heard of is refused at once, except while a
+  // new listener's buffer fills; a known frame may wait for the stamp.
+  const bool filling = (ros::WallTime::now() - tf_since_).toSec() < kTfFillSeconds;
   if (!filling && !tf_buffer_->_frameExists(frame)) {
     throw stc::InputError("header.frame_id", "tf knows no frame \"" + frame + "\"");
   }
   geometry_msgs::TransformStamped t;
   try {
-    t = tf_buffer_->lookupTransform(node_.worldFrame(), frame, req.header.stamp, ros::Duration(kTfWaitSeconds));
+    t = tf_buffer_->lookupTransform(node_.worldFrame(), frame, req.header.stamp, ros::Duration(kTfStampWaitSeconds));
   } catch (const tf2::TransformException& e) {
     throw stc::InputError("header.frame_id", e.what());
   }
@@ -78,15 +122,26 @@ sphere_tree_collision::SpawnEntity WorldServices::inWorldFrame(const sphere_tree
 bool WorldServices::spawn(sphere_tree_collision::Spawn::Request& req, sphere_tree_collision::Spawn::Response& res) {
   res.id = 0;
   answer(res, "spawn", [&] {
+    // Resolved here (tf may wait); the world changed on its own thread. The
+    // work holds copies and a shared answer: nothing of this thread's stack.
     const sphere_tree_collision::SpawnEntity entity = inWorldFrame(req);
-    try {
-      res.id = node_.spawnEntity(entity);
-    } catch (const stc::InputError& e) {  // named as fields of the request's `entity`
-      throw stc::InputError(e.field() == "max_entities" ? e.field() : "entity." + e.field(), reasonOf(e));
-    }
-    res.frame_id = node_.frameOf(res.id);
+    struct Made {
+      stc::EntityId id = 0;
+      std::string frame_id;
+    };
+    const auto made = std::make_shared<Made>();
+    onTickThread([this, entity, made] {
+      try {
+        made->id = node_.spawnEntity(entity);
+      } catch (const stc::InputError& e) {  // named as fields of the request's `entity`
+        throw stc::InputError(e.field() == "max_entities" ? e.field() : "entity." + e.field(), reasonOf(e));
+      }
+      made->frame_id = node_.frameOf(made->id);
+      node_.publishEntityList();
+    });
+    res.id = made->id;
+    res.frame_id = made->frame_id;
   });
-  if (res.success) node_.publishEntityList();
   return true;  // false would hide the message from the caller
 }
 

@@ -12,13 +12,16 @@
 #include <sphere_tree_collision/TickStats.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <set>
 #include <string>
+#include <thread>
 
 namespace {
 
@@ -173,6 +176,65 @@ TEST_F(Services, SpawnInAnotherFrameIsResolvedByTf) {
   EXPECT_TRUE(trigger("unpause").response.success);
 }
 
+// ~spawn waits for tf on a thread of its own: while a spawn waits for its
+// stamp, the world ticks on. The test gives tf that stamp only after it has
+// seen three ticks stamped after the call began; had the wait held the
+// ticks, the call would have run out of time first, and failed.
+TEST_F(Services, SpawnWaitingForTfLeavesTheTicksRunning) {
+  EXPECT_TRUE(trigger("unpause").response.success);
+  tf2_ros::TransformBroadcaster broadcaster;
+  const auto crane = [&](const ros::Time& stamp) {  // 2 m above the world origin
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = stamp;
+    t.header.frame_id = "world";
+    t.child_frame_id = "crane";
+    t.transform.translation.z = 2.0;
+    t.transform.rotation.w = 1.0;
+    broadcaster.sendTransform(t);
+  };
+  // First the node's tf learns the frame (stamp 0: its latest), the frame
+  // sent again before each try while the node's listener connects.
+  Spawn first = cube("hook_1", 6.0);
+  first.request.header.frame_id = "crane";
+  ros::Time last_sent;
+  ASSERT_TRUE(stc_test::spinUntil([&] {
+    last_sent = ros::Time::now();
+    crane(last_sent);
+    stc_test::spinFor(0.05);
+    first = call("spawn", first);
+    return first.response.success;
+  }, stc_test::kLivenessSeconds)) << first.response.message;
+
+  // Then a spawn stamped after anything tf has of the frame: the node waits.
+  Spawn waiting = cube("hook_2", 7.0);
+  waiting.request.header.frame_id = "crane";
+  waiting.request.header.stamp = last_sent + ros::Duration(0.5);
+  const ros::Time asked = ros::Time::now();
+  std::atomic<bool> answered{false};
+  std::thread caller([&] {
+    waiting = call("spawn", waiting);
+    answered = true;
+  });
+  // Three ticks stamped after the call began: one may come before the node
+  // takes the call up, not three in a row (the node serves calls between ticks).
+  std::uint64_t first_after = 0;
+  const bool ticked = stc_test::spinUntil([&] {
+    if (first_after == 0 && stats_.last.header.stamp > asked) first_after = stats_.last.tick;
+    return first_after != 0 && stats_.last.tick >= first_after + 2;
+  }, stc_test::kLivenessSeconds);
+  const bool ticked_while_waiting = ticked && !answered;
+  crane(waiting.request.header.stamp);
+  crane(waiting.request.header.stamp + ros::Duration(1.0));
+  caller.join();
+  EXPECT_TRUE(ticked_while_waiting) << "no tick between the call and its answer";
+  ASSERT_TRUE(waiting.response.success) << waiting.response.message;
+  EXPECT_EQ(waiting.response.frame_id, "hook_2");
+  ASSERT_TRUE(stc_test::spinUntil([&] { return tf_.canTransform("world", "hook_2", ros::Time(0)); }, stc_test::kLivenessSeconds));
+  const auto t = tf_.lookupTransform("world", "hook_2", ros::Time(0));
+  EXPECT_NEAR(t.transform.translation.x, 7.0, 1e-9);  // no gravity here, no twist: it stays put
+  EXPECT_NEAR(t.transform.translation.z, 7.0, 1e-9);  // 5 m up in the crane frame, 2 m up itself
+}
+
 TEST_F(Services, SpawnFailuresNameTheFieldAndChangeNothing) {
   const std::uint32_t before = statsAfterOneStep().entities;
   const auto expectRefused = [&](Spawn s, const std::string& field) {
@@ -279,17 +341,11 @@ TEST_F(Services, ClearThenResetBringsBackTheStartScene) {
   EXPECT_TRUE(waitForList([](const EntityList& l) { return l.entities.size() == 2; }));
   EXPECT_EQ(frames(list_.last), (std::set<std::string>{"floor", "drifter"}));
   // The drifter is back at its start: (0, 0, 2) after one step of 1/30 s at 0.5 m/s.
-  EXPECT_EQ(statsAfterOneStep().entities, 2u);
-  ASSERT_TRUE(stc_test::spinUntil([&] {
-    geometry_msgs::TransformStamped t;
-    try {
-      t = tf_.lookupTransform("world", "drifter", ros::Time(0));
-    } catch (const tf2::TransformException&) {
-      return false;
-    }
-    return t.header.stamp == stats_.last.header.stamp;
-  }, stc_test::kLivenessSeconds));
-  const auto t = tf_.lookupTransform("world", "drifter", ros::Time(0));
+  const ros::Time stepped = statsAfterOneStep().header.stamp;
+  EXPECT_EQ(stats_.last.entities, 2u);
+  // tf at that tick's stamp (a later message for the frame cannot hide it).
+  ASSERT_TRUE(stc_test::spinUntil([&] { return tf_.canTransform("world", "drifter", stepped); }, stc_test::kLivenessSeconds));
+  const auto t = tf_.lookupTransform("world", "drifter", stepped);
   EXPECT_NEAR(t.transform.translation.x, 0.5 / 30.0, 1e-9);
   EXPECT_NEAR(t.transform.translation.z, 2.0, 1e-9);
   EXPECT_TRUE(trigger("unpause").response.success);
