@@ -110,6 +110,7 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
            params_.tick_budget_ms > 0 ? std::to_string(params_.tick_budget_ms).c_str() : "none");
   diagnostics_ = std::make_unique<NodeDiagnostics>(nh_, pnh_, params_);
   tuning_ = std::make_unique<LiveTuning>(pnh_, params_, [this](const NodeParams& next) { retune(next); });
+  services_->start();  // last: nothing after it can throw
 }
 
 void WorldNode::retune(const NodeParams& next) {

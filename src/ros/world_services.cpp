@@ -59,7 +59,8 @@ class TickThreadCall final : public ros::CallbackInterface {
 
 }  // namespace
 
-WorldServices::WorldServices(ros::NodeHandle& pnh, WorldNode& node) : node_(node), spawn_spinner_(1, &spawn_queue_) {
+WorldServices::WorldServices(ros::NodeHandle& pnh, WorldNode& node)
+    : node_(node), world_frame_(node.worldFrame()), spawn_spinner_(1, &spawn_queue_) {
   ros::AdvertiseServiceOptions spawn_options;
   spawn_options.init<sphere_tree_collision::Spawn::Request, sphere_tree_collision::Spawn::Response>(
       "spawn", [this](sphere_tree_collision::Spawn::Request& req, sphere_tree_collision::Spawn::Response& res) {
@@ -73,22 +74,24 @@ WorldServices::WorldServices(ros::NodeHandle& pnh, WorldNode& node) : node_(node
   servers_.push_back(pnh.advertiseService("unpause", &WorldServices::unpause, this));
   servers_.push_back(pnh.advertiseService("reset", &WorldServices::reset, this));
   servers_.push_back(pnh.advertiseService("step", &WorldServices::step, this));
-  spawn_spinner_.start();
 }
 
-void WorldServices::onTickThread(std::function<void()> work) {
+// A call waiting for the node's spinner gives up, so the spinner's thread can be joined.
+WorldServices::~WorldServices() { stopping_ = true; }
+
+void WorldServices::onTickThread(std::function<void()> work) const {
   const auto call = boost::make_shared<TickThreadCall>(std::move(work));
   std::future<void> done = call->done();
   ros::getGlobalCallbackQueue()->addCallback(call);
   while (done.wait_for(std::chrono::milliseconds(100)) != std::future_status::ready) {
-    if (!ros::ok()) throw std::runtime_error("the node is shutting down");
+    if (stopping_ || !ros::ok() || ros::isShuttingDown()) throw std::runtime_error("the node is shutting down");
   }
   done.get();
 }
 
 sphere_tree_collision::SpawnEntity WorldServices::inWorldFrame(const sphere_tree_collision::Spawn::Request& req) {
   const std::string& frame = req.header.frame_id;
-  if (frame.empty() || frame == node_.worldFrame()) return req.entity;
+  if (frame.empty() || frame == world_frame_) return req.entity;
   if (!tf_buffer_) {
     tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
@@ -103,7 +106,7 @@ sphere_tree_collision::SpawnEntity WorldServices::inWorldFrame(const sphere_tree
   }
   geometry_msgs::TransformStamped t;
   try {
-    t = tf_buffer_->lookupTransform(node_.worldFrame(), frame, req.header.stamp, ros::Duration(kTfStampWaitSeconds));
+    t = tf_buffer_->lookupTransform(world_frame_, frame, req.header.stamp, ros::Duration(kTfStampWaitSeconds));
   } catch (const tf2::TransformException& e) {
     throw stc::InputError("header.frame_id", e.what());
   }

@@ -12,7 +12,6 @@
 #include <sphere_tree_collision/TickStats.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
@@ -177,62 +176,45 @@ TEST_F(Services, SpawnInAnotherFrameIsResolvedByTf) {
 }
 
 // ~spawn waits for tf on a thread of its own: while a spawn waits for its
-// stamp, the world ticks on. The test gives tf that stamp only after it has
-// seen three ticks stamped after the call began; had the wait held the
-// ticks, the call would have run out of time first, and failed.
+// stamp, the world ticks on. A spawn on the drifter (a frame the node itself
+// sends on /tf, one transform a tick) stamped 2 s ahead can only be answered
+// by a node that goes on ticking while the call waits: one whose ticks
+// stood still would never send the drifter at that stamp.
 TEST_F(Services, SpawnWaitingForTfLeavesTheTicksRunning) {
   EXPECT_TRUE(trigger("unpause").response.success);
-  tf2_ros::TransformBroadcaster broadcaster;
-  const auto crane = [&](const ros::Time& stamp) {  // 2 m above the world origin
-    geometry_msgs::TransformStamped t;
-    t.header.stamp = stamp;
-    t.header.frame_id = "world";
-    t.child_frame_id = "crane";
-    t.transform.translation.z = 2.0;
-    t.transform.rotation.w = 1.0;
-    broadcaster.sendTransform(t);
-  };
-  // First the node's tf learns the frame (stamp 0: its latest), the frame
-  // sent again before each try while the node's listener connects.
-  Spawn first = cube("hook_1", 6.0);
-  first.request.header.frame_id = "crane";
-  ros::Time last_sent;
+  // First the node's tf learns the frame (stamp 0: its latest; asked again
+  // while a new listener of the node's connects).
+  Spawn first = cube("rider_1", 0.0);
+  first.request.header.frame_id = "drifter";
   ASSERT_TRUE(stc_test::spinUntil([&] {
-    last_sent = ros::Time::now();
-    crane(last_sent);
-    stc_test::spinFor(0.05);
     first = call("spawn", first);
     return first.response.success;
   }, stc_test::kLivenessSeconds)) << first.response.message;
 
-  // Then a spawn stamped after anything tf has of the frame: the node waits.
-  Spawn waiting = cube("hook_2", 7.0);
-  waiting.request.header.frame_id = "crane";
-  waiting.request.header.stamp = last_sent + ros::Duration(0.5);
-  const ros::Time asked = ros::Time::now();
-  std::atomic<bool> answered{false};
-  std::thread caller([&] {
-    waiting = call("spawn", waiting);
-    answered = true;
+  Spawn ahead = cube("rider_2", 0.0);  // 5 m above the drifter
+  ahead.request.header.frame_id = "drifter";
+  const ros::Time stamp = ros::Time::now() + ros::Duration(2.0);
+  ahead.request.header.stamp = stamp;
+  Spawn answered;
+  std::atomic<bool> done{false};
+  std::thread caller([&, ahead] {
+    answered = call("spawn", ahead);
+    done = true;
   });
-  // Three ticks stamped after the call began: one may come before the node
-  // takes the call up, not three in a row (the node serves calls between ticks).
-  std::uint64_t first_after = 0;
-  const bool ticked = stc_test::spinUntil([&] {
-    if (first_after == 0 && stats_.last.header.stamp > asked) first_after = stats_.last.tick;
-    return first_after != 0 && stats_.last.tick >= first_after + 2;
-  }, stc_test::kLivenessSeconds);
-  const bool ticked_while_waiting = ticked && !answered;
-  crane(waiting.request.header.stamp);
-  crane(waiting.request.header.stamp + ros::Duration(1.0));
+  const bool returned = stc_test::spinUntil([&] { return done.load(); }, stc_test::kLivenessSeconds);
   caller.join();
-  EXPECT_TRUE(ticked_while_waiting) << "no tick between the call and its answer";
-  ASSERT_TRUE(waiting.response.success) << waiting.response.message;
-  EXPECT_EQ(waiting.response.frame_id, "hook_2");
-  ASSERT_TRUE(stc_test::spinUntil([&] { return tf_.canTransform("world", "hook_2", ros::Time(0)); }, stc_test::kLivenessSeconds));
-  const auto t = tf_.lookupTransform("world", "hook_2", ros::Time(0));
-  EXPECT_NEAR(t.transform.translation.x, 7.0, 1e-9);  // no gravity here, no twist: it stays put
-  EXPECT_NEAR(t.transform.translation.z, 7.0, 1e-9);  // 5 m up in the crane frame, 2 m up itself
+  ASSERT_TRUE(returned);
+  ASSERT_TRUE(answered.response.success) << answered.response.message;
+  EXPECT_EQ(answered.response.frame_id, "rider_2");
+  // Where the drifter was at the stamp, 5 m up: the rider does not move (no gravity, no twist).
+  ASSERT_TRUE(stc_test::spinUntil([&] {
+    return tf_.canTransform("world", "drifter", stamp) && tf_.canTransform("world", "rider_2", ros::Time(0));
+  }, stc_test::kLivenessSeconds));
+  const auto drifter = tf_.lookupTransform("world", "drifter", stamp);
+  const auto rider = tf_.lookupTransform("world", "rider_2", ros::Time(0));
+  EXPECT_NEAR(rider.transform.translation.x, drifter.transform.translation.x, 1e-9);
+  EXPECT_NEAR(rider.transform.translation.y, drifter.transform.translation.y, 1e-9);
+  EXPECT_NEAR(rider.transform.translation.z, drifter.transform.translation.z + 5.0, 1e-9);
 }
 
 TEST_F(Services, SpawnFailuresNameTheFieldAndChangeNothing) {

@@ -20,8 +20,10 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <atomic>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace stc_ros {
@@ -30,7 +32,11 @@ class WorldNode;
 
 class WorldServices {
  public:
+  // Advertises the services; ~spawn's thread is started by start(), once the
+  // node is whole (a call must not wait on a node that never spins).
   WorldServices(ros::NodeHandle& private_nh, WorldNode& node);
+  ~WorldServices();
+  void start() { spawn_spinner_.start(); }
 
  private:
   bool spawn(sphere_tree_collision::Spawn::Request& req, sphere_tree_collision::Spawn::Response& res);
@@ -43,10 +49,13 @@ class WorldServices {
   // The request's entity with its pose and twist in ~world_frame; throws InputError("header.frame_id").
   sphere_tree_collision::SpawnEntity inWorldFrame(const sphere_tree_collision::Spawn::Request& req);
   // Runs `work` on the node's spinner, between ticks, and waits for it; throws
-  // what `work` threw. For the services served on their own thread.
-  static void onTickThread(std::function<void()> work);
+  // what `work` threw, or when the node stops first. For the services served
+  // on their own thread.
+  void onTickThread(std::function<void()> work) const;
 
   WorldNode& node_;
+  const std::string world_frame_;  // the node's, copied: read on ~spawn's thread
+  std::atomic<bool> stopping_{false};
   // Created at the first spawn in another frame: the node's own /tf is not read otherwise.
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
