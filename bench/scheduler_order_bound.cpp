@@ -18,6 +18,12 @@
 //                  entity pair's, measured as the oracle's; new pairs last):
 //                  what a scheduler that remembered each pair's outcome could
 //                  reach at best, if the tick before had been resolved whole
+//   separate a tick before, then queues
+//                  the tick before run by the priority queues under the same
+//                  share of its sphere tests; the pairs they found separate
+//                  go first, whole, by that tick's v / C; then the queues over
+//                  the rest (pairs in contact are not put back): what a memory
+//                  of one budgeted tick could buy
 // Printed: true P left, summed over the snapshots, over round-robin's.
 //
 // Usage: bench_scheduler_order_bound [--scene packed_box|rockfall] [--snapshots N]
@@ -100,18 +106,28 @@ double pLeft(const std::vector<PairFacts>& facts, const Priority& priority, std:
   return trueP(tests, facts, perception);
 }
 
-// True P left by the library's priority queues (defaults) under `budget` tests.
-double queuesLeft(const std::vector<PairFacts>& facts, std::size_t body_count, const Perception& perception,
-                  std::int64_t budget) {
-  std::vector<PairTest> tests(facts.size());
+// The library's priority queues (defaults) over `tests` (parallel to `facts`,
+// fresh or part stepped) under `budget` more sphere tests.
+void runQueues(const std::vector<PairFacts>& facts, std::size_t body_count, const Perception& perception,
+               std::int64_t budget, std::vector<PairTest>& tests) {
   std::vector<std::array<std::uint32_t, 2>> of_pair(facts.size());
-  for (std::size_t i = 0; i < facts.size(); ++i) {
-    tests[i].reset(facts[i].a, facts[i].b);
-    of_pair[i] = facts[i].bodies;
-  }
+  for (std::size_t i = 0; i < facts.size(); ++i) of_pair[i] = facts[i].bodies;
   BudgetTracker tracker(Budget::ofSphereTests(budget));
   makeScheduler(SchedulerOptions{})->run(tests, tests.size(), PairBodies{of_pair.data(), body_count}, &perception,
                                          tracker);
+}
+
+std::vector<PairTest> freshTests(const std::vector<PairFacts>& facts) {
+  std::vector<PairTest> tests(facts.size());
+  for (std::size_t i = 0; i < facts.size(); ++i) tests[i].reset(facts[i].a, facts[i].b);
+  return tests;
+}
+
+// True P left by the library's priority queues (defaults) under `budget` tests.
+double queuesLeft(const std::vector<PairFacts>& facts, std::size_t body_count, const Perception& perception,
+                  std::int64_t budget) {
+  std::vector<PairTest> tests = freshTests(facts);
+  runQueues(facts, body_count, perception, budget, tests);
   return trueP(tests, facts, perception);
 }
 
@@ -131,23 +147,27 @@ double oracleLeft(const std::vector<PairFacts>& facts, std::int64_t budget) {
   return left;
 }
 
-// True P left by resolving pairs whole in order of last tick's v / C
-// (`last_value`, `last_cost`, parallel to `facts`; 0 value: unknown) under `budget` tests.
-double lastTickLeft(const std::vector<PairFacts>& facts, const std::vector<double>& last_value,
-                    const std::vector<double>& last_cost, std::int64_t budget, const Perception& perception) {
+// Pairs resolved whole in order of `first_value` / `first_cost` (parallel to
+// `facts`; value 0: not among them) while the budget lasts; then, with
+// `then_queues`, the priority queues over the rest with what is left.
+double promotedLeft(const std::vector<PairFacts>& facts, const std::vector<double>& first_value,
+                    const std::vector<double>& first_cost, bool then_queues, std::size_t body_count,
+                    std::int64_t budget, const Perception& perception) {
   const std::size_t n = facts.size();
-  std::vector<std::size_t> order(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (first_value[i] > 0.0 || !then_queues) order.push_back(i);
+  }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
-    return last_value[x] * last_cost[y] > last_value[y] * last_cost[x];
+    return first_value[x] * first_cost[y] > first_value[y] * first_cost[x];
   });
-  std::vector<PairTest> tests(n);
-  for (std::size_t i = 0; i < n; ++i) tests[i].reset(facts[i].a, facts[i].b);
+  std::vector<PairTest> tests = freshTests(facts);
   std::int64_t spent = 0;
-  for (std::size_t k = 0; k < n && spent < budget; ++k) {
+  for (std::size_t k = 0; k < order.size() && spent < budget; ++k) {
     PairTest& test = tests[order[k]];
     while (!test.resolved() && spent < budget) spent += test.step();
   }
+  if (then_queues && spent < budget) runQueues(facts, body_count, perception, budget - spent, tests);
   return trueP(tests, facts, perception);
 }
 
@@ -191,7 +211,7 @@ int main(int argc, char** argv) {
   const Priority by_gap = [](const PairTest& t, const PairFacts& f) {
     return f.weight * f.px_per_metre * (t.stepsDone() > 0 ? t.frontierGap() : 0.5) / t.nextStepTests();
   };
-  constexpr int kOrders = 6;
+  constexpr int kOrders = 7;
   std::vector<std::vector<double>> left(kOrders, std::vector<double>(shares.size(), 0.0));
   std::mt19937 pick(11);  // the gaze targets of bench_error_vs_runtime
   double t = 0.0;
@@ -233,9 +253,19 @@ int main(int argc, char** argv) {
     follow.mode = GazeMode::Follow;
     follow.target = spec.movers[pick() % spec.movers.size()];
     const GazeModel gaze(follow);  // copied fresh into each measure, as one per snapshot before
-    measure(gaze, before);  // the tick before the snapshot
+    const TickReport full_before = measure(gaze, before);  // the tick before the snapshot
     last_tick.clear();
     for (const PairFacts& f : before) last_tick[{f.a.id, f.b.id}] = &f;
+    // What the queues, under each share of that tick's tests, found separate.
+    std::vector<std::map<std::pair<EntityId, EntityId>, const PairFacts*>> separate_before(shares.size());
+    for (std::size_t b = 0; b < shares.size(); ++b) {
+      std::vector<PairTest> tests = freshTests(before);
+      runQueues(before, eval.bodies().size(), eval.perception(),
+                std::llround(shares[b] * static_cast<double>(full_before.sphere_tests)), tests);
+      for (std::size_t i = 0; i < before.size(); ++i) {
+        if (tests[i].status() == PairStatus::Separate) separate_before[b][{before[i].a.id, before[i].b.id}] = &before[i];
+      }
+    }
     sim.step(spec.dt, Budget::unlimited());
     t += spec.dt;
     const TickReport full = measure(gaze, facts);
@@ -254,7 +284,15 @@ int main(int argc, char** argv) {
       left[2][b] += pLeft(facts, by_gap, budget, perception);
       left[3][b] += queuesLeft(facts, eval.bodies().size(), perception, budget);
       left[4][b] += oracleLeft(facts, budget);
-      left[5][b] += lastTickLeft(facts, last_value, last_cost, budget, perception);
+      left[5][b] += promotedLeft(facts, last_value, last_cost, false, eval.bodies().size(), budget, perception);
+      std::vector<double> sep_value(facts.size(), 0.0), sep_cost(facts.size(), 1.0);
+      for (std::size_t i = 0; i < facts.size(); ++i) {
+        const auto found = separate_before[b].find({facts[i].a.id, facts[i].b.id});
+        if (found == separate_before[b].end()) continue;
+        sep_value[i] = found->second->value;
+        sep_cost[i] = std::max(found->second->cost, 1.0);
+      }
+      left[6][b] += promotedLeft(facts, sep_value, sep_cost, true, eval.bodies().size(), budget, perception);
     }
     std::fprintf(stderr, "  snapshot %d/%d\n", s + 1, snapshots);
   }
@@ -264,7 +302,8 @@ int main(int argc, char** argv) {
   std::printf("\n|---|");
   for (std::size_t b = 0; b < shares.size(); ++b) std::printf("---|");
   const char* names[] = {"round_robin", "greedy, g = reach", "greedy, g = paper's estimate",
-                         "priority_queues (defaults)", "oracle", "last tick's v / C, known exactly"};
+                         "priority_queues (defaults)", "oracle", "last tick's v / C, known exactly",
+                         "separate a tick before (queues, same share) first, then queues"};
   for (int o = 0; o < kOrders; ++o) {
     std::printf("\n| %s |", names[o]);
     for (std::size_t b = 0; b < shares.size(); ++b) std::printf(" %.2f |", left[o][b] / left[0][b]);
