@@ -24,6 +24,13 @@
 //                  go first, whole, by that tick's v / C; then the queues over
 //                  the rest (pairs in contact are not put back): what a memory
 //                  of one budgeted tick could buy
+//   memory, explore X
+//                  run on every tick, under the same share of each tick's
+//                  tests, remembering what each pair was when last resolved:
+//                  pairs remembered separate first, whole, by w s g / c (g the
+//                  gap their test saw: roots apart, else the paper's); then X
+//                  of the budget on the pairs resolved longest ago (never
+//                  first), whole; then the queues over the rest
 // Printed: true P left, summed over the snapshots, over round-robin's.
 //
 // Usage: bench_scheduler_order_bound [--scene packed_box|rockfall] [--snapshots N]
@@ -147,6 +154,15 @@ double oracleLeft(const std::vector<PairFacts>& facts, std::int64_t budget) {
   return left;
 }
 
+// The pairs `order` names, each stepped until resolved, while `spent` is under `until`.
+void resolveWhole(std::vector<PairTest>& tests, const std::vector<std::size_t>& order, std::int64_t until,
+                  std::int64_t& spent) {
+  for (std::size_t k = 0; k < order.size() && spent < until; ++k) {
+    PairTest& test = tests[order[k]];
+    while (!test.resolved() && spent < until) spent += test.step();
+  }
+}
+
 // Pairs resolved whole in order of `first_value` / `first_cost` (parallel to
 // `facts`; value 0: not among them) while the budget lasts; then, with
 // `then_queues`, the priority queues over the rest with what is left.
@@ -163,12 +179,64 @@ double promotedLeft(const std::vector<PairFacts>& facts, const std::vector<doubl
   });
   std::vector<PairTest> tests = freshTests(facts);
   std::int64_t spent = 0;
-  for (std::size_t k = 0; k < order.size() && spent < budget; ++k) {
-    PairTest& test = tests[order[k]];
-    while (!test.resolved() && spent < budget) spent += test.step();
-  }
+  resolveWhole(tests, order, budget, spent);
   if (then_queues && spent < budget) runQueues(facts, body_count, perception, budget - spent, tests);
   return trueP(tests, facts, perception);
+}
+
+// What a pair was when last resolved.
+struct Remembered {
+  int tick = -1;
+  bool separate = false;
+  double cost = 1.0;  // sphere tests it took
+  double gap = 0.0;   // separate: its gap as the test saw it (metres)
+};
+using Memory = std::map<std::pair<EntityId, EntityId>, Remembered>;
+
+// A separate pair's gap as its own test saw it: its roots' gap when they do
+// not touch, else the last frontier's (the paper's estimate).
+double seenGap(const PairTest& test) {
+  const SphereNode& ra = test.bodyA().tree->node(0);
+  const SphereNode& rb = test.bodyB().tree->node(0);
+  const double roots = (test.bodyA().pose->apply(ra.centre) - test.bodyB().pose->apply(rb.centre)).norm() -
+                       ra.radius - rb.radius;
+  return roots > 0.0 ? roots : test.frontierGap();
+}
+
+// One budgeted tick of the memory order over this tick's pairs; `memory` learns what it resolved.
+std::vector<PairTest> memoryTick(const std::vector<PairFacts>& facts, Memory& memory, int tick, double explore,
+                                 std::size_t body_count, std::int64_t budget, const Perception& perception) {
+  const std::size_t n = facts.size();
+  std::vector<PairTest> tests = freshTests(facts);
+  for (PairTest& test : tests) test.trackFrontierGap();
+  std::vector<Remembered> known(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto found = memory.find({facts[i].a.id, facts[i].b.id});
+    if (found != memory.end()) known[i] = found->second;
+  }
+  std::vector<std::size_t> separate, stale(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    stale[i] = i;
+    if (known[i].separate) separate.push_back(i);
+  }
+  const auto worth = [&](std::size_t i) {
+    return facts[i].weight * facts[i].px_per_metre * known[i].gap / known[i].cost;
+  };
+  std::stable_sort(separate.begin(), separate.end(), [&](std::size_t x, std::size_t y) { return worth(x) > worth(y); });
+  std::stable_sort(stale.begin(), stale.end(), [&](std::size_t x, std::size_t y) { return known[x].tick < known[y].tick; });
+  std::int64_t spent = 0;
+  const auto exploring = std::llround(explore * static_cast<double>(budget));
+  resolveWhole(tests, separate, budget - exploring, spent);
+  resolveWhole(tests, stale, std::min<std::int64_t>(budget, spent + exploring), spent);
+  if (spent < budget) runQueues(facts, body_count, perception, budget - spent, tests);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (tests[i].resolved()) {
+      memory[{facts[i].a.id, facts[i].b.id}] =
+          Remembered{tick, tests[i].status() == PairStatus::Separate, std::max<double>(1.0, tests[i].sphereTests()),
+                     tests[i].status() == PairStatus::Separate ? seenGap(tests[i]) : 0.0};
+    }
+  }
+  return tests;
 }
 
 }  // namespace
@@ -211,14 +279,16 @@ int main(int argc, char** argv) {
   const Priority by_gap = [](const PairTest& t, const PairFacts& f) {
     return f.weight * f.px_per_metre * (t.stepsDone() > 0 ? t.frontierGap() : 0.5) / t.nextStepTests();
   };
-  constexpr int kOrders = 7;
+  const std::vector<double> explores = {0.0, 0.2};
+  const int kOrders = 7 + static_cast<int>(explores.size());
   std::vector<std::vector<double>> left(kOrders, std::vector<double>(shares.size(), 0.0));
   std::mt19937 pick(11);  // the gaze targets of bench_error_vs_runtime
   double t = 0.0;
   const int warmup = kind == SceneKind::Rockfall ? 75 : 30;
   for (int i = 0; i < warmup; ++i, t += spec.dt) sim.step(spec.dt, Budget::unlimited());
   // The simulation's poses under a fresh `gaze` at time t: each pair's facts, and the full run's report.
-  const auto measure = [&](GazeModel gaze, std::vector<PairFacts>& facts) {
+  // Without `truth` no FCL work (gap and value 0): a tick only run through.
+  const auto measure = [&](GazeModel gaze, std::vector<PairFacts>& facts, bool truth) {
     for (std::size_t i = 0; i < sim.entityCount(); ++i) eval.bodies()[i].pose = sim.bodies()[i].pose;
     eval.perception().setFixation(gaze.fixationAt(t, sim));
     const TickReport full = eval.step(0.0, Budget::unlimited());
@@ -235,6 +305,7 @@ int main(int argc, char** argv) {
       f.px_per_metre = std::sqrt(ga.px_per_metre * gb.px_per_metre);
       f.cost = static_cast<double>(test.sphereTests());
       f.bodies = {static_cast<std::uint32_t>(*eval.indexOf(f.a.id)), static_cast<std::uint32_t>(*eval.indexOf(f.b.id))};
+      if (!truth) continue;
       const truth::FclMesh& ma = meshOf(*eval.indexOf(f.a.id));
       const truth::FclMesh& mb = meshOf(*eval.indexOf(f.b.id));
       const bool touching = truth::exactCollide(ma, *f.a.pose, mb, *f.b.pose);
@@ -245,15 +316,34 @@ int main(int argc, char** argv) {
     }
     return full;
   };
-  std::vector<PairFacts> facts, before;
+  std::vector<PairFacts> facts, before, passing;
   std::map<std::pair<EntityId, EntityId>, const PairFacts*> last_tick;
+  std::vector<std::vector<Memory>> memories(explores.size(), std::vector<Memory>(shares.size()));
+  int tick = 0;
+  // Each memory order's budgeted tick on `tick_facts` (a tick of `report`'s full cost).
+  const auto rememberTick = [&](const std::vector<PairFacts>& tick_facts, const TickReport& report) {
+    for (std::size_t x = 0; x < explores.size(); ++x) {
+      for (std::size_t b = 0; b < shares.size(); ++b) {
+        memoryTick(tick_facts, memories[x][b], tick, explores[x], eval.bodies().size(),
+                   std::llround(shares[b] * static_cast<double>(report.sphere_tests)), eval.perception());
+      }
+    }
+    ++tick;
+  };
   for (int s = 0; s < snapshots; ++s) {
-    for (int i = 0; i < 5; ++i, t += spec.dt) sim.step(spec.dt, Budget::unlimited());
     GazeParams follow;
     follow.mode = GazeMode::Follow;
     follow.target = spec.movers[pick() % spec.movers.size()];
     const GazeModel gaze(follow);  // copied fresh into each measure, as one per snapshot before
-    const TickReport full_before = measure(gaze, before);  // the tick before the snapshot
+    for (int i = 0; i < 4; ++i) {
+      sim.step(spec.dt, Budget::unlimited());
+      t += spec.dt;
+      rememberTick(passing, measure(gaze, passing, false));
+    }
+    sim.step(spec.dt, Budget::unlimited());
+    t += spec.dt;
+    const TickReport full_before = measure(gaze, before, true);  // the tick before the snapshot
+    rememberTick(before, full_before);
     last_tick.clear();
     for (const PairFacts& f : before) last_tick[{f.a.id, f.b.id}] = &f;
     // What the queues, under each share of that tick's tests, found separate.
@@ -268,7 +358,7 @@ int main(int argc, char** argv) {
     }
     sim.step(spec.dt, Budget::unlimited());
     t += spec.dt;
-    const TickReport full = measure(gaze, facts);
+    const TickReport full = measure(gaze, facts, true);
     const Perception& perception = eval.perception();
     std::vector<double> last_value(facts.size(), 0.0), last_cost(facts.size(), 1.0);
     for (std::size_t i = 0; i < facts.size(); ++i) {
@@ -293,7 +383,13 @@ int main(int argc, char** argv) {
         sep_cost[i] = std::max(found->second->cost, 1.0);
       }
       left[6][b] += promotedLeft(facts, sep_value, sep_cost, true, eval.bodies().size(), budget, perception);
+      for (std::size_t x = 0; x < explores.size(); ++x) {
+        const std::vector<PairTest> tests =
+            memoryTick(facts, memories[x][b], tick, explores[x], eval.bodies().size(), budget, perception);
+        left[7 + x][b] += trueP(tests, facts, perception);
+      }
     }
+    ++tick;
     std::fprintf(stderr, "  snapshot %d/%d\n", s + 1, snapshots);
   }
   std::printf("%s, %d snapshots: true P left / round-robin's, at a share of the full sphere tests\n\n| order |",
@@ -301,11 +397,12 @@ int main(int argc, char** argv) {
   for (double share : shares) std::printf(" %.1f %% |", 100 * share);
   std::printf("\n|---|");
   for (std::size_t b = 0; b < shares.size(); ++b) std::printf("---|");
-  const char* names[] = {"round_robin", "greedy, g = reach", "greedy, g = paper's estimate",
-                         "priority_queues (defaults)", "oracle", "last tick's v / C, known exactly",
-                         "separate a tick before (queues, same share) first, then queues"};
+  std::vector<std::string> names = {"round_robin", "greedy, g = reach", "greedy, g = paper's estimate",
+                                    "priority_queues (defaults)", "oracle", "last tick's v / C, known exactly",
+                                    "separate a tick before (queues, same share) first, then queues"};
+  for (double x : explores) names.push_back("memory of every budgeted tick, explore " + std::to_string(x).substr(0, 4));
   for (int o = 0; o < kOrders; ++o) {
-    std::printf("\n| %s |", names[o]);
+    std::printf("\n| %s |", names[o].c_str());
     for (std::size_t b = 0; b < shares.size(); ++b) std::printf(" %.2f |", left[o][b] / left[0][b]);
   }
   std::printf("\n");
