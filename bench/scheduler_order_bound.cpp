@@ -154,6 +154,25 @@ double oracleLeft(const std::vector<PairFacts>& facts, std::int64_t budget) {
   return left;
 }
 
+// A pair's entity ids: the same pair from one tick to the next.
+using PairKey = std::pair<EntityId, EntityId>;
+PairKey keyOf(const PairFacts& f) { return {f.a.id, f.b.id}; }
+using FactsByPair = std::map<PairKey, const PairFacts*>;
+
+// Each of `facts`' value and cost (at least 1) as `known` had them (value 0,
+// cost 1: a pair it lacks).
+void knownWorth(const FactsByPair& known, const std::vector<PairFacts>& facts, std::vector<double>& value,
+                std::vector<double>& cost) {
+  value.assign(facts.size(), 0.0);
+  cost.assign(facts.size(), 1.0);
+  for (std::size_t i = 0; i < facts.size(); ++i) {
+    const auto found = known.find(keyOf(facts[i]));
+    if (found == known.end()) continue;
+    value[i] = found->second->value;
+    cost[i] = std::max(found->second->cost, 1.0);
+  }
+}
+
 // The pairs `order` names, each stepped until resolved, while `spent` is under `until`.
 void resolveWhole(std::vector<PairTest>& tests, const std::vector<std::size_t>& order, std::int64_t until,
                   std::int64_t& spent) {
@@ -191,7 +210,7 @@ struct Remembered {
   double cost = 1.0;  // sphere tests it took
   double gap = 0.0;   // separate: its gap as the test saw it (metres)
 };
-using Memory = std::map<std::pair<EntityId, EntityId>, Remembered>;
+using Memory = std::map<PairKey, Remembered>;
 
 // A separate pair's gap as its own test saw it: its roots' gap when they do
 // not touch, else the last frontier's (the paper's estimate).
@@ -211,7 +230,7 @@ std::vector<PairTest> memoryTick(const std::vector<PairFacts>& facts, Memory& me
   for (PairTest& test : tests) test.trackFrontierGap();
   std::vector<Remembered> known(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const auto found = memory.find({facts[i].a.id, facts[i].b.id});
+    const auto found = memory.find(keyOf(facts[i]));
     if (found != memory.end()) known[i] = found->second;
   }
   std::vector<std::size_t> separate, stale(n);
@@ -230,11 +249,10 @@ std::vector<PairTest> memoryTick(const std::vector<PairFacts>& facts, Memory& me
   resolveWhole(tests, stale, std::min<std::int64_t>(budget, spent + exploring), spent);
   if (spent < budget) runQueues(facts, body_count, perception, budget - spent, tests);
   for (std::size_t i = 0; i < n; ++i) {
-    if (tests[i].resolved()) {
-      memory[{facts[i].a.id, facts[i].b.id}] =
-          Remembered{tick, tests[i].status() == PairStatus::Separate, std::max<double>(1.0, tests[i].sphereTests()),
-                     tests[i].status() == PairStatus::Separate ? seenGap(tests[i]) : 0.0};
-    }
+    if (!tests[i].resolved()) continue;
+    const bool separate = tests[i].status() == PairStatus::Separate;
+    memory[keyOf(facts[i])] = Remembered{tick, separate, std::max<double>(1.0, tests[i].sphereTests()),
+                                         separate ? seenGap(tests[i]) : 0.0};
   }
   return tests;
 }
@@ -317,7 +335,7 @@ int main(int argc, char** argv) {
     return full;
   };
   std::vector<PairFacts> facts, before, passing;
-  std::map<std::pair<EntityId, EntityId>, const PairFacts*> last_tick;
+  FactsByPair last_tick;
   std::vector<std::vector<Memory>> memories(explores.size(), std::vector<Memory>(shares.size()));
   int tick = 0;
   // Each memory order's budgeted tick on `tick_facts` (a tick of `report`'s full cost).
@@ -345,28 +363,23 @@ int main(int argc, char** argv) {
     const TickReport full_before = measure(gaze, before, true);  // the tick before the snapshot
     rememberTick(before, full_before);
     last_tick.clear();
-    for (const PairFacts& f : before) last_tick[{f.a.id, f.b.id}] = &f;
+    for (const PairFacts& f : before) last_tick[keyOf(f)] = &f;
     // What the queues, under each share of that tick's tests, found separate.
-    std::vector<std::map<std::pair<EntityId, EntityId>, const PairFacts*>> separate_before(shares.size());
+    std::vector<FactsByPair> separate_before(shares.size());
     for (std::size_t b = 0; b < shares.size(); ++b) {
       std::vector<PairTest> tests = freshTests(before);
       runQueues(before, eval.bodies().size(), eval.perception(),
                 std::llround(shares[b] * static_cast<double>(full_before.sphere_tests)), tests);
       for (std::size_t i = 0; i < before.size(); ++i) {
-        if (tests[i].status() == PairStatus::Separate) separate_before[b][{before[i].a.id, before[i].b.id}] = &before[i];
+        if (tests[i].status() == PairStatus::Separate) separate_before[b][keyOf(before[i])] = &before[i];
       }
     }
     sim.step(spec.dt, Budget::unlimited());
     t += spec.dt;
     const TickReport full = measure(gaze, facts, true);
     const Perception& perception = eval.perception();
-    std::vector<double> last_value(facts.size(), 0.0), last_cost(facts.size(), 1.0);
-    for (std::size_t i = 0; i < facts.size(); ++i) {
-      const auto found = last_tick.find({facts[i].a.id, facts[i].b.id});
-      if (found == last_tick.end()) continue;
-      last_value[i] = found->second->value;
-      last_cost[i] = std::max(found->second->cost, 1.0);
-    }
+    std::vector<double> last_value, last_cost, sep_value, sep_cost;
+    knownWorth(last_tick, facts, last_value, last_cost);
     for (std::size_t b = 0; b < shares.size(); ++b) {
       const auto budget = std::llround(shares[b] * static_cast<double>(full.sphere_tests));
       left[0][b] += pLeft(facts, nullptr, budget, perception);
@@ -375,13 +388,7 @@ int main(int argc, char** argv) {
       left[3][b] += queuesLeft(facts, eval.bodies().size(), perception, budget);
       left[4][b] += oracleLeft(facts, budget);
       left[5][b] += promotedLeft(facts, last_value, last_cost, false, eval.bodies().size(), budget, perception);
-      std::vector<double> sep_value(facts.size(), 0.0), sep_cost(facts.size(), 1.0);
-      for (std::size_t i = 0; i < facts.size(); ++i) {
-        const auto found = separate_before[b].find({facts[i].a.id, facts[i].b.id});
-        if (found == separate_before[b].end()) continue;
-        sep_value[i] = found->second->value;
-        sep_cost[i] = std::max(found->second->cost, 1.0);
-      }
+      knownWorth(separate_before[b], facts, sep_value, sep_cost);
       left[6][b] += promotedLeft(facts, sep_value, sep_cost, true, eval.bodies().size(), budget, perception);
       for (std::size_t x = 0; x < explores.size(); ++x) {
         const std::vector<PairTest> tests =
