@@ -39,6 +39,7 @@ struct SolveStats {
   double refinement_seconds = 0.0;  // spent in the iterations a deadline may cut (set with one)
   std::uint32_t slabs = 1;          // slabs of the manifolds' blocks (contact_partition.hpp)
   std::size_t crossing_manifolds = 0;  // manifolds in the stages after the first (across slabs)
+  std::size_t wide_batches = 0;        // batches of up to four manifolds the passes took (0: one at a time)
 };
 
 // What the tick lets the solver spend: the response is refineable (paper 3.5
@@ -138,6 +139,41 @@ class ContactSolver {
   // One sequential-impulse step of a row (friction, then non-penetration)
   // on the velocities of its two bodies: the unit of work of a pass.
   static void relax(Row& row, Motion& a, Motion& b);
+  // One step of a pair's rolling resistance, its rows' normal impulse so far
+  // `normal`, on the pair's velocities a and b (after its rows, in a pass).
+  static void resistRolling(Rolling& roll, double normal, Motion& a, Motion& b);
+
+  // The sequential velocity passes take kLanes manifolds side by side
+  // (contact_solver_wide.cpp).
+  static constexpr std::uint32_t kLanes = 4;
+  // One row of each lane's manifold (a lane without one here is left alone).
+  // What a velocity pass streams: t2 is n x t1 again (tangentBasis), and
+  // shock propagation's masses are in a WideShockMass of the same place.
+  struct alignas(32) WideRow {
+    double ra[3][kLanes], rb[3][kLanes], n[3][kLanes], t1[3][kLanes];
+    double ang_a[3][3][kLanes], ang_b[3][3][kLanes];  // [direction][axis][lane]
+    double inv_ma[kLanes], inv_mb[kLanes], mass[3][kLanes];
+    double friction[kLanes], speculative[kLanes], bounce_impulse[kLanes];
+    double lambda[3][kLanes];
+  };
+  struct alignas(32) WideShockMass {
+    double mass[3][kLanes];
+  };
+  // The same for the split-impulse passes by translation (RowInfo's push terms).
+  struct alignas(32) WidePush {
+    double n[3][kLanes];
+    double inv_ma[kLanes], inv_mb[kLanes], push[kLanes], mass[kLanes], shock_mass[kLanes], lambda[kLanes];
+    long long pull[kLanes];  // all ones: may pull (bounced across a gap), else clamped at 0
+  };
+  struct WideBatch {
+    std::uint32_t first_row = 0, rows = 0;  // its wide rows: as many as its largest manifold's
+    std::uint32_t lanes = 0;
+    std::uint32_t manifold[kLanes] = {};
+    std::uint32_t manifold_rows[kLanes] = {};
+    std::uint32_t body_a[kLanes] = {}, body_b[kLanes] = {};  // dense indices (a static one is read, never written)
+    bool write_a[kLanes] = {}, write_b[kLanes] = {};
+    bool move_a[kLanes] = {}, move_b[kLanes] = {};  // shock propagation: not held
+  };
 
  private:
   // The rest of a row: the restitution waves, shock propagation and the
@@ -234,6 +270,36 @@ class ContactSolver {
   // body of each row held: what they left of a pile's overlap goes upward.
   void propagatePositionShock(const ResponseOptions& options);
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
+
+  // The sequential velocity passes, kLanes manifolds side by side
+  // (contact_solver_wide.cpp): a block's manifolds in batches that share no
+  // movable body, each manifold in a batch after those of the block's earlier
+  // manifolds on its bodies. Every body so meets its manifolds in the block's
+  // order, and the passes give the one-at-a-time passes' result bit for bit.
+  // After the rows are prepared: batches_, their wide rows' places, batch_start_.
+  void batchManifolds();
+  // Batches [first, end): rows_ copied in, or their impulses copied back.
+  void packWide(std::size_t first, std::size_t end);
+  void unpackWide(std::size_t first, std::size_t end);
+  // `passes` sequential velocity passes on the batches (each pair's rolling
+  // resistance after its rows), and shock propagation's (propagateShock).
+  void solveVelocitiesWide(int passes);
+  void propagateShockWide(int passes);
+  // The position passes by translation alone on the batches: one pass, and
+  // the position shock sweep (after packWidePush).
+  void packWidePush(std::size_t first, std::size_t end);
+  void solvePositionsWide();
+  void propagatePositionShockWide();
+  // batches(first, end) over each block's batches, stage by stage (as forEachStage).
+  void forEachStageBatches(RangeFn batches);
+
+  bool wide_ = false;  // this solve's velocity passes run on the batches
+  std::vector<WideBatch> batches_;
+  std::vector<WideRow> wide_rows_;
+  std::vector<WideShockMass> wide_shock_mass_;
+  std::vector<WidePush> wide_push_;
+  std::vector<std::uint32_t> batch_start_;  // by manifold, at block boundaries
+  std::vector<std::uint32_t> body_batch_;   // batchManifolds: a body's last batch + 1
 
   std::vector<Row> rows_;
   std::vector<RowInfo> info_;

@@ -106,6 +106,10 @@ STC_HOT_INLINE void rollingStep(ContactSolver::Rolling& roll, double normal, con
 
 void ContactSolver::relax(Row& row, Motion& a, Motion& b) { relaxRow(row, a, b); }
 
+void ContactSolver::resistRolling(Rolling& roll, double normal, Motion& a, Motion& b) {
+  rollingStep(roll, normal, a.w, b.w, a, b);
+}
+
 void ContactSolver::prepare(const std::vector<BodyState>& bodies,
                             const std::vector<Contact>& contacts, const ResponseOptions& options,
                             double dt, SolveStats& stats) {
@@ -213,6 +217,9 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   stats.contacts = rows_.size();
   stats.manifolds = manifold_start_.size() - 1;
   prepareRolling(bodies, jacobi);
+  wide_ = options.wide_passes && !jacobi;
+  if (wide_) batchManifolds();
+  stats.wide_batches = wide_ ? batches_.size() : 0;
 }
 
 // A pair resists rolling with the larger coefficient of its two materials,
@@ -343,6 +350,10 @@ void ContactSolver::overManifolds(std::size_t first, std::size_t end, std::vecto
 // below them) are left as the iterations made them.
 void ContactSolver::propagateShock(const ResponseOptions& options) {
   const int passes = std::max(2, options.iterations / 2);
+  if (wide_) {
+    propagateShockWide(passes);
+    return;
+  }
   const auto shockStep = [&](std::size_t r, Motion& pair_a, Motion& pair_b) {
     Row& row = rows_[r];
     const RowInfo& info = info_[r];
@@ -492,12 +503,16 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
     }
     return;
   }
+  if (wide_) {
+    solveVelocitiesWide(passes);
+    return;
+  }
   // Sequential: the rows of one body pair in a row, on local copies of the
   // two bodies' velocities, then the pair's rolling resistance.
   const auto relaxStep = [&](std::size_t r, Motion& a, Motion& b) { relaxRow(rows_[r], a, b); };
   const auto relaxRolling = [&](std::size_t m, Motion& a, Motion& b) {
     Rolling& roll = rolling_[m];
-    if (roll.per_normal != 0.0) rollingStep(roll, normalImpulse(m), a.w, b.w, a, b);
+    if (roll.per_normal != 0.0) resistRolling(roll, normalImpulse(m), a, b);
   };
   for (int it = 0; it < passes; ++it) {
     forEachStage([&](std::size_t first, std::size_t end) {
@@ -637,6 +652,14 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
     pushStep(row, info, a, b, turns ? row.mass[0] : info.push_mass, turns, out_a, out_b);
   };
   int passes = 0;
+  if (wide_ && !turns) {
+    forEachStageBatches([&](std::size_t first, std::size_t end) { packWidePush(first, end); });
+    for (int it = 0; it < options.iterations; ++it, ++passes) {
+      if (it > 0 && deadline.passed()) break;
+      solvePositionsWide();
+    }
+    return passes;
+  }
   for (int it = 0; it < options.iterations; ++it, ++passes) {
     if (it > 0 && deadline.passed()) break;
     // Stage by stage, as the velocity passes.
@@ -654,6 +677,10 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
 // into what supports it; what rests on it moves instead.
 void ContactSolver::propagatePositionShock(const ResponseOptions& options) {
   const bool turns = options.position_turns;
+  if (wide_ && !turns) {
+    propagatePositionShockWide();
+    return;
+  }
   const auto shockPush = [&](std::size_t r, Motion& pair_a, Motion& pair_b) {
     const Row& row = rows_[r];
     RowInfo& info = info_[r];
@@ -827,6 +854,7 @@ void ContactSolver::iterate(const ResponseOptions& options, const SolveBudget& b
   const Deadline& deadline = budget.deadline;
   ResponseOptions run = options;
   run.iterations = std::max(1, std::min(options.iterations, budget.max_iterations));
+  if (wide_) forEachStageBatches([&](std::size_t first, std::size_t end) { packWide(first, end); });
   const double t_first = deadline.isSet() ? deadline.now() : 0.0;
   solveVelocities(run, 1);
   const double t_more = deadline.isSet() ? deadline.now() : 0.0;
@@ -842,6 +870,7 @@ void ContactSolver::iterate(const ResponseOptions& options, const SolveBudget& b
   };
   if (jacobi) keepMainImpulses();
   if (options.shock_propagation) propagateShock(run);
+  if (wide_) forEachStageBatches([&](std::size_t first, std::size_t end) { unpackWide(first, end); });
   if (!jacobi) keepMainImpulses();
   const double t_positions = deadline.isSet() ? deadline.now() : 0.0;
   stats.position_passes = solvePositions(run, deadline);

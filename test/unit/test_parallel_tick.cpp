@@ -8,6 +8,7 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/workers.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "same_state.hpp"
 
 #include <gtest/gtest.h>
 
@@ -38,33 +39,6 @@ World sceneWorld(SceneKind kind, int threads) {
   // the default (512) would leave every colour on the calling thread.
   config.response.solver_task_manifolds = 4;
   return sceneWorld(kind, config);
-}
-
-// Bit-identical: every double compared with ==, none within a tolerance.
-::testing::AssertionResult sameState(const World& x, const World& y) {
-  if (x.entityCount() != y.entityCount()) return ::testing::AssertionFailure() << "entity counts differ";
-  for (std::size_t i = 0; i < x.entityCount(); ++i) {
-    const BodyState& a = x.bodies()[i];
-    const BodyState& b = y.bodies()[i];
-    if (x.entityIds()[i] != y.entityIds()[i] || a.pose.position != b.pose.position ||
-        a.pose.orientation.coeffs() != b.pose.orientation.coeffs() || a.linear_velocity != b.linear_velocity ||
-        a.angular_velocity != b.angular_velocity) {
-      return ::testing::AssertionFailure() << "body " << i << " differs";
-    }
-  }
-  const std::vector<Contact>& cx = x.contacts();
-  const std::vector<Contact>& cy = y.contacts();
-  if (cx.size() != cy.size()) return ::testing::AssertionFailure() << "contact counts " << cx.size() << " " << cy.size();
-  for (std::size_t k = 0; k < cx.size(); ++k) {
-    const Contact& a = cx[k];
-    const Contact& b = cy[k];
-    if (a.a != b.a || a.b != b.b || a.point != b.point || a.normal != b.normal || a.separation != b.separation ||
-        a.gap_bound != b.gap_bound || a.resolved != b.resolved || a.normal_impulse != b.normal_impulse ||
-        a.friction_impulse != b.friction_impulse) {
-      return ::testing::AssertionFailure() << "contact " << k << " differs";
-    }
-  }
-  return ::testing::AssertionSuccess();
 }
 
 const SceneKind kScenes[] = {SceneKind::CornerDrift, SceneKind::Rockfall, SceneKind::PackedBox};

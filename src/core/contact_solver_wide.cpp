@@ -1,0 +1,452 @@
+// The sequential velocity passes four manifolds at a time. One row step is a
+// short chain of dependent scalar operations; four manifolds that share no
+// movable body go through the same operations side by side, one lane each,
+// in vector registers. The operations and their order are the scalar
+// relaxRow's (contact_solver.cpp), with no fused multiply-add, so each lane
+// computes the scalar result bit for bit.
+#include "sphere_tree_collision/contact_solver.hpp"
+
+#include <cmath>
+#include <cstring>
+
+// The vector types below never cross a call that is not inlined, so the
+// ABI note about passing them without AVX does not apply.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+
+namespace stc {
+
+namespace {
+
+constexpr std::uint32_t kLanes = ContactSolver::kLanes;
+static_assert(kLanes == 4, "the lane types below are four doubles wide");
+
+// Four doubles, and a lane mask of the same width (GCC/Clang vector types:
+// SSE2 pairs by default, one AVX2 register in the avx2 clone below).
+typedef double Wide __attribute__((vector_size(32)));
+typedef long long WideMask __attribute__((vector_size(32)));
+
+// Everything below is inlined into relaxBatches, so it is compiled for its clones.
+#define STC_WIDE inline __attribute__((always_inline))
+
+struct Wide3 {
+  Wide x, y, z;
+};
+
+STC_WIDE Wide load(const double* p) {
+  Wide v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+STC_WIDE void store(double* p, const Wide& v) { std::memcpy(p, &v, sizeof v); }
+STC_WIDE Wide3 load3(const double (&p)[3][kLanes]) { return {load(p[0]), load(p[1]), load(p[2])}; }
+
+// The same expressions, and order, as Eigen's Vector3d cross and dot.
+STC_WIDE Wide3 cross(const Wide3& u, const Wide3& v) {
+  return {u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+}
+STC_WIDE Wide dot(const Wide3& u, const Wide3& v) { return (u.x * v.x + u.y * v.y) + u.z * v.z; }
+
+// Both bodies' velocities of every lane.
+struct WideMotion {
+  Wide3 va, wa, vb, wb;
+};
+
+// relativeVelocity (contact_solver.cpp): vb + wb x rb - va - wa x ra.
+STC_WIDE Wide3 relativeVelocity(const WideMotion& m, const Wide3& ra, const Wide3& rb) {
+  const Wide3 cb = cross(m.wb, rb);
+  const Wide3 ca = cross(m.wa, ra);
+  return {((m.vb.x + cb.x) - m.va.x) - ca.x, ((m.vb.y + cb.y) - m.va.y) - ca.y,
+          ((m.vb.z + cb.z) - m.va.z) - ca.z};
+}
+
+STC_WIDE Wide select(const WideMask& on, const Wide& yes, const Wide& no) { return on ? yes : no; }
+STC_WIDE Wide3 select(const WideMask& on, const Wide3& yes, const Wide3& no) {
+  return {on ? yes.x : no.x, on ? yes.y : no.y, on ? yes.z : no.z};
+}
+
+// relaxRow for the lanes `on`, with the effective masses `mass`: friction,
+// then non-penetration. Body A's velocities change only in the lanes on_a,
+// B's in on_b (shock propagation holds a supporting body still).
+STC_WIDE void relaxWide(ContactSolver::WideRow& row, const double (&mass)[3][kLanes], const WideMask& on,
+                        const WideMask& on_a, const WideMask& on_b, WideMotion& m) {
+  const Wide zero = {0.0, 0.0, 0.0, 0.0};
+  const Wide one = {1.0, 1.0, 1.0, 1.0};
+  const Wide3 ra = load3(row.ra), rb = load3(row.rb);
+  const Wide3 n = load3(row.n), t1 = load3(row.t1);
+  const Wide3 t2 = cross(n, t1);  // as tangentBasis made it
+  const Wide inv_ma = load(row.inv_ma), inv_mb = load(row.inv_mb);
+  Wide lambda0 = load(row.lambda[0]), lambda1 = load(row.lambda[1]), lambda2 = load(row.lambda[2]);
+
+  // frictionStep
+  const Wide3 vrel = relativeVelocity(m, ra, rb);
+  const Wide limit = load(row.friction) * (lambda0 + load(row.bounce_impulse));
+  const Wide f1 = lambda1 - load(mass[1]) * dot(vrel, t1);
+  const Wide f2 = lambda2 - load(mass[2]) * dot(vrel, t2);
+  const Wide squared = f1 * f1 + f2 * f2;
+  Wide tn = squared;
+  for (std::uint32_t l = 0; l < kLanes; ++l) tn[l] = std::sqrt(squared[l]);
+  const Wide scale = tn > limit ? (tn > zero ? limit / tn : zero) : one;
+  const Wide d1 = select(on, f1 * scale - lambda1, zero);
+  const Wide d2 = select(on, f2 * scale - lambda2, zero);
+  lambda1 = lambda1 + d1;
+  lambda2 = lambda2 + d2;
+
+  // applyFriction
+  const Wide3 p = {d1 * t1.x + d2 * t2.x, d1 * t1.y + d2 * t2.y, d1 * t1.z + d2 * t2.z};
+  const Wide3 a1 = load3(row.ang_a[1]), a2 = load3(row.ang_a[2]);
+  const Wide3 b1 = load3(row.ang_b[1]), b2 = load3(row.ang_b[2]);
+  const auto applyFriction = [&](Wide3& v, Wide3& w, const Wide& inv_m, const Wide3& k1, const Wide3& k2,
+                                 bool minus, const WideMask& on) __attribute__((always_inline)) {
+    const Wide3 dv = {inv_m * p.x, inv_m * p.y, inv_m * p.z};
+    const Wide3 dw = {d1 * k1.x + d2 * k2.x, d1 * k1.y + d2 * k2.y, d1 * k1.z + d2 * k2.z};
+    if (minus) {
+      v = select(on, Wide3{v.x - dv.x, v.y - dv.y, v.z - dv.z}, v);
+      w = select(on, Wide3{w.x - dw.x, w.y - dw.y, w.z - dw.z}, w);
+    } else {
+      v = select(on, Wide3{v.x + dv.x, v.y + dv.y, v.z + dv.z}, v);
+      w = select(on, Wide3{w.x + dw.x, w.y + dw.y, w.z + dw.z}, w);
+    }
+  };
+  applyFriction(m.va, m.wa, inv_ma, a1, a2, true, on_a);
+  applyFriction(m.vb, m.wb, inv_mb, b1, b2, false, on_b);
+
+  // Non-penetration, from the relative velocity after the friction impulse.
+  const Wide vn = dot(relativeVelocity(m, ra, rb), n);
+  const Wide target = lambda0 + load(mass[0]) * (-load(row.speculative) - vn);
+  const Wide normal = zero < target ? target : zero;  // std::max(0.0, target)
+  const Wide dn = select(on, normal - lambda0, zero);
+  lambda0 = select(on, normal, lambda0);
+
+  // applyNormal
+  const Wide3 a0 = load3(row.ang_a[0]), b0 = load3(row.ang_b[0]);
+  const Wide ka = inv_ma * dn, kb = inv_mb * dn;
+  m.va = select(on_a, Wide3{m.va.x - ka * n.x, m.va.y - ka * n.y, m.va.z - ka * n.z}, m.va);
+  m.vb = select(on_b, Wide3{m.vb.x + kb * n.x, m.vb.y + kb * n.y, m.vb.z + kb * n.z}, m.vb);
+  m.wa = select(on_a, Wide3{m.wa.x - dn * a0.x, m.wa.y - dn * a0.y, m.wa.z - dn * a0.z}, m.wa);
+  m.wb = select(on_b, Wide3{m.wb.x + dn * b0.x, m.wb.y + dn * b0.y, m.wb.z + dn * b0.z}, m.wb);
+
+  store(row.lambda[0], lambda0);
+  store(row.lambda[1], lambda1);
+  store(row.lambda[2], lambda2);
+}
+
+// One pass over batches: the velocity iterations' (kShock false) or shock
+// propagation's, with the supporting bodies held (kShock).
+template <bool kShock>
+STC_WIDE void relaxBatchesOf(ContactSolver::WideRow* wide_rows, const ContactSolver::WideShockMass* shock_mass,
+                             ContactSolver::Rolling* rolling, const ContactSolver::WideBatch* batch,
+                             std::size_t count, ContactSolver::Motion* motion) {
+  for (std::size_t k = 0; k < count; ++k, ++batch) {
+    WideMotion m{};
+    for (std::uint32_t l = 0; l < batch->lanes; ++l) {
+      const ContactSolver::Motion& a = motion[batch->body_a[l]];
+      const ContactSolver::Motion& b = motion[batch->body_b[l]];
+      m.va.x[l] = a.v.x(), m.va.y[l] = a.v.y(), m.va.z[l] = a.v.z();
+      m.wa.x[l] = a.w.x(), m.wa.y[l] = a.w.y(), m.wa.z[l] = a.w.z();
+      m.vb.x[l] = b.v.x(), m.vb.y[l] = b.v.y(), m.vb.z[l] = b.v.z();
+      m.wb.x[l] = b.w.x(), m.wb.y[l] = b.w.y(), m.wb.z[l] = b.w.z();
+    }
+    WideMask rows_left, move_a, move_b;
+    for (std::uint32_t l = 0; l < kLanes; ++l) {
+      rows_left[l] = batch->manifold_rows[l];
+      move_a[l] = batch->move_a[l] ? -1 : 0;
+      move_b[l] = batch->move_b[l] ? -1 : 0;
+    }
+    for (std::uint32_t s = 0; s < batch->rows; ++s) {
+      const WideMask slot = {s, s, s, s};
+      const WideMask on = rows_left > slot;
+      ContactSolver::WideRow& row = wide_rows[batch->first_row + s];
+      if (kShock) {
+        relaxWide(row, shock_mass[batch->first_row + s].mass, on, on & move_a, on & move_b, m);
+      } else {
+        relaxWide(row, row.mass, on, on, on, m);
+      }
+    }
+    // Each pair's rolling resistance after its rows, one lane at a time.
+    for (std::uint32_t l = 0; rolling != nullptr && l < batch->lanes; ++l) {
+      ContactSolver::Rolling& roll = rolling[batch->manifold[l]];
+      if (roll.per_normal == 0.0) continue;
+      double normal = 0.0;  // as ContactSolver::normalImpulse sums it
+      for (std::uint32_t s = 0; s < batch->manifold_rows[l]; ++s) {
+        const ContactSolver::WideRow& row = wide_rows[batch->first_row + s];
+        normal += row.lambda[0][l] + row.bounce_impulse[l];
+      }
+      ContactSolver::Motion a, b;
+      a.v = Vec3(m.va.x[l], m.va.y[l], m.va.z[l]);
+      a.w = Vec3(m.wa.x[l], m.wa.y[l], m.wa.z[l]);
+      b.v = Vec3(m.vb.x[l], m.vb.y[l], m.vb.z[l]);
+      b.w = Vec3(m.wb.x[l], m.wb.y[l], m.wb.z[l]);
+      ContactSolver::resistRolling(roll, normal, a, b);
+      m.wa.x[l] = a.w.x(), m.wa.y[l] = a.w.y(), m.wa.z[l] = a.w.z();
+      m.wb.x[l] = b.w.x(), m.wb.y[l] = b.w.y(), m.wb.z[l] = b.w.z();
+    }
+    for (std::uint32_t l = 0; l < batch->lanes; ++l) {
+      if (batch->write_a[l]) {
+        ContactSolver::Motion& a = motion[batch->body_a[l]];
+        a.v = Vec3(m.va.x[l], m.va.y[l], m.va.z[l]);
+        a.w = Vec3(m.wa.x[l], m.wa.y[l], m.wa.z[l]);
+      }
+      if (batch->write_b[l]) {
+        ContactSolver::Motion& b = motion[batch->body_b[l]];
+        b.v = Vec3(m.vb.x[l], m.vb.y[l], m.vb.z[l]);
+        b.w = Vec3(m.wb.x[l], m.wb.y[l], m.wb.z[l]);
+      }
+    }
+  }
+}
+
+// pushStep by translation alone (contact_solver.cpp) for the lanes `on`,
+// with the effective masses `mass`; A moves in the lanes on_a, B in on_b.
+STC_WIDE void pushWide(ContactSolver::WidePush& row, const double (&mass)[kLanes], const WideMask& on,
+                       const WideMask& on_a, const WideMask& on_b, Wide3& va, Wide3& vb) {
+  const Wide zero = {0.0, 0.0, 0.0, 0.0};
+  const Wide3 n = load3(row.n);
+  const Wide lambda = load(row.lambda);
+  const Wide vn = dot(Wide3{vb.x - va.x, vb.y - va.y, vb.z - va.z}, n);
+  const Wide unclamped = lambda + load(mass) * (load(row.push) - vn);
+  WideMask pull;
+  std::memcpy(&pull, row.pull, sizeof pull);
+  const Wide normal = pull ? unclamped : (zero < unclamped ? unclamped : zero);
+  const Wide delta = select(on, normal - lambda, zero);
+  store(row.lambda, select(on, normal, lambda));
+  const Wide ka = load(row.inv_ma) * delta, kb = load(row.inv_mb) * delta;
+  va = select(on_a, Wide3{va.x - ka * n.x, va.y - ka * n.y, va.z - ka * n.z}, va);
+  vb = select(on_b, Wide3{vb.x + kb * n.x, vb.y + kb * n.y, vb.z + kb * n.z}, vb);
+}
+
+// One split-impulse pass over batches (pseudo-velocities, translation
+// alone): the position iterations' (kShock false) or the position shock
+// sweep's, with the supporting bodies held (kShock).
+template <bool kShock>
+STC_WIDE void pushBatchesOf(ContactSolver::WidePush* wide_rows, const ContactSolver::WideBatch* batch,
+                            std::size_t count, ContactSolver::Motion* pseudo) {
+  for (std::size_t k = 0; k < count; ++k, ++batch) {
+    Wide3 va{}, vb{};
+    for (std::uint32_t l = 0; l < batch->lanes; ++l) {
+      const Vec3& a = pseudo[batch->body_a[l]].v;
+      const Vec3& b = pseudo[batch->body_b[l]].v;
+      va.x[l] = a.x(), va.y[l] = a.y(), va.z[l] = a.z();
+      vb.x[l] = b.x(), vb.y[l] = b.y(), vb.z[l] = b.z();
+    }
+    WideMask rows_left, move_a, move_b;
+    for (std::uint32_t l = 0; l < kLanes; ++l) {
+      rows_left[l] = batch->manifold_rows[l];
+      move_a[l] = batch->move_a[l] ? -1 : 0;
+      move_b[l] = batch->move_b[l] ? -1 : 0;
+    }
+    for (std::uint32_t s = 0; s < batch->rows; ++s) {
+      const WideMask slot = {s, s, s, s};
+      const WideMask on = rows_left > slot;
+      ContactSolver::WidePush& row = wide_rows[batch->first_row + s];
+      if (kShock) {
+        pushWide(row, row.shock_mass, on, on & move_a, on & move_b, va, vb);
+      } else {
+        pushWide(row, row.mass, on, on, on, va, vb);
+      }
+    }
+    for (std::uint32_t l = 0; l < batch->lanes; ++l) {
+      if (batch->write_a[l]) pseudo[batch->body_a[l]].v = Vec3(va.x[l], va.y[l], va.z[l]);
+      if (batch->write_b[l]) pseudo[batch->body_b[l]].v = Vec3(vb.x[l], vb.y[l], vb.z[l]);
+    }
+  }
+}
+
+// Compiled for AVX2 too where the compiler can pick at load time (the same
+// operations either way, no FMA: the same bits).
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+#define STC_WIDE_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define STC_WIDE_CLONES
+#endif
+
+STC_WIDE_CLONES void relaxBatches(ContactSolver::WideRow* wide_rows, ContactSolver::Rolling* rolling,
+                                  const ContactSolver::WideBatch* batch, std::size_t count,
+                                  ContactSolver::Motion* motion) {
+  relaxBatchesOf<false>(wide_rows, nullptr, rolling, batch, count, motion);
+}
+
+STC_WIDE_CLONES void shockBatches(ContactSolver::WideRow* wide_rows, const ContactSolver::WideShockMass* shock_mass,
+                                  const ContactSolver::WideBatch* batch, std::size_t count,
+                                  ContactSolver::Motion* motion) {
+  relaxBatchesOf<true>(wide_rows, shock_mass, nullptr, batch, count, motion);
+}
+
+STC_WIDE_CLONES void pushBatches(ContactSolver::WidePush* wide_rows, const ContactSolver::WideBatch* batch,
+                                 std::size_t count, ContactSolver::Motion* pseudo) {
+  pushBatchesOf<false>(wide_rows, batch, count, pseudo);
+}
+
+STC_WIDE_CLONES void shockPushBatches(ContactSolver::WidePush* wide_rows, const ContactSolver::WideBatch* batch,
+                                      std::size_t count, ContactSolver::Motion* pseudo) {
+  pushBatchesOf<true>(wide_rows, batch, count, pseudo);
+}
+
+}  // namespace
+
+void ContactSolver::batchManifolds() {
+  batches_.clear();
+  batch_start_.assign(manifolds_.size() + 1, 0);
+  body_batch_.assign(motion_.size(), 0);
+  // A block's manifolds are in the order from the ground; each level's run
+  // of them (shock propagation's unit, blockManifolds) is batched on its own.
+  const std::uint32_t block_count = partition_.blockCount();
+  for (std::uint32_t block = 0; block < block_count; ++block) {
+    const std::uint32_t end_manifold = block_manifold_start_[block + 1];
+    std::uint32_t open = 0;  // the run's batches before it are full
+    for (std::uint32_t m = block_manifold_start_[block]; m < end_manifold; ++m) {
+      if (m == block_manifold_start_[block] || info_[manifold_start_[m]].level != info_[manifold_start_[m - 1]].level) {
+        open = static_cast<std::uint32_t>(batches_.size());
+        batch_start_[m] = open;
+      }
+      const SolverGroup& group = manifolds_[m];
+      // After the batches of the run's manifolds so far on either body
+      // (body_batch_ from an earlier run is at most the run's first).
+      std::uint32_t k = open;
+      if (group.a != SolverGroup::kStatic) k = std::max(k, body_batch_[group.a]);
+      if (group.b != SolverGroup::kStatic) k = std::max(k, body_batch_[group.b]);
+      while (k < batches_.size() && batches_[k].lanes == kLanes) ++k;
+      if (k == batches_.size()) batches_.emplace_back();
+      WideBatch& batch = batches_[k];
+      batch.manifold[batch.lanes] = m;
+      batch.manifold_rows[batch.lanes] = manifold_start_[m + 1] - manifold_start_[m];
+      batch.rows = std::max(batch.rows, batch.manifold_rows[batch.lanes]);
+      ++batch.lanes;
+      if (group.a != SolverGroup::kStatic) body_batch_[group.a] = k + 1;
+      if (group.b != SolverGroup::kStatic) body_batch_[group.b] = k + 1;
+      while (open < batches_.size() && batches_[open].lanes == kLanes) ++open;
+    }
+    batch_start_[end_manifold] = static_cast<std::uint32_t>(batches_.size());
+  }
+  std::uint32_t wide_rows = 0;
+  for (WideBatch& batch : batches_) {
+    batch.first_row = wide_rows;
+    wide_rows += batch.rows;
+    for (std::uint32_t l = 0; l < batch.lanes; ++l) {
+      const std::uint32_t m = batch.manifold[l];
+      batch.body_a[l] = rows_[manifold_start_[m]].a;
+      batch.body_b[l] = rows_[manifold_start_[m]].b;
+      batch.write_a[l] = manifolds_[m].a != SolverGroup::kStatic;
+      batch.write_b[l] = manifolds_[m].b != SolverGroup::kStatic;
+      batch.move_a[l] = info_[manifold_start_[m]].move_a;
+      batch.move_b[l] = info_[manifold_start_[m]].move_b;
+    }
+  }
+  wide_rows_.resize(wide_rows);
+  wide_shock_mass_.resize(wide_rows);
+  wide_push_.resize(wide_rows);
+}
+
+void ContactSolver::packWide(std::size_t first, std::size_t end) {
+  for (std::size_t k = first; k < end; ++k) {
+    const WideBatch& batch = batches_[k];
+    for (std::uint32_t s = 0; s < batch.rows; ++s) {
+      WideRow& wide = wide_rows_[batch.first_row + s];
+      WideShockMass& shock = wide_shock_mass_[batch.first_row + s];
+      std::memset(&wide, 0, sizeof wide);
+      std::memset(&shock, 0, sizeof shock);
+      for (std::uint32_t l = 0; l < batch.lanes; ++l) {
+        if (s >= batch.manifold_rows[l]) continue;
+        const Row& row = rows_[manifold_start_[batch.manifold[l]] + s];
+        const RowInfo& info = info_[manifold_start_[batch.manifold[l]] + s];
+        for (int i = 0; i < 3; ++i) {
+          wide.ra[i][l] = row.ra[i];
+          wide.rb[i][l] = row.rb[i];
+          wide.n[i][l] = row.n[i];
+          wide.t1[i][l] = row.t1[i];
+          for (int d = 0; d < 3; ++d) {
+            wide.ang_a[d][i][l] = row.ang_a[d][i];
+            wide.ang_b[d][i][l] = row.ang_b[d][i];
+          }
+          wide.mass[i][l] = row.mass[i];
+          shock.mass[i][l] = info.shock_mass[i];
+          wide.lambda[i][l] = row.lambda[i];
+        }
+        wide.inv_ma[l] = row.inv_ma;
+        wide.inv_mb[l] = row.inv_mb;
+        wide.friction[l] = row.friction;
+        wide.speculative[l] = row.speculative;
+        wide.bounce_impulse[l] = row.bounce_impulse;
+      }
+    }
+  }
+}
+
+void ContactSolver::packWidePush(std::size_t first, std::size_t end) {
+  for (std::size_t k = first; k < end; ++k) {
+    const WideBatch& batch = batches_[k];
+    for (std::uint32_t s = 0; s < batch.rows; ++s) {
+      WidePush& wide = wide_push_[batch.first_row + s];
+      std::memset(&wide, 0, sizeof wide);
+      for (std::uint32_t l = 0; l < batch.lanes; ++l) {
+        if (s >= batch.manifold_rows[l]) continue;
+        const std::uint32_t r = manifold_start_[batch.manifold[l]] + s;
+        const Row& row = rows_[r];
+        const RowInfo& info = info_[r];
+        for (int i = 0; i < 3; ++i) wide.n[i][l] = row.n[i];
+        wide.inv_ma[l] = row.inv_ma;
+        wide.inv_mb[l] = row.inv_mb;
+        wide.push[l] = info.push;
+        wide.mass[l] = info.push_mass;
+        wide.shock_mass[l] = info.shock_push_mass;
+        wide.lambda[l] = info.lambda_push;
+        wide.pull[l] = info.bounced && info.push < 0.0 ? -1 : 0;
+      }
+    }
+  }
+}
+
+void ContactSolver::unpackWide(std::size_t first, std::size_t end) {
+  for (std::size_t k = first; k < end; ++k) {
+    const WideBatch& batch = batches_[k];
+    for (std::uint32_t l = 0; l < batch.lanes; ++l) {
+      for (std::uint32_t s = 0; s < batch.manifold_rows[l]; ++s) {
+        const WideRow& wide = wide_rows_[batch.first_row + s];
+        Row& row = rows_[manifold_start_[batch.manifold[l]] + s];
+        for (int i = 0; i < 3; ++i) row.lambda[i] = wide.lambda[i][l];
+      }
+    }
+  }
+}
+
+void ContactSolver::forEachStageBatches(RangeFn batches) {
+  forEachStage([&](std::size_t first, std::size_t end) { batches(batch_start_[first], batch_start_[end]); });
+}
+
+void ContactSolver::propagateShockWide(int passes) {
+  for (std::size_t level = 0; level < shockLevels(); ++level) {
+    for (int pass = 0; pass < passes; ++pass) {
+      forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) {
+        shockBatches(wide_rows_.data(), wide_shock_mass_.data(), batches_.data() + batch_start_[first], batch_start_[end] - batch_start_[first],
+                     motion_.data());
+      });
+    }
+  }
+}
+
+void ContactSolver::solvePositionsWide() {
+  forEachStageBatches([&](std::size_t first, std::size_t end) {
+    pushBatches(wide_push_.data(), batches_.data() + first, end - first, pseudo_.data());
+  });
+}
+
+void ContactSolver::propagatePositionShockWide() {
+  for (std::size_t level = 0; level < shockLevels(); ++level) {
+    forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) {
+      shockPushBatches(wide_push_.data(), batches_.data() + batch_start_[first],
+                       batch_start_[end] - batch_start_[first], pseudo_.data());
+    });
+  }
+}
+
+void ContactSolver::solveVelocitiesWide(int passes) {
+  for (int it = 0; it < passes; ++it) {
+    forEachStageBatches([&](std::size_t first, std::size_t end) {
+      relaxBatches(wide_rows_.data(), any_rolling_ ? rolling_.data() : nullptr, batches_.data() + first, end - first,
+                   motion_.data());
+    });
+  }
+}
+
+}  // namespace stc
