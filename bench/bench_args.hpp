@@ -2,6 +2,8 @@
 // walked in order, so each bench lists only its own flags.
 #pragma once
 
+#include "sphere_tree_collision/types.hpp"
+
 #include <cstdio>
 #include <string>
 
@@ -14,6 +16,12 @@ class Args {
   const std::string& flag() { return flag_ = argv_[next_++]; }
   // The value after the current flag ("" when the flag ends the line).
   std::string value() { return next_ < argc_ ? argv_[next_++] : ""; }
+  // The value after the current flag; throws InputError naming it when the line ends.
+  std::string required() {
+    const std::string v = value();
+    if (v.empty()) throw stc::InputError(flag_, "needs a value");
+    return v;
+  }
   // Says which flag is unknown; the exit code for main.
   int unknown() const {
     std::fprintf(stderr, "unknown argument %s\n", flag_.c_str());

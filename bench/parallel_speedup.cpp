@@ -24,6 +24,7 @@
 //   scene is moving and colliding when timing starts).
 // Last lines: SPEEDUP scene=<name> threads=<N> x=<wall ratio>.
 #include "bench_args.hpp"
+#include "scene_cases.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
@@ -52,10 +53,8 @@ double processCpuSeconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-struct Case {
-  SceneKind kind = SceneKind::CornerDrift;
-  int bodies = 500;
-};
+using Case = stc_bench::SceneCase;
+using stc_bench::caseName;
 
 struct Options {
   std::vector<Case> cases{{SceneKind::CornerDrift, 500},
@@ -129,7 +128,6 @@ double coreRoundTrip() {
 double ms(double s) { return 1e3 * s; }
 double ratio(double a, double b) { return b > 0.0 ? a / b : NAN; }
 
-std::string name(const Case& c) { return std::string(toString(c.kind)) + "_" + std::to_string(c.bodies); }
 
 // Amdahl: t_n / t_1 = s + (1 - s) / n, solved for s from one n.
 double serialFraction(double t1, double tn, int n) {
@@ -177,7 +175,7 @@ double runCase(const Case& c, const Options& opt) {
   const double load_after = loadAverage();
 
   std::printf("\n## %s: %d ticks timed after %d, threads 1 vs %d (load average %.2f -> %.2f)\n\n",
-              name(c).c_str(), ticks, settle, opt.threads, load_before, load_after);
+              caseName(c).c_str(), ticks, settle, opt.threads, load_before, load_after);
   std::printf("contacts %.0f, manifolds %.0f, solver slabs %.1f, manifolds across slabs %.0f a tick (mean)\n\n",
               r1.contacts / ticks, r1.manifolds / ticks, r1.slabs / ticks, r1.crossing / ticks);
   std::printf("| phase | 1 thread ms | %d threads ms | speed-up |\n|---|---|---|---|\n", opt.threads);
@@ -210,37 +208,13 @@ double runCase(const Case& c, const Options& opt) {
   return x;
 }
 
-Case parseCase(const std::string& item) {
-  const std::size_t colon = item.find(':');
-  Case c;
-  c.kind = parseScene(item.substr(0, colon));
-  if (colon != std::string::npos) c.bodies = std::stoi(item.substr(colon + 1));
-  if (c.bodies < 1) throw InputError("--scenes", "entity count must be >= 1");
-  return c;
-}
-
-// The value after `flag`; throws InputError naming the flag when the line ends.
-std::string valueOf(stc_bench::Args& args, const std::string& flag) {
-  const std::string v = args.value();
-  if (v.empty()) throw InputError(flag, "needs a value");
-  return v;
-}
-
 Options parseOptions(int argc, char** argv) {
   Options o;
   for (stc_bench::Args args(argc, argv); args.more();) {
     const std::string a = args.flag();
-    const auto next = [&] { return valueOf(args, a); };
+    const auto next = [&] { return args.required(); };
     if (a == "--scenes") {
-      o.cases.clear();
-      const std::string list = next();
-      std::size_t start = 0;
-      while (start <= list.size()) {
-        const std::size_t comma = list.find(',', start);
-        o.cases.push_back(parseCase(list.substr(start, comma - start)));
-        if (comma == std::string::npos) break;
-        start = comma + 1;
-      }
+      o.cases = stc_bench::parseSceneCases(next());
     } else if (a == "--threads") {
       o.threads = std::stoi(next());
       validateThreads(o.threads);
@@ -276,7 +250,7 @@ int main(int argc, char** argv) {
   for (const Case& c : opt.cases) {
     const double x = runCase(c, opt);
     char buf[128];
-    std::snprintf(buf, sizeof buf, "SPEEDUP scene=%s threads=%d x=%.2f", name(c).c_str(), opt.threads, x);
+    std::snprintf(buf, sizeof buf, "SPEEDUP scene=%s threads=%d x=%.2f", caseName(c).c_str(), opt.threads, x);
     lines.emplace_back(buf);
   }
   std::printf("\n");
