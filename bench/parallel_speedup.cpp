@@ -56,15 +56,9 @@ double processCpuSeconds() {
 using Case = stc_bench::SceneCase;
 using stc_bench::caseName;
 
-struct Options {
-  std::vector<Case> cases{{SceneKind::CornerDrift, 500},
-                          {SceneKind::Rockfall, 1000},
-                          {SceneKind::PackedBox, 500},
-                          {SceneKind::CubeBox, 10000}};
+struct Options : stc_bench::SceneTiming {
+  Options() { seconds = 6.0; }
   int threads = 2;
-  double seconds = 6.0;
-  double cube_seconds = 1.5;
-  double settle = 1.0;
 };
 
 // Per-tick samples of one run, seconds.
@@ -147,7 +141,7 @@ double runCase(const Case& c, const Options& opt) {
     one.step(spec.dt, Budget::unlimited());
     many.step(spec.dt, Budget::unlimited());
   }
-  const double seconds = c.kind == SceneKind::CubeBox ? opt.cube_seconds : opt.seconds;
+  const double seconds = opt.secondsOf(c);
   const int ticks = std::max(1, static_cast<int>(std::lround(seconds / spec.dt)));
   const int block = 30;  // ticks per turn: the two runs take turns
   Run r1, rn;
@@ -212,25 +206,14 @@ Options parseOptions(int argc, char** argv) {
   Options o;
   for (stc_bench::Args args(argc, argv); args.more();) {
     const std::string a = args.flag();
-    const auto next = [&] { return args.required(); };
-    if (a == "--scenes") {
-      o.cases = stc_bench::parseSceneCases(next());
-    } else if (a == "--threads") {
-      o.threads = std::stoi(next());
+    if (o.take(a, args)) continue;
+    if (a == "--threads") {
+      o.threads = std::stoi(args.required());
       validateThreads(o.threads);
       if (o.threads < 2) throw InputError("--threads", "compare with at least 2");
-    } else if (a == "--seconds") {
-      o.seconds = std::stod(next());
-    } else if (a == "--cube-seconds") {
-      o.cube_seconds = std::stod(next());
-    } else if (a == "--settle") {
-      o.settle = std::stod(next());
     } else {
       throw InputError(a, "unknown option (see the comment at the top of bench/parallel_speedup.cpp)");
     }
-  }
-  if (!(o.seconds > 0.0) || !(o.cube_seconds > 0.0) || !(o.settle >= 0.0)) {
-    throw InputError("--seconds", "seconds must be > 0 and --settle >= 0");
   }
   return o;
 }

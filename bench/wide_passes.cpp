@@ -38,15 +38,7 @@ using stc_bench::threadCpuSeconds;
 using Case = stc_bench::SceneCase;
 using stc_bench::caseName;
 
-struct Options {
-  std::vector<Case> cases{{SceneKind::CornerDrift, 500},
-                          {SceneKind::Rockfall, 1000},
-                          {SceneKind::PackedBox, 500},
-                          {SceneKind::CubeBox, 10000}};
-  double seconds = 3.0;
-  double cube_seconds = 1.5;
-  double settle = 1.0;
-};
+using Options = stc_bench::SceneTiming;  // its defaults: 3 s a scene, cube_box 1.5 s, 1 s settling
 
 struct Run {
   std::vector<double> tick_cpu, response;  // seconds per tick
@@ -89,20 +81,9 @@ Options parseOptions(int argc, char** argv) {
   Options o;
   for (stc_bench::Args args(argc, argv); args.more();) {
     const std::string a = args.flag();
-    if (a == "--scenes") {
-      o.cases = stc_bench::parseSceneCases(args.required());
-    } else if (a == "--seconds") {
-      o.seconds = std::stod(args.required());
-    } else if (a == "--cube-seconds") {
-      o.cube_seconds = std::stod(args.required());
-    } else if (a == "--settle") {
-      o.settle = std::stod(args.required());
-    } else {
+    if (!o.take(a, args)) {
       throw InputError(a, "unknown option (see the comment at the top of bench/wide_passes.cpp)");
     }
-  }
-  if (!(o.seconds > 0.0) || !(o.cube_seconds > 0.0) || !(o.settle >= 0.0)) {
-    throw InputError("--seconds", "seconds must be > 0 and --settle >= 0");
   }
   return o;
 }
@@ -126,7 +107,7 @@ int main(int argc, char** argv) {
     SceneWorld one = makeWorld(c, false);
     SceneWorld wide = makeWorld(c, true);
     const double dt = one.spec.dt;
-    const double seconds = c.kind == SceneKind::CubeBox ? options.cube_seconds : options.seconds;
+    const double seconds = options.secondsOf(c);
     const int ticks = std::max(1, static_cast<int>(std::lround(seconds / dt)));
     const int settle = static_cast<int>(std::lround(options.settle / dt));
     bool same = true;

@@ -66,6 +66,23 @@ STC_WIDE Wide3 select(const WideMask& on, const Wide3& yes, const Wide3& no) {
   return {on ? yes.x : no.x, on ? yes.y : no.y, on ? yes.z : no.z};
 }
 
+// A batch's lanes: which have a row in a slot, and which bodies shock
+// propagation moves (the others it holds).
+struct LaneMasks {
+  WideMask rows, move_a, move_b;
+  STC_WIDE explicit LaneMasks(const ContactSolver::WideBatch& batch) {
+    for (std::uint32_t l = 0; l < kLanes; ++l) {
+      rows[l] = batch.manifold_rows[l];
+      move_a[l] = batch.move_a[l] ? -1 : 0;
+      move_b[l] = batch.move_b[l] ? -1 : 0;
+    }
+  }
+  STC_WIDE WideMask withRow(std::uint32_t slot) const {
+    const WideMask at = {slot, slot, slot, slot};
+    return rows > at;
+  }
+};
+
 // relaxRow for the lanes `on`, with the effective masses `mass`: friction,
 // then non-penetration. Body A's velocities change only in the lanes on_a,
 // B's in on_b (shock propagation holds a supporting body still).
@@ -148,18 +165,12 @@ STC_WIDE void relaxBatchesOf(ContactSolver::WideRow* wide_rows, const ContactSol
       m.vb.x[l] = b.v.x(), m.vb.y[l] = b.v.y(), m.vb.z[l] = b.v.z();
       m.wb.x[l] = b.w.x(), m.wb.y[l] = b.w.y(), m.wb.z[l] = b.w.z();
     }
-    WideMask rows_left, move_a, move_b;
-    for (std::uint32_t l = 0; l < kLanes; ++l) {
-      rows_left[l] = batch->manifold_rows[l];
-      move_a[l] = batch->move_a[l] ? -1 : 0;
-      move_b[l] = batch->move_b[l] ? -1 : 0;
-    }
+    const LaneMasks lanes(*batch);
     for (std::uint32_t s = 0; s < batch->rows; ++s) {
-      const WideMask slot = {s, s, s, s};
-      const WideMask on = rows_left > slot;
+      const WideMask on = lanes.withRow(s);
       ContactSolver::WideRow& row = wide_rows[batch->first_row + s];
       if (kShock) {
-        relaxWide(row, shock_mass[batch->first_row + s].mass, on, on & move_a, on & move_b, m);
+        relaxWide(row, shock_mass[batch->first_row + s].mass, on, on & lanes.move_a, on & lanes.move_b, m);
       } else {
         relaxWide(row, row.mass, on, on, on, m);
       }
@@ -230,18 +241,12 @@ STC_WIDE void pushBatchesOf(ContactSolver::WidePush* wide_rows, const ContactSol
       va.x[l] = a.x(), va.y[l] = a.y(), va.z[l] = a.z();
       vb.x[l] = b.x(), vb.y[l] = b.y(), vb.z[l] = b.z();
     }
-    WideMask rows_left, move_a, move_b;
-    for (std::uint32_t l = 0; l < kLanes; ++l) {
-      rows_left[l] = batch->manifold_rows[l];
-      move_a[l] = batch->move_a[l] ? -1 : 0;
-      move_b[l] = batch->move_b[l] ? -1 : 0;
-    }
+    const LaneMasks lanes(*batch);
     for (std::uint32_t s = 0; s < batch->rows; ++s) {
-      const WideMask slot = {s, s, s, s};
-      const WideMask on = rows_left > slot;
+      const WideMask on = lanes.withRow(s);
       ContactSolver::WidePush& row = wide_rows[batch->first_row + s];
       if (kShock) {
-        pushWide(row, row.shock_mass, on, on & move_a, on & move_b, va, vb);
+        pushWide(row, row.shock_mass, on, on & lanes.move_a, on & lanes.move_b, va, vb);
       } else {
         pushWide(row, row.mass, on, on, on, va, vb);
       }
