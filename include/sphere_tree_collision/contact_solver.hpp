@@ -143,8 +143,8 @@ class ContactSolver {
   // `normal`, on the pair's velocities a and b (after its rows, in a pass).
   static void resistRolling(Rolling& roll, double normal, Motion& a, Motion& b);
 
-  // The sequential velocity passes take kLanes manifolds side by side
-  // (contact_solver_wide.cpp).
+  // The sequential passes take kLanes manifolds side by side
+  // (contact_solver_wide.cpp; public for its kernels).
   static constexpr std::uint32_t kLanes = 4;
   // One row of each lane's manifold (a lane without one here is left alone).
   // What a velocity pass streams: t2 is n x t1 again (tangentBasis), and
@@ -271,8 +271,8 @@ class ContactSolver {
   void propagatePositionShock(const ResponseOptions& options);
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
 
-  // The sequential velocity passes, kLanes manifolds side by side
-  // (contact_solver_wide.cpp): a block's manifolds in batches that share no
+  // The sequential passes (velocity, shock, position, position shock),
+  // kLanes manifolds side by side (contact_solver_wide.cpp): a block's manifolds in batches that share no
   // movable body, each manifold in a batch after those of the block's earlier
   // manifolds on its bodies. Every body so meets its manifolds in the block's
   // order, and the passes give the one-at-a-time passes' result bit for bit.
@@ -293,12 +293,12 @@ class ContactSolver {
   // batches(first, end) over each block's batches, stage by stage (as forEachStage).
   void forEachStageBatches(RangeFn batches);
 
-  bool wide_ = false;  // this solve's velocity passes run on the batches
+  bool wide_ = false;  // this solve's sequential passes run on the batches
   std::vector<WideBatch> batches_;
   std::vector<WideRow> wide_rows_;
   std::vector<WideShockMass> wide_shock_mass_;
   std::vector<WidePush> wide_push_;
-  std::vector<std::uint32_t> batch_start_;  // by manifold, at block boundaries
+  std::vector<std::uint32_t> batch_start_;  // by manifold, where a block or a level's run in it starts
   std::vector<std::uint32_t> body_batch_;   // batchManifolds: a body's last batch + 1
 
   std::vector<Row> rows_;

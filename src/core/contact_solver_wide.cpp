@@ -1,9 +1,10 @@
-// The sequential velocity passes four manifolds at a time. One row step is a
-// short chain of dependent scalar operations; four manifolds that share no
-// movable body go through the same operations side by side, one lane each,
-// in vector registers. The operations and their order are the scalar
-// relaxRow's (contact_solver.cpp), with no fused multiply-add, so each lane
-// computes the scalar result bit for bit.
+// The solver's sequential passes (velocity, shock propagation, position by
+// translation, position shock) four manifolds at a time. A row step is a
+// short run of scalar operations; four manifolds that share no movable body
+// go through the same operations side by side, one lane each, in vector
+// registers. The operations and their order are those of relaxRow and
+// pushStep (contact_solver.cpp), with no fused multiply-add (CMakeLists.txt),
+// so each lane computes the one-at-a-time result bit for bit.
 #include "sphere_tree_collision/contact_solver.hpp"
 
 #include <cmath>
@@ -27,7 +28,7 @@ static_assert(kLanes == 4, "the lane types below are four doubles wide");
 typedef double Wide __attribute__((vector_size(32)));
 typedef long long WideMask __attribute__((vector_size(32)));
 
-// Everything below is inlined into relaxBatches, so it is compiled for its clones.
+// Everything below is inlined into the batch loops, so it is compiled for their clones.
 #define STC_WIDE inline __attribute__((always_inline))
 
 struct Wide3 {
