@@ -12,7 +12,7 @@
 
 // The vector types below never cross a call that is not inlined, so the
 // ABI note about passing them without AVX does not apply.
-#if defined(__GNUC__) && !defined(__clang__)
+#if defined(__GNUC__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 
