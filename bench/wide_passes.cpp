@@ -16,6 +16,7 @@
 //   --settle: simulated time run first, untimed (both worlds).
 // Last lines: WIDE scene=<name> tick_x=<ratio of tick CPU p50> response_x=<ratio of response p50>.
 #include "bench_args.hpp"
+#include "same_bits.hpp"
 #include "scene_cases.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -64,12 +65,7 @@ void timedTicks(World& world, double dt, int ticks, Run& run) {
 bool sameBodies(const World& x, const World& y) {
   if (x.entityCount() != y.entityCount()) return false;
   for (std::size_t i = 0; i < x.entityCount(); ++i) {
-    const BodyState& a = x.bodies()[i];
-    const BodyState& b = y.bodies()[i];
-    if (a.pose.position != b.pose.position || a.pose.orientation.coeffs() != b.pose.orientation.coeffs() ||
-        a.linear_velocity != b.linear_velocity || a.angular_velocity != b.angular_velocity) {
-      return false;
-    }
+    if (!sameBits(x.bodies()[i], y.bodies()[i])) return false;
   }
   return true;
 }

@@ -292,6 +292,8 @@ class ContactSolver {
   void propagatePositionShockWide();
   // batches(first, end) over each block's batches, stage by stage (as forEachStage).
   void forEachStageBatches(RangeFn batches);
+  // The same over one shock level's batches (as forEachStageOfLevel).
+  void forEachStageBatchesOfLevel(std::size_t level, RangeFn batches);
 
   bool wide_ = false;  // this solve's sequential passes run on the batches
   std::vector<WideBatch> batches_;

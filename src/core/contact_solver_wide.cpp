@@ -420,12 +420,15 @@ void ContactSolver::forEachStageBatches(RangeFn batches) {
   forEachStage([&](std::size_t first, std::size_t end) { batches(batch_start_[first], batch_start_[end]); });
 }
 
+void ContactSolver::forEachStageBatchesOfLevel(std::size_t level, RangeFn batches) {
+  forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) { batches(batch_start_[first], batch_start_[end]); });
+}
+
 void ContactSolver::propagateShockWide(int passes) {
   for (std::size_t level = 0; level < shockLevels(); ++level) {
     for (int pass = 0; pass < passes; ++pass) {
-      forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) {
-        shockBatches(wide_rows_.data(), wide_shock_mass_.data(), batches_.data() + batch_start_[first], batch_start_[end] - batch_start_[first],
-                     motion_.data());
+      forEachStageBatchesOfLevel(level, [&](std::size_t first, std::size_t end) {
+        shockBatches(wide_rows_.data(), wide_shock_mass_.data(), batches_.data() + first, end - first, motion_.data());
       });
     }
   }
@@ -439,9 +442,8 @@ void ContactSolver::solvePositionsWide() {
 
 void ContactSolver::propagatePositionShockWide() {
   for (std::size_t level = 0; level < shockLevels(); ++level) {
-    forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) {
-      shockPushBatches(wide_push_.data(), batches_.data() + batch_start_[first],
-                       batch_start_[end] - batch_start_[first], pseudo_.data());
+    forEachStageBatchesOfLevel(level, [&](std::size_t first, std::size_t end) {
+      shockPushBatches(wide_push_.data(), batches_.data() + first, end - first, pseudo_.data());
     });
   }
 }

@@ -2,6 +2,7 @@
 // contact compared with ==, none within a tolerance.
 #pragma once
 
+#include "same_bits.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <gtest/gtest.h>
@@ -13,11 +14,7 @@ namespace stc {
 inline ::testing::AssertionResult sameState(const World& x, const World& y) {
   if (x.entityCount() != y.entityCount()) return ::testing::AssertionFailure() << "entity counts differ";
   for (std::size_t i = 0; i < x.entityCount(); ++i) {
-    const BodyState& a = x.bodies()[i];
-    const BodyState& b = y.bodies()[i];
-    if (x.entityIds()[i] != y.entityIds()[i] || a.pose.position != b.pose.position ||
-        a.pose.orientation.coeffs() != b.pose.orientation.coeffs() || a.linear_velocity != b.linear_velocity ||
-        a.angular_velocity != b.angular_velocity) {
+    if (x.entityIds()[i] != y.entityIds()[i] || !sameBits(x.bodies()[i], y.bodies()[i])) {
       return ::testing::AssertionFailure() << "body " << i << " differs";
     }
   }
