@@ -292,6 +292,14 @@ STC_WIDE_CLONES void shockPushBatches(ContactSolver::WidePush* wide_rows, const 
 }  // namespace
 
 void ContactSolver::batchManifolds() {
+  // Sized by the rows, in the tick they grow (no allocation in a later tick
+  // that batches differently with no more rows): a batch holds at least one
+  // manifold, and its wide rows are at most its manifolds' rows.
+  batch_start_.reserve(rows_.size() + 1);
+  batches_.reserve(rows_.size());
+  wide_rows_.reserve(rows_.size());
+  wide_shock_mass_.reserve(rows_.size());
+  wide_push_.reserve(rows_.size());
   batches_.clear();
   batch_start_.assign(manifolds_.size() + 1, 0);
   body_batch_.assign(motion_.size(), 0);
