@@ -3,6 +3,7 @@
 #include "sphere_tree_collision/contact_solver.hpp"
 
 #include "sphere_tree_collision/dynamics.hpp"
+#include "grow_capacity.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -144,12 +145,12 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   // Everything sized by the rows grows with them, in the same tick (no
   // allocation in a later tick whose waves or manifolds happen to be larger;
   // both warm-start buffers, as they swap every tick).
-  for (std::vector<std::uint32_t>* v : {&wave_rows_, &last_wave_rows_, &next_wave_rows_}) v->reserve(rows_.size());
-  row_bodies_.reserve(rows_.size());
+  for (std::vector<std::uint32_t>* v : {&wave_rows_, &last_wave_rows_, &next_wave_rows_}) growCapacity(*v, rows_.size());
+  growCapacity(row_bodies_, rows_.size());
   for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_, &merged_manifolds_}) {
-    v->reserve(rows_.size());
+    growCapacity(*v, rows_.size());
   }
-  for (std::vector<CachedPoint>* v : {&cache_, &next_cache_}) v->reserve(rows_.size());
+  for (std::vector<CachedPoint>* v : {&cache_, &next_cache_}) growCapacity(*v, rows_.size());
   // Each row from its contact alone: in pieces on the workers.
   const auto prepareRow = [&](std::size_t r) {
     const std::uint32_t ci = order_[r];

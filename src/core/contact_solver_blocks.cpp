@@ -2,6 +2,8 @@
 // that runs a pass over them stage by stage, each stage's blocks in parallel.
 #include "sphere_tree_collision/contact_solver.hpp"
 
+#include "grow_capacity.hpp"
+
 #include <limits>
 
 namespace stc {
@@ -16,11 +18,11 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const s
   // Sized by the contacts, in the tick they grow (no allocation in a later
   // tick with more manifolds or levels and no more contacts).
   for (std::vector<std::uint32_t>* v : {&group_first_, &group_order_, &block_order_, &manifold_start_, &cursor_}) {
-    v->reserve(order_.size() + 1);
+    growCapacity(*v, order_.size() + 1);
   }
-  groups_.reserve(order_.size());
-  manifolds_.reserve(order_.size());
-  levels_.reserve(order_.size());
+  growCapacity(groups_, order_.size());
+  growCapacity(manifolds_, order_.size());
+  growCapacity(levels_, order_.size());
   for (std::size_t p = 0; p < order_.size(); ++p) {
     const Contact& c = contacts[order_[p]];
     const int level = levelOf(c);

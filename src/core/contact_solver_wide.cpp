@@ -7,6 +7,8 @@
 // so each lane computes the one-at-a-time result bit for bit.
 #include "sphere_tree_collision/contact_solver.hpp"
 
+#include "grow_capacity.hpp"
+
 #include <cmath>
 #include <cstring>
 
@@ -294,13 +296,14 @@ STC_WIDE_CLONES void shockPushBatches(ContactSolver::WidePush* wide_rows, const 
 void ContactSolver::batchManifolds() {
   // Sized by the rows, in the tick they grow (no allocation in a later tick
   // that batches differently with no more rows): a batch holds at least one
-  // manifold, and its wide rows are at most its manifolds' rows.
-  batch_start_.reserve(rows_.size() + 1);
-  batches_.reserve(rows_.size());
-  wide_rows_.reserve(rows_.size());
-  wide_shock_mass_.reserve(rows_.size());
-  wide_push_.reserve(rows_.size());
+  // manifold, and its wide rows are at most its manifolds' rows. The batches
+  // are cleared first: a growth copies nothing of the last tick's.
   batches_.clear();
+  growCapacity(batch_start_, rows_.size() + 1);
+  growCapacity(batches_, rows_.size());
+  growCapacity(wide_rows_, rows_.size());
+  growCapacity(wide_shock_mass_, rows_.size());
+  growCapacity(wide_push_, rows_.size());
   batch_start_.assign(manifolds_.size() + 1, 0);
   body_batch_.assign(motion_.size(), 0);
   // A block's manifolds are in the order from the ground; each level's run
