@@ -35,6 +35,7 @@
 //   (one command line; callgrind_annotate --inclusive=yes on its output file)
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "scene_cases.hpp"
 #include "tick_clock.hpp"
 
 #include <btBulletDynamicsCommon.h>
@@ -59,15 +60,12 @@ using stc_bench::maxOf;
 using stc_bench::meanOf;
 using stc_bench::percentile;
 
-struct Case {
-  SceneKind kind;
-  int bodies;
-};
-const Case kDefaultCases[] = {{SceneKind::CornerDrift, 500},
-                              {SceneKind::PackedBox, 500},
-                              {SceneKind::Rockfall, 1000},
-                              {SceneKind::Rockfall, 5000},
-                              {SceneKind::CubeBox, 10000}};
+using Case = stc_bench::SceneCase;
+const std::vector<Case> kDefaultCases{{SceneKind::CornerDrift, 500},
+                                      {SceneKind::PackedBox, 500},
+                                      {SceneKind::Rockfall, 1000},
+                                      {SceneKind::Rockfall, 5000},
+                                      {SceneKind::CubeBox, 10000}};
 
 // What one engine did over one run of one scene.
 struct Run {
@@ -450,22 +448,7 @@ Options parse(int argc, char** argv) {
       throw InputError(a, "unknown argument");
     }
   }
-  if (scenes.empty()) {
-    o.cases.assign(std::begin(kDefaultCases), std::end(kDefaultCases));
-  }
-  for (const std::string& item : splitList(scenes)) {
-    const auto colon = item.find(':');
-    const SceneKind kind = parseScene(item.substr(0, colon));
-    if (colon != std::string::npos) {
-      const int bodies = std::stoi(item.substr(colon + 1));
-      if (bodies <= 0) throw InputError("--scenes", "bodies must be > 0 in '" + item + "'");
-      o.cases.push_back({kind, bodies});
-      continue;
-    }
-    for (const Case& c : kDefaultCases) {
-      if (c.kind == kind) o.cases.push_back(c);
-    }
-  }
+  o.cases = scenes.empty() ? kDefaultCases : stc_bench::parseSceneCases(scenes, kDefaultCases);
   return o;
 }
 

@@ -6,6 +6,7 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/types.hpp"
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -16,24 +17,31 @@ struct SceneCase {
   int bodies = 500;
 };
 
-// "corner_drift:500" (the count may be left out: 500); throws InputError("--scenes").
-inline SceneCase parseSceneCase(const std::string& item) {
-  const std::size_t colon = item.find(':');
-  SceneCase c;
-  c.kind = stc::parseScene(item.substr(0, colon));
-  if (colon != std::string::npos) c.bodies = std::stoi(item.substr(colon + 1));
-  if (c.bodies < 1) throw stc::InputError("--scenes", "entity count must be >= 1");
-  return c;
-}
-
-inline std::vector<SceneCase> parseSceneCases(const std::string& list) {
+// "rockfall:1000", or a bare "rockfall": that scene's cases in `defaults`
+// (500 bodies when it has none). Empty items are skipped. Throws
+// InputError("--scenes") on a count below 1 or an unknown name.
+inline std::vector<SceneCase> parseSceneCases(const std::string& list, const std::vector<SceneCase>& defaults = {}) {
   std::vector<SceneCase> cases;
   std::size_t start = 0;
   while (start <= list.size()) {
-    const std::size_t comma = list.find(',', start);
-    cases.push_back(parseSceneCase(list.substr(start, comma - start)));
-    if (comma == std::string::npos) break;
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    const std::string item = list.substr(start, comma - start);
     start = comma + 1;
+    if (item.empty()) continue;
+    const std::size_t colon = item.find(':');
+    SceneCase c;
+    c.kind = stc::parseScene(item.substr(0, colon));
+    if (colon == std::string::npos) {
+      const std::size_t before = cases.size();
+      for (const SceneCase& d : defaults) {
+        if (d.kind == c.kind) cases.push_back(d);
+      }
+      if (cases.size() == before) cases.push_back(c);
+      continue;
+    }
+    c.bodies = std::stoi(item.substr(colon + 1));
+    if (c.bodies < 1) throw stc::InputError("--scenes", "entity count must be >= 1 in '" + item + "'");
+    cases.push_back(c);
   }
   return cases;
 }
@@ -56,7 +64,7 @@ struct SceneTiming {
   // or --settle (false: not one of them); throws InputError naming it.
   bool take(const std::string& flag, Args& args) {
     if (flag == "--scenes") {
-      cases = parseSceneCases(args.required());
+      cases = parseSceneCases(args.required(), cases);
     } else if (flag == "--seconds") {
       seconds = std::stod(args.required());
     } else if (flag == "--cube-seconds") {
