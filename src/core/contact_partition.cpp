@@ -1,12 +1,15 @@
 // Spatial partition of the solver's contact groups (contact_partition.hpp).
 #include "sphere_tree_collision/contact_partition.hpp"
 
+#include "grow_capacity.hpp"
+
 #include <algorithm>
 #include <cmath>
 
 namespace stc {
 
 void ContactPartition::assign(const std::vector<SolverGroup>& groups, const std::vector<BodyState>& bodies) {
+  growCapacity(block_, groups.size());  // assign alone would reallocate to the exact count
   block_.assign(groups.size(), 0);
   slabs_ = 1;
   crossing_ = 0;

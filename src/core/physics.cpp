@@ -4,6 +4,8 @@
 
 #include "sphere_tree_collision/dynamics.hpp"
 
+#include "grow_capacity.hpp"
+
 #include <algorithm>
 
 namespace stc {
@@ -99,6 +101,7 @@ void Physics::respond(const StepContext& step) {
   const std::size_t count = step.pair_count;
   std::vector<Contact>& contacts = *step.contacts;
   contacts.clear();
+  growCapacity(sweep_hit_of_pair_, count);  // assign alone would reallocate to the exact count
   sweep_hit_of_pair_.assign(count, -1);
   for (const std::uint32_t body : sweep_scratch_.clamped) {
     const SweepHit& hit = sweep_scratch_.hits[body];
