@@ -419,23 +419,19 @@ std::vector<std::string> splitList(const std::string& s) {
 Options parse(int argc, char** argv) {
   Options o;
   std::string scenes;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) throw InputError(a, "needs a value");
-      return argv[++i];
-    };
+  for (stc_bench::Args args(argc, argv); args.more();) {
+    const std::string a = args.flag();
     if (a == "--seconds") {
-      o.seconds = std::stod(next());
+      o.seconds = std::stod(args.required());
       if (!(o.seconds > 0.0)) throw InputError("--seconds", "must be > 0");
     } else if (a == "--settle") {
-      o.settle = std::stod(next());
+      o.settle = std::stod(args.required());
       if (!(o.settle >= 0.0)) throw InputError("--settle", "must be >= 0");
     } else if (a == "--scenes") {
-      scenes = next();
-    } else if (a == "--variants") {
+      scenes = args.required();
+    } else if (a == "--variants") {  // may be empty: no Bullet run
       o.variants.clear();
-      for (const std::string& v : splitList(next())) {
+      for (const std::string& v : splitList(args.value())) {
         if (v == "compound") o.variants.push_back(BulletShape::Compound);
         else if (v == "hull") o.variants.push_back(BulletShape::Hull);
         else throw InputError("--variants", "unknown value '" + v + "' (expected compound, hull)");
@@ -443,7 +439,7 @@ Options parse(int argc, char** argv) {
     } else if (a == "--bullet-only") {
       o.bullet_only = true;
     } else if (a == "--markdown") {
-      o.markdown = next();
+      o.markdown = args.required();
     } else {
       throw InputError(a, "unknown argument");
     }
