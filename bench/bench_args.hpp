@@ -5,6 +5,7 @@
 #include "sphere_tree_collision/types.hpp"
 
 #include <cstdio>
+#include <exception>
 #include <string>
 
 namespace stc_bench {
@@ -34,5 +35,19 @@ class Args {
   int next_ = 1;
   std::string flag_;
 };
+
+// A bench's flags parsed by `parse(argc, argv)` into `out`; a bad flag
+// (InputError or a number that does not read) is printed as "<bench>: <why>"
+// and false returned: main then exits with 2.
+template <typename Options, typename Parse>
+bool parseFlags(const char* bench, Parse parse, int argc, char** argv, Options& out) {
+  try {
+    out = parse(argc, argv);
+    return true;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", bench, e.what());
+    return false;
+  }
+}
 
 }  // namespace stc_bench

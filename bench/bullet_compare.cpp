@@ -452,12 +452,7 @@ Options parse(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   Options opt;
-  try {
-    opt = parse(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_bullet_compare: %s\n", e.what());
-    return 2;
-  }
+  if (!stc_bench::parseFlags("bench_bullet_compare", parse, argc, argv, opt)) return 2;
   const int ticks = static_cast<int>(std::lround(opt.seconds * 60.0));
   const int settle_ticks = static_cast<int>(std::lround(opt.settle * 60.0));
   std::string runs_md =

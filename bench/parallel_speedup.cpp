@@ -222,12 +222,7 @@ Options parseOptions(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   Options opt;
-  try {
-    opt = parseOptions(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_parallel_speedup: %s\n", e.what());
-    return 2;
-  }
+  if (!stc_bench::parseFlags("bench_parallel_speedup", parseOptions, argc, argv, opt)) return 2;
   std::printf("# Parallel tick: 1 vs %d threads, unlimited budget (load average %.2f)\n", opt.threads, loadAverage());
   std::vector<std::string> lines;
   for (const Case& c : opt.cases) {

@@ -88,12 +88,7 @@ Options parseOptions(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   Options options;
-  try {
-    options = parseOptions(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_wide_passes: %s\n", e.what());
-    return 2;
-  }
+  if (!stc_bench::parseFlags("bench_wide_passes", parseOptions, argc, argv, options)) return 2;
   constexpr int kTurn = 30;  // ticks per turn
   std::printf("# solver passes four manifolds wide against one at a time: one thread, unlimited budget\n");
   std::printf("| scene | ticks | tick CPU p50 / mean ms, one at a time | four wide | response p50 / mean ms, one at a time "
