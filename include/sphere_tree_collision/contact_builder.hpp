@@ -8,6 +8,7 @@
 #include "sphere_tree_collision/types.hpp"
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace stc {
@@ -104,10 +105,16 @@ void gatherCandidates(const PairTest& test, const PairGeometry& geometry, std::v
 // Largest overlap of the candidates (-infinity when there are none).
 double deepestOverlap(const std::vector<ContactCandidate>& candidates);
 // 2. Refines (PairGeometry::refine) the candidates with at least half the
-// deepest overlap (all of them when nothing overlaps); only those can
-// represent the pair, the others only join clusters.
+// deepest overlap (only the deepest when nothing overlaps); only those can
+// represent the pair.
 void refineDeepCandidates(std::vector<ContactCandidate>& candidates, double deepest, const PairGeometry& geometry,
                           bool face_normals);
+// 2b. Drops the candidates refineDeepCandidates left unrefined: they can
+// neither represent the pair nor give a cluster its normal, and on a face of
+// leaf spheres, where they are four in five (the neighbours across, their
+// lines of centres 45 degrees off the face), none measures a separation
+// either. The steps after it walked past them, pair after pair.
+void dropShallowCandidates(std::vector<ContactCandidate>& candidates);
 // Most representatives a pair can have (ContactBuildOptions::max_contacts_per_pair).
 constexpr int kMaxRepresentatives = 16;
 
@@ -120,6 +127,16 @@ constexpr int kMaxRepresentatives = 16;
 // so it leaves every candidate in its cluster, as assignClusters does.
 void pickRepresentatives(std::vector<ContactCandidate>& candidates, double deepest, int limit,
                          std::vector<int>& reps);
+// Where the candidates lie, as pickRepresentatives measures from it: the mean
+// of their points and their smallest reach (r_a + r_b, the length unit).
+struct CandidateSpread {
+  Vec3 centroid = Vec3::Zero();
+  double scale = std::numeric_limits<double>::infinity();
+};
+CandidateSpread spreadOf(const std::vector<ContactCandidate>& candidates);
+// ... measuring from `spread` (spreadOf the set before dropShallowCandidates).
+void pickRepresentatives(std::vector<ContactCandidate>& candidates, double deepest, int limit,
+                         const CandidateSpread& spread, std::vector<int>& reps);
 // 4. Every candidate joins its nearest representative (cluster = position in
 // reps; a tie goes to the earlier one).
 void assignClusters(std::vector<ContactCandidate>& candidates, const std::vector<int>& reps);
@@ -160,7 +177,7 @@ class ContactBuilder {
   // Appends the contacts of one test (none when Separate, or Unresolved and not accepted).
   // bounds_a/bounds_b: of the test's trees, or nullptr (surface at the spheres).
   // The steps, in order: gatherCandidates, refineDeepCandidates,
-  // pickRepresentatives (which assigns the clusters), then one contact per cluster
+  // spreadOf, dropShallowCandidates, pickRepresentatives (which assigns the clusters), then one contact per cluster
   // (clusterNormals, clusterSeparations).
   void append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b, double priority,
               const BodySurface& a, const BodySurface& b, const ContactBuildOptions& options,

@@ -246,6 +246,12 @@ void refineDeepCandidates(std::vector<ContactCandidate>& candidates, double deep
   }
 }
 
+void dropShallowCandidates(std::vector<ContactCandidate>& candidates) {
+  candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                  [](const ContactCandidate& c) { return !c.refined; }),
+                   candidates.end());
+}
+
 namespace {
 
 // A candidate nearer to a representative `at` (number `cluster`) than to
@@ -266,19 +272,30 @@ void joinRepresentative(std::vector<ContactCandidate>& candidates, int rep, int 
 
 }  // namespace
 
+CandidateSpread spreadOf(const std::vector<ContactCandidate>& candidates) {
+  CandidateSpread spread;
+  if (candidates.empty()) return spread;
+  for (const ContactCandidate& c : candidates) {
+    spread.centroid += c.point;
+    spread.scale = std::min(spread.scale, c.overlap + (c.cb - c.ca).norm());
+  }
+  spread.centroid /= static_cast<double>(candidates.size());
+  return spread;
+}
+
 void pickRepresentatives(std::vector<ContactCandidate>& candidates, double deepest, int limit,
                          std::vector<int>& reps) {
+  pickRepresentatives(candidates, deepest, limit, spreadOf(candidates), reps);
+}
+
+void pickRepresentatives(std::vector<ContactCandidate>& candidates, double deepest, int limit,
+                         const CandidateSpread& spread, std::vector<int>& reps) {
   reps.clear();
   if (candidates.empty()) return;
   limit = std::clamp(limit, 1, kMaxRepresentatives);
-  Vec3 centroid = Vec3::Zero();
-  double scale = std::numeric_limits<double>::infinity();  // smallest reach: the length unit
-  for (ContactCandidate& c : candidates) {
-    centroid += c.point;
-    scale = std::min(scale, c.overlap + (c.cb - c.ca).norm());
-    c.nearest = std::numeric_limits<double>::infinity();
-  }
-  centroid /= static_cast<double>(candidates.size());
+  for (ContactCandidate& c : candidates) c.nearest = std::numeric_limits<double>::infinity();
+  const Vec3& centroid = spread.centroid;
+  const double scale = spread.scale;     // smallest reach: the length unit
   const double tie = 1e-3 * scale;      // overlaps this close count as equal
   const double distinct = 1e-6 * scale;  // points closer than this are one point
 
@@ -391,7 +408,11 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
   gatherCandidates(test, geometry, candidates_);
   const double deepest = deepestOverlap(candidates_);
   refineDeepCandidates(candidates_, deepest, geometry, options.face_normals);
-  pickRepresentatives(candidates_, deepest, options.max_contacts_per_pair, reps_);  // and assigns the clusters
+  // Measured before the shallow ones go: the first pick among a face's equally
+  // far corners is left to rounding, and it orders the solver's rows.
+  const CandidateSpread spread = spreadOf(candidates_);
+  dropShallowCandidates(candidates_);
+  pickRepresentatives(candidates_, deepest, options.max_contacts_per_pair, spread, reps_);  // and assigns the clusters
 
   clusterNormals(candidates_, reps_, normals_);
   clusterSeparations(candidates_, reps_, normals_, geometry, separations_);

@@ -153,6 +153,51 @@ TEST(ContactSteps, RefineDeepCandidatesSkipsThoseUnderHalfTheDeepestOverlap) {
   EXPECT_LT(refined, candidates.size());  // the tilted neighbour pairs overlap about half as much
 }
 
+// Face-on and turned 30 degrees about the contact normal: the contacts built
+// from the deep candidates alone (measured from the whole set's spread) are
+// those built from all of them, in the same order.
+TEST(ContactSteps, DroppingTheShallowCandidatesKeepsTheContactsAndTheirOrder) {
+  const Quat turned(Eigen::AngleAxisd(0.5235987755982988, Vec3::UnitX()));
+  for (const Quat& turn : {Quat::Identity(), turned}) {
+    TwoCubes cubes(Vec3(0.39, 0.0, 0.0), turn);
+    const PairGeometry geometry(cubes.test, &cubes.bounds, &cubes.bounds);
+    std::vector<ContactCandidate> all;
+    gatherCandidates(cubes.test, geometry, all);
+    const double deepest = deepestOverlap(all);
+    refineDeepCandidates(all, deepest, geometry, true);
+    std::vector<ContactCandidate> deep = all;
+    const CandidateSpread spread = spreadOf(deep);
+    dropShallowCandidates(deep);
+    ASSERT_LT(deep.size(), all.size());
+    std::size_t next = 0;  // the kept ones are the refined ones, in their order
+    for (const ContactCandidate& c : all) {
+      if (!c.refined) continue;
+      ASSERT_LT(next, deep.size());
+      EXPECT_EQ(deep[next].node_a, c.node_a);
+      EXPECT_EQ(deep[next].node_b, c.node_b);
+      ++next;
+    }
+    EXPECT_EQ(next, deep.size());
+
+    std::vector<int> reps_all, reps_deep;
+    pickRepresentatives(all, deepest, 4, reps_all);
+    pickRepresentatives(deep, deepest, 4, spread, reps_deep);
+    ASSERT_EQ(reps_all.size(), 4u);
+    ASSERT_EQ(reps_deep.size(), reps_all.size());
+    std::vector<Vec3> normals_all, normals_deep;
+    std::vector<double> separations_all, separations_deep;
+    clusterNormals(all, reps_all, normals_all);
+    clusterNormals(deep, reps_deep, normals_deep);
+    clusterSeparations(all, reps_all, normals_all, geometry, separations_all);
+    clusterSeparations(deep, reps_deep, normals_deep, geometry, separations_deep);
+    for (std::size_t r = 0; r < reps_all.size(); ++r) {
+      EXPECT_EQ(deep[reps_deep[r]].point, all[reps_all[r]].point) << r;
+      EXPECT_EQ(normals_deep[r], normals_all[r]) << r;
+      EXPECT_EQ(separations_deep[r], separations_all[r]) << r;
+    }
+  }
+}
+
 TEST(ContactSteps, RepresentativesAreTheCornersOfAFaceAndNeverTwoAtOnePoint) {
   std::vector<ContactCandidate> grid = faceGrid();
   std::vector<int> reps;
