@@ -188,7 +188,11 @@ class ContactSolver {
     double push = 0.0;         // split impulse: target normal pseudo-velocity
     double push_mass = 0.0;    // 1 / effective mass along n of the bodies' translation alone
     double shock_push_mass = 0.0;  // the same with the support held (position shock sweep)
-    double lambda_main = 0.0;  // normal impulse before restitution (what warm starts)
+    // What warm starts the next tick: the velocity iterations' impulses (normal
+    // without the bounce; friction along t1, t2), which both bodies took.
+    // Shock propagation's later ones the upper body took alone.
+    double lambda_main = 0.0;
+    double friction_main[2] = {0.0, 0.0};
     double lambda_push = 0.0;
     double bounce_from = 0.0;  // normal velocity its bounce reverses (< 0), in its wave
     double lambda_wave = 0.0;  // impulse of the current restitution wave

@@ -70,7 +70,7 @@ Scene stack(int count, double voxel, double dt, double seconds, double settle_se
   return scene;
 }
 
-Scene massRatio(double ratio, double seconds, const ResponseOptions& response) {
+Scene massRatio(double ratio, double seconds, const ResponseOptions& response, double gap) {
   Scene scene;
   scene.name = "mass ratio " + std::to_string(static_cast<int>(ratio)) + ":1";
   scene.world = makeWorld(Vec3(0.0, 0.0, -kGravity), response);
@@ -87,7 +87,8 @@ Scene massRatio(double ratio, double seconds, const ResponseOptions& response) {
     EntitySpec spec;
     spec.shape = light;
     spec.density = light_density;
-    spec.pose.position = Vec3(((i % 2) - 0.5) * light_side, ((i / 2) - 0.5) * light_side, 0.5 * light_side);
+    const double pitch = light_side + gap;
+    spec.pose.position = Vec3(((i % 2) - 0.5) * pitch, ((i / 2) - 0.5) * pitch, 0.5 * light_side);
     addMover(world, scene, spec);
   }
   // Same voxel volume ratio 8:1, so the density ratio is ratio / 8.

@@ -31,9 +31,10 @@ struct Scene {
 Scene stack(int count = 10, double voxel = 0.05, double dt = 1.0 / 60.0, double seconds = 10.0,
             double settle_seconds = 2.0, const ResponseOptions& response = ResponseOptions{});
 // A heavy cube (8 voxels) on a 2 x 2 of light cubes (4 voxels), mass ratio
-// `ratio` (heavy : one light), on the floor.
+// `ratio` (heavy : one light), on the floor. The light cubes stand `gap`
+// metres apart (0: face to face, bracing each other).
 Scene massRatio(double ratio = 1000.0, double seconds = 5.0,
-                const ResponseOptions& response = ResponseOptions{});
+                const ResponseOptions& response = ResponseOptions{}, double gap = 0.0);
 // A one-voxel sphere at `speed` m/s straight at a one-voxel-thick static
 // plate (16 x 16 x 1), no gravity; the sphere starts 1 m above the plate.
 Scene fastSphere(double speed = 100.0, double seconds = 0.5,

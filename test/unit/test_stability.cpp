@@ -16,10 +16,11 @@ constexpr double kEnergyTolerance = 1e-3;   // of KE(0) + potential above the lo
 constexpr double kRestingPenetration = 0.1; // voxels, in resting scenes
 constexpr double kDrift = 0.1;              // voxels per second once settled
 
-void expectSane(const Scene& scene, const Metrics& m, double max_penetration) {
+void expectSane(const Scene& scene, const Metrics& m, double max_penetration,
+                double energy_tolerance = kEnergyTolerance) {
   SCOPED_TRACE(scene.name);
   EXPECT_EQ(m.nan_count, 0u);
-  EXPECT_LE(m.energy_gain, kEnergyTolerance);
+  EXPECT_LE(m.energy_gain, energy_tolerance);
   EXPECT_LE(m.max_penetration, max_penetration);
   EXPECT_LE(m.max_speed, scene.speed_bound);
   for (const BodyState& b : scene.world->bodies()) EXPECT_TRUE(isFinite(b));
@@ -49,19 +50,40 @@ TEST(Stability, StackRestsWithATenthOfAMillisecondTick) {
 
 TEST(Stability, StackRestsWithATenthOfASecondTick) { expectStackRests(stack(10, 0.05, 0.1, 20.0, 5.0)); }
 
-TEST(Stability, HeavyCubeOnLightCubesAtMassRatio1000Holds) {
-  Scene scene = massRatio(1000.0);
+// The heavy cube and the light ones stay where they rest.
+void expectMassRatioHolds(Scene scene, double energy_tolerance = kEnergyTolerance) {
   const std::size_t heavy = scene.movers.back();
   const Vec3 rest = scene.world->bodies()[heavy].pose.position;
   std::vector<Vec3> light;
   for (std::size_t k = 0; k + 1 < scene.movers.size(); ++k) light.push_back(scene.world->bodies()[scene.movers[k]].pose.position);
   const Metrics m = run(scene);
-  expectSane(scene, m, kRestingPenetration);
+  expectSane(scene, m, kRestingPenetration, energy_tolerance);
   EXPECT_LE(m.drift, kDrift);
   const auto& b = scene.world->bodies();
   EXPECT_LE((b[heavy].pose.position - rest).norm(), kRestingPenetration * scene.voxel);
   for (std::size_t k = 0; k < light.size(); ++k) {
     EXPECT_LE((b[scene.movers[k]].pose.position - light[k]).norm(), kRestingPenetration * scene.voxel);
+  }
+}
+
+TEST(Stability, HeavyCubeOnLightCubesAtMassRatio1000Holds) { expectMassRatioHolds(massRatio(1000.0)); }
+
+// The light cubes 2 mm and 1 cm apart, so none braces another: each carries
+// its quarter alone. Shock propagation holds each one still for the heavy
+// cube; warm-started, those impulses came back next tick on the light cubes
+// too (a quarter of the heavy cube's weight each, which they never took), and
+// the scene blew up from the second tick (2.5 m/s; at 10 iterations 40 m/s).
+// Now the warm start is the velocity iterations' impulses alone. 2 mm apart
+// the light cubes' leaf spheres still meet: settling in the first ticks lifts
+// the heavy cube by 0.9 mm, an energy gain of 3.5e-3 of the scene's scale
+// (the 10-iteration test's bound, 1e-2, holds it).
+TEST(Stability, HeavyCubeOnLightCubesStandingApartHolds) {
+  ResponseOptions ten;
+  ten.iterations = 10;
+  for (const double gap : {0.002, 0.01}) {
+    SCOPED_TRACE(gap);
+    expectMassRatioHolds(massRatio(1000.0, 5.0, ResponseOptions{}, gap), 1e-2);
+    expectMassRatioHolds(massRatio(1000.0, 5.0, ten, gap), 1e-2);
   }
 }
 
