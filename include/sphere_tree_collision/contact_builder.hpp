@@ -176,9 +176,9 @@ class ContactBuilder {
  public:
   // Appends the contacts of one test (none when Separate, or Unresolved and not accepted).
   // bounds_a/bounds_b: of the test's trees, or nullptr (surface at the spheres).
-  // The steps, in order: gatherCandidates, refineDeepCandidates,
-  // spreadOf, dropShallowCandidates, pickRepresentatives (which assigns the clusters), then one contact per cluster
-  // (clusterNormals, clusterSeparations).
+  // The steps, in order: gatherCandidates, refineDeepCandidates, spreadOf,
+  // dropShallowCandidates, pickRepresentatives (which assigns the clusters),
+  // then one contact per cluster (clusterNormals, clusterSeparations).
   void append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b, double priority,
               const BodySurface& a, const BodySurface& b, const ContactBuildOptions& options,
               std::vector<Contact>& out);
