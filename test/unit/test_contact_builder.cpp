@@ -29,6 +29,13 @@ struct TwoCubes {
     test.reset(PairBody{0, &tree, &pose_a}, PairBody{1, &tree, &pose_b});
     while (!test.resolved()) test.step();
   }
+  PairGeometry geometry() const { return PairGeometry(test, &bounds, &bounds); }
+  // gatherCandidates of the test.
+  std::vector<ContactCandidate> candidates(const PairGeometry& geometry) const {
+    std::vector<ContactCandidate> out;
+    gatherCandidates(test, geometry, out);
+    return out;
+  }
 };
 
 // A refined candidate at `point` with the given overlap and normal.
@@ -57,9 +64,8 @@ std::vector<ContactCandidate> faceGrid() {
 TEST(ContactSteps, GatherTakesTheLastPairsOrTheRootsOfAnUntestedPair) {
   TwoCubes cubes(Vec3(0.39, 0.0, 0.0));
   ASSERT_EQ(cubes.test.status(), PairStatus::Colliding);
-  const PairGeometry geometry(cubes.test, &cubes.bounds, &cubes.bounds);
-  std::vector<ContactCandidate> candidates;
-  gatherCandidates(cubes.test, geometry, candidates);
+  const PairGeometry geometry = cubes.geometry();
+  std::vector<ContactCandidate> candidates = cubes.candidates(geometry);
   ASSERT_EQ(candidates.size(), cubes.test.lastPairs().size());
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     EXPECT_EQ(candidates[i].node_a, cubes.test.lastPairs()[i].a);
@@ -86,9 +92,8 @@ TEST(ContactSteps, RefineTurnsTiltedLinesOfCentresToTheFaceAxisOfEitherBox) {
   const Quat quarter(Eigen::AngleAxisd(0.5 * M_PI, Vec3::UnitZ()));
   for (const Quat& turn : {Quat::Identity(), quarter}) {
     TwoCubes cubes(Vec3(0.39, 0.05, 0.0), turn);
-    const PairGeometry geometry(cubes.test, &cubes.bounds, &cubes.bounds);
-    std::vector<ContactCandidate> candidates;
-    gatherCandidates(cubes.test, geometry, candidates);
+    const PairGeometry geometry = cubes.geometry();
+    std::vector<ContactCandidate> candidates = cubes.candidates(geometry);
     const double deepest = deepestOverlap(candidates);
     std::size_t tilted = 0;
     for (ContactCandidate c : candidates) {
@@ -139,9 +144,8 @@ TEST(ContactSteps, CoincidentCentresGiveTheBodyDirectionThenPlusZNeverNaN) {
 
 TEST(ContactSteps, RefineDeepCandidatesSkipsThoseUnderHalfTheDeepestOverlap) {
   TwoCubes cubes(Vec3(0.39, 0.0, 0.0));
-  const PairGeometry geometry(cubes.test, &cubes.bounds, &cubes.bounds);
-  std::vector<ContactCandidate> candidates;
-  gatherCandidates(cubes.test, geometry, candidates);
+  const PairGeometry geometry = cubes.geometry();
+  std::vector<ContactCandidate> candidates = cubes.candidates(geometry);
   const double deepest = deepestOverlap(candidates);
   refineDeepCandidates(candidates, deepest, geometry, true);
   std::size_t refined = 0;
@@ -160,9 +164,8 @@ TEST(ContactSteps, DroppingTheShallowCandidatesKeepsTheContactsAndTheirOrder) {
   const Quat turned(Eigen::AngleAxisd(0.5235987755982988, Vec3::UnitX()));
   for (const Quat& turn : {Quat::Identity(), turned}) {
     TwoCubes cubes(Vec3(0.39, 0.0, 0.0), turn);
-    const PairGeometry geometry(cubes.test, &cubes.bounds, &cubes.bounds);
-    std::vector<ContactCandidate> all;
-    gatherCandidates(cubes.test, geometry, all);
+    const PairGeometry geometry = cubes.geometry();
+    std::vector<ContactCandidate> all = cubes.candidates(geometry);
     const double deepest = deepestOverlap(all);
     refineDeepCandidates(all, deepest, geometry, true);
     std::vector<ContactCandidate> deep = all;
@@ -317,9 +320,8 @@ TEST(ContactSteps, ClusterNormalAveragesTheDeepestMembersOnly) {
 
 TEST(ContactSteps, ClusterSeparationIsTheClosestAlignedMembersGap) {
   TwoCubes cubes(Vec3(0.39, 0.0, 0.0));
-  const PairGeometry geometry(cubes.test, &cubes.bounds, &cubes.bounds);
-  std::vector<ContactCandidate> candidates;
-  gatherCandidates(cubes.test, geometry, candidates);
+  const PairGeometry geometry = cubes.geometry();
+  std::vector<ContactCandidate> candidates = cubes.candidates(geometry);
   refineDeepCandidates(candidates, deepestOverlap(candidates), geometry, true);
   for (ContactCandidate& c : candidates) c.cluster = 0;
   candidates[0].separation = 0.5;
