@@ -94,6 +94,8 @@ class PairGeometry {
   const std::uint8_t* covered_b_;
   Mat3 rot_a_, rot_b_;
   Mat3 b_in_a_;  // B's axes in A's frame (columns)
+  Mat3 a_in_b_;  // A's axes in B's frame: its transpose
+  Mat3 abs_b_in_a_, abs_a_in_b_;  // their absolute values: a box's half extents along the other's axes
   Vec3 pos_a_, pos_b_;
   mutable FaceFrame face_frame_;  // faceFrame's last: a cache, not state
 };

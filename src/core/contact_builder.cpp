@@ -46,6 +46,33 @@ double boxExtent(const ShapeBounds* bounds, const SphereTree& tree, std::int32_t
   return bounds->box_half[static_cast<std::size_t>(node)].dot(dir_body.cwiseAbs());
 }
 
+// A node's voxel box (body frame) and its sphere's radius, read once for the
+// six face axes. Without bounds the box is the sphere's cube: every support is r.
+struct NodeBox {
+  Vec3 offset = Vec3::Zero(), half = Vec3::Zero();
+  double radius = 0.0;
+  bool has_box = false;
+  // Support towards sign x its own axis `axis` (ShapeBounds::axisSupport).
+  double along(int axis, double sign) const {
+    return has_box ? std::min(radius, sign * offset[axis] + half[axis]) : radius;
+  }
+  // Support towards a direction whose offset . dir and half . |dir| are given (ShapeBounds::support).
+  double towards(double offset_along, double half_along) const {
+    return has_box ? std::min(radius, offset_along + half_along) : radius;
+  }
+};
+
+NodeBox nodeBox(const ShapeBounds* bounds, const SphereTree& tree, std::int32_t node) {
+  NodeBox box;
+  box.radius = tree.node(node).radius;
+  if (bounds != nullptr) {
+    box.offset = bounds->box_offset[static_cast<std::size_t>(node)];
+    box.half = bounds->box_half[static_cast<std::size_t>(node)];
+    box.has_box = true;
+  }
+  return box;
+}
+
 }  // namespace
 
 PairGeometry::PairGeometry(const PairTest& test, const BodySurface& a, const BodySurface& b)
@@ -58,6 +85,9 @@ PairGeometry::PairGeometry(const PairTest& test, const BodySurface& a, const Bod
       rot_a_(test.bodyA().pose->orientation.toRotationMatrix()),
       rot_b_(test.bodyB().pose->orientation.toRotationMatrix()),
       b_in_a_(rot_a_.transpose() * rot_b_),
+      a_in_b_(b_in_a_.transpose()),
+      abs_b_in_a_(b_in_a_.cwiseAbs()),
+      abs_a_in_b_(a_in_b_.cwiseAbs()),
       pos_a_(test.bodyA().pose->position),
       pos_b_(test.bodyB().pose->position) {}
 
@@ -193,6 +223,16 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
   const Vec3 delta_a = rot_a_.transpose() * delta;
   const Vec3 delta_b = b_in_a_.transpose() * delta_a;
   const double better_by = 1e-12 * std::abs(c.overlap + delta.norm());  // more than rounding
+  // Each node's box read once. Along +-axis k of one box the other box's
+  // support is min(r, -+offset . axis + half . |axis|): the dot products of
+  // the six axes are four 3 x 3 products. Each is a transposed product, which
+  // Eigen sums as the dot product of a column, as support() does.
+  const NodeBox box_a = nodeBox(bounds_a_, tree_a_, c.node_a);
+  const NodeBox box_b = nodeBox(bounds_b_, tree_b_, c.node_b);
+  const Vec3 offset_b_in_a = a_in_b_.transpose() * box_b.offset;  // B's box offset along A's axes
+  const Vec3 half_b_in_a = abs_a_in_b_.transpose() * box_b.half;   // B's half extent along A's axes
+  const Vec3 offset_a_in_b = b_in_a_.transpose() * box_a.offset;
+  const Vec3 half_a_in_b = abs_b_in_a_.transpose() * box_a.half;
   for (int k = 0; k < 6; ++k) {
     // Axis k of A (k < 3) or of B, pointing from a to b, in both frames.
     const bool of_a = k < 3;
@@ -207,10 +247,10 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
       if (intoCover(mask_a, mask_b, normalOf())) continue;
     }
     // The node whose own axis this is reads its support straight off its box.
-    const double g = of_a ? sign * along - axisSupportA(c.node_a, box_axis, sign) -
-                                localSupportB(c.node_b, -sign * Vec3(b_in_a_.row(box_axis).transpose()))
-                          : sign * along - localSupportA(c.node_a, sign * Vec3(b_in_a_.col(box_axis))) -
-                                axisSupportB(c.node_b, box_axis, -sign);
+    const double g = of_a ? sign * along - box_a.along(box_axis, sign) -
+                                box_b.towards(-sign * offset_b_in_a[box_axis], half_b_in_a[box_axis])
+                          : sign * along - box_a.towards(sign * offset_a_in_b[box_axis], half_a_in_b[box_axis]) -
+                                box_b.along(box_axis, -sign);
     // Under cover the line of centres was bent: any open face axis is the better normal.
     if (g > c.separation + better_by || (covered && !face)) {
       c.separation = g;
