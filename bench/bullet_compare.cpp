@@ -28,6 +28,10 @@
 //               a bare NAME picks that scene's cases from the default list)
 //   --variants  Bullet shapes to run: compound,hull (default both; empty: none)
 //   --bullet-only  skip this package's run (to run the engines apart, in parallel)
+//   --iterations N  this package's velocity and position iterations per tick
+//               (ResponseOptions::iterations; default: the World's, 20). Bullet
+//               runs its default 10 always: --iterations 10 compares the two
+//               at the same solver effort. The SUMMARY lines say which was used.
 // Where the response's time goes (instruction counts, stable on a loaded machine;
 // docs/response.md, "Cost of the response"):
 //   valgrind --tool=callgrind --toggle-collect='stc::Physics::respond*'
@@ -124,10 +128,13 @@ class MotionCheck {
   std::size_t samples_ = 0;
 };
 
-SceneWorld sceneWorld(const Case& c) {
+// iterations > 0: this package's solver iterations instead of the default.
+SceneWorld sceneWorld(const Case& c, int iterations = 0) {
   SceneParams params;
   params.entities = c.bodies;
-  return makeSceneWorld(c.kind, params);
+  WorldConfig config;
+  if (iterations > 0) config.response.iterations = iterations;
+  return makeSceneWorld(c.kind, params, config);
 }
 
 void timeTick(Run& run, double wall0, double cpu0) {
@@ -135,8 +142,8 @@ void timeTick(Run& run, double wall0, double cpu0) {
   run.cpu.push_back(stc_bench::threadCpuSeconds() - cpu0);
 }
 
-Run runPackage(const Case& c, int ticks, int settle_ticks) {
-  SceneWorld scene = sceneWorld(c);
+Run runPackage(const Case& c, int ticks, int settle_ticks, int iterations) {
+  SceneWorld scene = sceneWorld(c, iterations);
   World& world = scene.world;
   const SceneSpec& spec = scene.spec;
   for (int t = 0; t < settle_ticks; ++t) world.step(spec.dt, Budget::unlimited());
@@ -150,7 +157,7 @@ Run runPackage(const Case& c, int ticks, int settle_ticks) {
     }
   };
   Run run;
-  run.engine = "this package";
+  run.engine = iterations > 0 ? "this package, " + std::to_string(iterations) + " iterations" : "this package";
   MotionCheck check(spec.bounds, spec.dt);
   read();
   check.start(positions);
@@ -402,6 +409,7 @@ struct Options {
   double seconds = 10.0;
   double settle = 0.0;
   bool bullet_only = false;
+  int iterations = 0;  // 0: the World's default
   std::vector<Case> cases;
   std::vector<BulletShape> variants{BulletShape::Compound, BulletShape::Hull};
   std::string markdown;
@@ -438,6 +446,9 @@ Options parse(int argc, char** argv) {
       }
     } else if (a == "--bullet-only") {
       o.bullet_only = true;
+    } else if (a == "--iterations") {
+      o.iterations = std::stoi(args.required());
+      if (o.iterations < 1) throw InputError("--iterations", "must be >= 1");
     } else if (a == "--markdown") {
       o.markdown = args.required();
     } else {
@@ -468,7 +479,7 @@ int main(int argc, char** argv) {
   for (const Case& c : opt.cases) {
     std::printf("## %s (load %.2f)\n", label(c).c_str(), loadAverage());
     std::fflush(stdout);
-    const Run ours = opt.bullet_only ? Run{} : runPackage(c, ticks, settle_ticks);
+    const Run ours = opt.bullet_only ? Run{} : runPackage(c, ticks, settle_ticks, opt.iterations);
     std::string rows = opt.bullet_only ? std::string() : runRow(c, ours);
     std::printf("%s", rows.c_str());
     std::fflush(stdout);
@@ -491,9 +502,9 @@ int main(int argc, char** argv) {
     const double p50 = percentile(ours.cpu, 0.5);
     std::snprintf(buf, sizeof buf,
                   "SUMMARY scene=%s bodies=%d p50_ms=%.3f p99_ms=%.3f bullet_best_p50_ms=%.3f "
-                  "ratio_p50=%.3f\n",
+                  "ratio_p50=%.3f%s\n",
                   toString(c.kind), c.bodies, 1e3 * p50, 1e3 * percentile(ours.cpu, 0.99), 1e3 * best,
-                  p50 / best);
+                  p50 / best, opt.iterations > 0 ? (" iterations=" + std::to_string(opt.iterations)).c_str() : "");
     summary += buf;
   }
   std::string md;
