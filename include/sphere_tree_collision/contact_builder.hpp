@@ -174,7 +174,9 @@ void clusterSeparations(const std::vector<ContactCandidate>& candidates, const s
 // measured along that normal between the nodes' surfaces
 // (ShapeBounds::support; the sphere itself without bounds). Coincident
 // centres: the direction between the body centres, then +Z; never NaN.
-class ContactBuilder {
+// A cache line of its own: the parallel contact building gives each thread
+// a builder, and its scratch vectors' ends move with every candidate.
+class alignas(64) ContactBuilder {
  public:
   // Appends the contacts of one test (none when Separate, or Unresolved and not accepted).
   // bounds_a/bounds_b: of the test's trees, or nullptr (surface at the spheres).

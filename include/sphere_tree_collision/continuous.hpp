@@ -30,8 +30,8 @@ struct SweepHit {
 };
 
 // One task's run of the pairs: its own node stack and earliest hits, merged
-// after all runs are done.
-struct SweepLane {
+// after all runs are done. A cache line of its own: lanes run side by side.
+struct alignas(64) SweepLane {
   std::vector<std::pair<std::int32_t, std::int32_t>> stack;  // node pairs of one sweep
   std::vector<SweepHit> hits;            // per body; t = 1 except at `touched`
   std::vector<std::uint32_t> touched;    // bodies this lane found a hit for

@@ -16,7 +16,9 @@
 
 namespace stc {
 
-struct NarrowChunk {
+// A cache line of its own: a chunk's step counters change with every
+// step, and a neighbour's thread reads its own next to them.
+struct alignas(64) NarrowChunk {
   std::unique_ptr<Scheduler> scheduler;
   PairArena arena;    // hits and pairs of this chunk's tests
   ScheduleStats stats;  // of this tick's run

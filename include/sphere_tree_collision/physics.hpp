@@ -83,7 +83,10 @@ class Physics {
   // A builder (its scratch) and the contacts of each chunk of the pairs
   // (parallel contact building); capacity kept between ticks.
   std::vector<ContactBuilder> builders_;
-  std::vector<std::vector<Contact>> chunk_contacts_;
+  struct alignas(64) ChunkContacts {  // a line of its own: its end moves with each contact
+    std::vector<Contact> contacts;
+  };
+  std::vector<ChunkContacts> chunk_contacts_;
   std::size_t builder_turn_ = 0;
   ContactSolver solver_;
   double gravity_speed_ = 0.0;  // |g| dt of the last integrate

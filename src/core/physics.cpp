@@ -122,12 +122,14 @@ void Physics::respond(const StepContext& step) {
     // what any part of the pair list needs and then allocates no more.
     ++builder_turn_;
     step.workers->forChunks(chunks, [&](std::size_t k, std::size_t) {
-      chunk_contacts_[k].clear();
+      std::vector<Contact>& chunk = chunk_contacts_[k].contacts;
+      chunk.clear();
       const auto [first, last] = chunkRange(count, k, chunks);
-      appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk_contacts_[k]);
+      appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk);
     });
     for (std::size_t k = 0; k < chunks; ++k) {
-      contacts.insert(contacts.end(), chunk_contacts_[k].begin(), chunk_contacts_[k].end());
+      const std::vector<Contact>& chunk = chunk_contacts_[k].contacts;
+      contacts.insert(contacts.end(), chunk.begin(), chunk.end());
     }
   }
   report_.solve = SolveStats{};
