@@ -227,12 +227,9 @@ class ContactSolver {
   void blockManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
   struct ManifoldRun {
     std::uint32_t first = 0, end = 0;
-    std::uint32_t block = 0;  // of partition_
   };
-  // manifolds(first, end) over every block's manifolds, stage by stage, each
-  // block's manifolds by one thread. On the workers a block waits only for
-  // the blocks of earlier stages that share a slab with it (Team::forBlocksAfter):
-  // each body still meets its manifolds in the serial order.
+  // manifolds(first, end) over every block's manifolds, stage by stage, a
+  // stage's blocks on the workers, each block's manifolds by one thread.
   void forEachStage(RangeFn manifolds);
   // Shock propagation's order: the levels from the ground (unreached rows
   // aside), and a level's manifolds stage by stage, as forEachStage.
@@ -240,12 +237,9 @@ class ContactSolver {
     return level_stage_start_.empty() ? 0 : (level_stage_start_.size() - 1) / ContactPartition::kStages;
   }
   void forEachStageOfLevel(std::size_t level, RangeFn manifolds);
-  // The runs of one pass's stages (stage s: [stage_first[s], stage_first[s + 1]),
-  // from 0; after[k]: the earlier runs run k waits for): on the team when
-  // there are two or more and they hold task_manifolds_ or more, else in
-  // order here.
-  void runStages(const ManifoldRun* runs, const std::uint64_t* after, const std::uint32_t* stage_first,
-                 RangeFn manifolds) const;
+  // The blocks runs[0, count) of one stage: on the team when there are two
+  // or more and they hold task_manifolds_ or more, else in turn here.
+  void runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds) const;
   // step(r, a, b) over the rows r of manifolds [first, end), a and b the
   // pair's entries of `motion` copied in, then written back (a static body's
   // never is: blocks do not hold it apart).
@@ -348,8 +342,6 @@ class ContactSolver {
   // per block, and each (level, stage)'s first run.
   std::vector<ManifoldRun> pass_runs_, level_runs_;
   std::vector<std::uint32_t> pass_stage_start_, level_stage_start_, cursor_;
-  // Per run: the runs before it (bit j: run j of its pass, or of its level) it waits for.
-  std::vector<std::uint64_t> pass_after_, level_after_;
   std::vector<int> levels_;
 };
 

@@ -45,7 +45,6 @@ class RangeFn {
 class Team {
  public:
   static constexpr std::size_t kMaxBlocks = 64;  // of one forBlocks round
-  static constexpr std::size_t kMaxStages = 8;   // of one forBlocksAfter round
   int members() const { return members_; }
   // fn(k, k + 1) once for each block k in [0, count), each by one member, who
   // first claims its whole own share (the k with k * members / count ==
@@ -53,27 +52,12 @@ class Team {
   // block left; returns when all are done. Only the thread that called
   // withTeam may call it.
   void forBlocks(std::size_t count, RangeFn fn);
-  // Stages of blocks in one round, for work where a block needs only some
-  // blocks of the earlier stages done, not all: block k starts once every
-  // block j whose bit is set in after[k] (j < k) has finished. The blocks
-  // come stage by stage, stage s being [stage_first[s], stage_first[s + 1])
-  // (stages + 1 entries); each member claims its share of every stage (the
-  // blocks forBlocks would give it stage by stage) and runs them in order,
-  // then takes any block left; a member waiting for a block nobody has
-  // claimed runs it itself. One hand-over for the round instead of one a
-  // stage: a stage of a few microseconds costs as much again to hand over
-  // when the cores are far apart. count <= kMaxBlocks, stages <= kMaxStages.
-  void forBlocksAfter(std::size_t count, const std::uint64_t* after, const std::uint32_t* stage_first,
-                      std::size_t stages, RangeFn fn);
 
  private:
   friend class Workers;
   struct State;
-  struct Round;  // what one forBlocks or forBlocksAfter round publishes
   explicit Team(State* state, int members) : state_(state), members_(members) {}
-  void publish(Round& round);                     // post a round (sets its stage) and take part in it
-  void take(int member, const Round& round);      // claim and run
-  void runAfter(std::size_t k, const Round& round);  // block k once its `after` blocks are done
+  void take(int member, std::uint64_t stage, const RangeFn* fn, std::size_t count);  // claim and run
   void serve(int member);  // a worker member: run stages until the team stops
   State* state_;           // null with one member
   int members_;

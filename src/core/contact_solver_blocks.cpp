@@ -7,38 +7,6 @@
 #include <limits>
 
 namespace stc {
-namespace {
-
-// The slabs a block's groups may hold movable bodies of (bit s: slab s): its
-// own in stage 0, the two at its cut in stages 1 and 2, any in stage 3
-// (ContactPartition).
-std::uint32_t slabsOfBlock(std::uint32_t block, std::uint32_t slabs) {
-  const std::uint32_t stage = block / slabs;
-  const std::uint32_t slab = block % slabs;
-  if (stage == 0) return 1u << slab;
-  if (stage < 3) return 3u << slab;
-  return ~0u;
-}
-
-// after[k] for runs[0, count): the earlier runs of an earlier stage that
-// share a slab with run k. Blocks of one stage share no movable body, so
-// these are all a run must wait for to see its bodies as the serial order would.
-template <typename Run>
-void waitMasks(const Run* runs, std::size_t count, std::uint32_t slabs, std::uint64_t* after) {
-  for (std::size_t k = 0; k < count; ++k) {
-    const std::uint32_t stage = runs[k].block / slabs;
-    const std::uint32_t mine = slabsOfBlock(runs[k].block, slabs);
-    std::uint64_t wait = 0;
-    for (std::size_t j = 0; j < k; ++j) {
-      if (runs[j].block / slabs < stage && (slabsOfBlock(runs[j].block, slabs) & mine) != 0) {
-        wait |= std::uint64_t{1} << j;
-      }
-    }
-    after[k] = wait;
-  }
-}
-
-}  // namespace
 
 void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts) {
   // Groups: the manifolds, runs of one body pair in order_ (a pair's contacts
@@ -100,14 +68,10 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const s
   for (std::uint32_t b = 0; b < block_count; ++b) {
     if (b % slabs == 0) pass_stage_start_.push_back(static_cast<std::uint32_t>(pass_runs_.size()));
     if (block_manifold_start_[b + 1] > block_manifold_start_[b]) {
-      pass_runs_.push_back(ManifoldRun{block_manifold_start_[b], block_manifold_start_[b + 1], b});
+      pass_runs_.push_back(ManifoldRun{block_manifold_start_[b], block_manifold_start_[b + 1]});
     }
   }
   pass_stage_start_.push_back(static_cast<std::uint32_t>(pass_runs_.size()));
-  static_assert(ContactPartition::kStages * ContactPartition::kMaxSlabs <= Team::kMaxBlocks, "a pass is one round");
-  growCapacity(pass_after_, pass_runs_.size());
-  pass_after_.resize(pass_runs_.size());
-  waitMasks(pass_runs_.data(), pass_runs_.size(), slabs, pass_after_.data());
 
   // Shock propagation's runs: within a block the manifolds are in the order
   // from the ground, so each level takes the next run of every block, stage
@@ -123,44 +87,34 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const s
       if (b % slabs == 0) level_stage_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
       std::uint32_t end = cursor_[b];
       while (end < block_manifold_start_[b + 1] && levelOf(contacts[order_[manifold_start_[end]]]) == level) ++end;
-      if (end > cursor_[b]) level_runs_.push_back(ManifoldRun{cursor_[b], end, b});
+      if (end > cursor_[b]) level_runs_.push_back(ManifoldRun{cursor_[b], end});
       cursor_[b] = end;
     }
   }
   if (!level_stage_start_.empty()) level_stage_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
-  growCapacity(level_after_, level_runs_.size());
-  level_after_.resize(level_runs_.size());
-  for (std::size_t level = 0; level < shockLevels(); ++level) {  // masks relative to the level's first run
-    const std::uint32_t first = level_stage_start_[level * ContactPartition::kStages];
-    const std::uint32_t end = level_stage_start_[(level + 1) * ContactPartition::kStages];
-    waitMasks(level_runs_.data() + first, end - first, slabs, level_after_.data() + first);
-  }
 }
 
-void ContactSolver::runStages(const ManifoldRun* runs, const std::uint64_t* after, const std::uint32_t* stage_first,
-                              RangeFn manifolds) const {
-  const std::size_t count = stage_first[ContactPartition::kStages];
+void ContactSolver::runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds) const {
   std::size_t total = 0;
   for (std::size_t k = 0; k < count; ++k) total += runs[k].end - runs[k].first;
   if (team_ == nullptr || count < 2 || total < task_manifolds_) {
     for (std::size_t k = 0; k < count; ++k) manifolds(runs[k].first, runs[k].end);
     return;
   }
-  team_->forBlocksAfter(count, after, stage_first, ContactPartition::kStages,
-                        [&](std::size_t k, std::size_t) { manifolds(runs[k].first, runs[k].end); });
+  team_->forBlocks(count, [&](std::size_t k, std::size_t) { manifolds(runs[k].first, runs[k].end); });
 }
 
 void ContactSolver::forEachStage(RangeFn manifolds) {
-  if (pass_stage_start_.empty()) return;
-  runStages(pass_runs_.data(), pass_after_.data(), pass_stage_start_.data(), manifolds);
+  for (std::size_t s = 0; s + 1 < pass_stage_start_.size(); ++s) {
+    runStage(pass_runs_.data() + pass_stage_start_[s], pass_stage_start_[s + 1] - pass_stage_start_[s], manifolds);
+  }
 }
 
 void ContactSolver::forEachStageOfLevel(std::size_t level, RangeFn manifolds) {
   const std::size_t first = level * ContactPartition::kStages;
-  const std::uint32_t base = level_stage_start_[first];
-  std::uint32_t stage_first[ContactPartition::kStages + 1];
-  for (std::size_t s = 0; s <= ContactPartition::kStages; ++s) stage_first[s] = level_stage_start_[first + s] - base;
-  runStages(level_runs_.data() + base, level_after_.data() + base, stage_first, manifolds);
+  for (std::size_t s = first; s < first + ContactPartition::kStages; ++s) {
+    runStage(level_runs_.data() + level_stage_start_[s], level_stage_start_[s + 1] - level_stage_start_[s], manifolds);
+  }
 }
 
 }  // namespace stc

@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <cassert>
 #include <chrono>
 #include <string>
 #include <thread>
@@ -58,26 +57,12 @@ class Spin {
 
 }  // namespace
 
-// Members copy a round out of the State (below), never through a pointer to
-// the caller's: the caller returns once the last block is done, while a
-// member may still be reading. `fn` and `after` are read only for a block
-// claimed, while the round is live.
-struct Team::Round {
-  std::uint64_t sequence = 0;  // the value of State::sequence it was published under
-  const RangeFn* fn = nullptr;
-  std::size_t count = 0;
-  const std::uint64_t* after = nullptr;  // null: no block waits for another
-  std::size_t stages = 1;
-  std::array<std::uint32_t, kMaxStages + 1> stage_first{};  // stage s: [stage_first[s], stage_first[s + 1])
-};
-
-// A round is published like a sequence lock: `sequence` is odd while the
-// calling thread writes the round's fields and even once they are out, so a
+// A stage is published like a sequence lock: `sequence` is odd while the
+// calling thread writes the stage's fields and even once they are out, so a
 // member that read the same even value before and after reading the fields
-// has one round's fields. Each block keeps the sequence of the round that
-// took it; a member takes a block by raising that to its own round's, so a
-// member still reading an old round takes nothing. In a forBlocksAfter round
-// a block also records the round that finished it, for the blocks waiting.
+// has one stage's fields. Each block keeps the sequence of the stage that
+// took it; a member takes a block by raising that to its own stage's, so a
+// member still reading an old stage takes nothing.
 //
 // A member task stays after a withTeam call for kLinger, spinning, so that
 // the next call (the next tick) finds it awake; then it leaves. A member
@@ -87,15 +72,10 @@ struct Team::Round {
 // member, which claiming makes harmless).
 struct Team::State {
   std::atomic<std::uint64_t> sequence{0};
-  // The live round's fields (Round), written while `sequence` is odd.
   std::atomic<const RangeFn*> fn{nullptr};
   std::atomic<std::size_t> count{0};
-  std::atomic<const std::uint64_t*> after{nullptr};
-  std::atomic<std::size_t> stages{1};
-  std::array<std::atomic<std::uint32_t>, kMaxStages + 1> stage_first{};
   std::atomic<std::size_t> done{0};
   std::array<std::atomic<std::uint64_t>, kMaxBlocks> taken{};
-  std::array<std::atomic<std::uint64_t>, kMaxBlocks> finished{};  // the round that last finished it
   std::atomic<bool> open{false};      // a withTeam call is running
   std::atomic<bool> shutdown{false};  // the Workers are going
   std::array<std::atomic<bool>, kMaxThreads> present{};  // a task serves as member m
@@ -162,78 +142,33 @@ void Workers::forChunks(std::size_t chunks, RangeFn fn) const {
   });
 }
 
-namespace {
-
-// Claims block k for the round published as `sequence`; false when a member did first.
-bool claimBlock(std::array<std::atomic<std::uint64_t>, Team::kMaxBlocks>& taken, std::size_t k,
-                std::uint64_t sequence) {
-  std::uint64_t was = taken[k].load(std::memory_order_relaxed);
-  while (was < sequence) {
-    if (taken[k].compare_exchange_weak(was, sequence, std::memory_order_acq_rel)) return true;
-  }
-  return false;
-}
-
-}  // namespace
-
-void Team::runAfter(std::size_t k, const Round& round) {
-  if (round.after != nullptr) {
-    for (std::uint64_t wait = round.after[k]; wait != 0; wait &= wait - 1) {
-      const auto j = static_cast<std::size_t>(__builtin_ctzll(wait));
-      Spin spin;
-      while (state_->finished[j].load(std::memory_order_acquire) < round.sequence) {
-        if (claimBlock(state_->taken, j, round.sequence)) {  // nobody has it: run it here
-          runAfter(j, round);
-          break;
-        }
-        spin.wait();
-      }
+void Team::take(int member, std::uint64_t stage, const RangeFn* fn, std::size_t count) {
+  const auto claim = [&](std::size_t k) {
+    std::uint64_t was = state_->taken[k].load(std::memory_order_relaxed);
+    while (was < stage) {
+      if (state_->taken[k].compare_exchange_weak(was, stage, std::memory_order_acq_rel)) return true;
     }
+    return false;
+  };
+  const auto run = [&](std::size_t k) {
+    (*fn)(k, k + 1);
+    state_->done.fetch_add(1, std::memory_order_release);
+  };
+  // The own share is claimed whole before any of it runs: a busy member's
+  // next block stays its own (taking it would move its data between cores).
+  const std::size_t first = (static_cast<std::size_t>(member) * count + members_ - 1) / members_;
+  const std::size_t last = (static_cast<std::size_t>(member + 1) * count + members_ - 1) / members_;
+  std::uint64_t own = 0;  // bit k - first: claimed (at most kMaxBlocks)
+  for (std::size_t k = first; k < last; ++k) {
+    if (claim(k)) own |= std::uint64_t{1} << (k - first);
   }
-  (*round.fn)(k, k + 1);
-  if (round.after != nullptr) state_->finished[k].store(round.sequence, std::memory_order_release);
-  state_->done.fetch_add(1, std::memory_order_release);
-}
-
-void Team::take(int member, const Round& round) {
-  // The own share of each stage is claimed whole before any of it runs: a
-  // busy member's next block stays its own (taking it would move its data
-  // between cores).
-  const std::size_t members = static_cast<std::size_t>(members_);
-  const auto m = static_cast<std::size_t>(member);
-  std::uint64_t own = 0;  // bit k: claimed here
-  for (std::size_t s = 0; s < round.stages; ++s) {
-    const std::size_t begin = round.stage_first[s];
-    const std::size_t size = round.stage_first[s + 1] - begin;
-    const std::size_t first = begin + (m * size + members - 1) / members;
-    const std::size_t last = begin + ((m + 1) * size + members - 1) / members;
-    for (std::size_t k = first; k < last; ++k) {
-      if (claimBlock(state_->taken, k, round.sequence)) own |= std::uint64_t{1} << k;
-    }
+  for (std::size_t k = first; k < last; ++k) {
+    if ((own >> (k - first)) & 1u) run(k);
   }
-  for (std::uint64_t left = own; left != 0; left &= left - 1) {
-    runAfter(static_cast<std::size_t>(__builtin_ctzll(left)), round);
+  for (std::size_t i = last - first; i < count; ++i) {  // then what the others have not claimed
+    const std::size_t k = (first + i) % count;
+    if (claim(k)) run(k);
   }
-  for (std::size_t k = 0; k < round.count; ++k) {  // then what the others have not claimed
-    if (claimBlock(state_->taken, k, round.sequence)) runAfter(k, round);
-  }
-}
-
-void Team::publish(Round& round) {
-  const std::uint64_t odd = state_->sequence.load(std::memory_order_relaxed) + 1;
-  state_->sequence.store(odd, std::memory_order_relaxed);
-  std::atomic_thread_fence(std::memory_order_release);
-  state_->fn.store(round.fn, std::memory_order_relaxed);
-  state_->count.store(round.count, std::memory_order_relaxed);
-  state_->after.store(round.after, std::memory_order_relaxed);
-  state_->stages.store(round.stages, std::memory_order_relaxed);
-  for (std::size_t s = 0; s <= round.stages; ++s) state_->stage_first[s].store(round.stage_first[s], std::memory_order_relaxed);
-  state_->done.store(0, std::memory_order_relaxed);
-  round.sequence = odd + 1;
-  state_->sequence.store(round.sequence, std::memory_order_release);
-  take(0, round);
-  Spin spin;
-  while (state_->done.load(std::memory_order_acquire) < round.count) spin.wait();
 }
 
 void Team::forBlocks(std::size_t count, RangeFn fn) {
@@ -242,30 +177,20 @@ void Team::forBlocks(std::size_t count, RangeFn fn) {
     return;
   }
   for (std::size_t base = 0; base < count; base += kMaxBlocks) {
+    const std::size_t round = std::min(kMaxBlocks, count - base);
     const auto shifted = [&](std::size_t k, std::size_t) { fn(base + k, base + k + 1); };
     const RangeFn round_fn(shifted);
-    Round round;
-    round.fn = &round_fn;
-    round.count = std::min(kMaxBlocks, count - base);
-    round.stage_first[1] = static_cast<std::uint32_t>(round.count);
-    publish(round);
+    const std::uint64_t odd = state_->sequence.load(std::memory_order_relaxed) + 1;
+    state_->sequence.store(odd, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    state_->fn.store(&round_fn, std::memory_order_relaxed);
+    state_->count.store(round, std::memory_order_relaxed);
+    state_->done.store(0, std::memory_order_relaxed);
+    state_->sequence.store(odd + 1, std::memory_order_release);
+    take(0, odd + 1, &round_fn, round);
+    Spin spin;
+    while (state_->done.load(std::memory_order_acquire) < round) spin.wait();
   }
-}
-
-void Team::forBlocksAfter(std::size_t count, const std::uint64_t* after, const std::uint32_t* stage_first,
-                          std::size_t stages, RangeFn fn) {
-  assert(count <= kMaxBlocks && stages <= kMaxStages && stage_first[0] == 0 && stage_first[stages] == count);
-  if (state_ == nullptr || count < 2) {  // in order: every block's `after` comes before it
-    for (std::size_t k = 0; k < count; ++k) fn(k, k + 1);
-    return;
-  }
-  Round round;
-  round.fn = &fn;
-  round.count = count;
-  round.after = after;
-  round.stages = stages;
-  std::copy(stage_first, stage_first + stages + 1, round.stage_first.begin());
-  publish(round);
 }
 
 void Team::serve(int member) {
@@ -273,21 +198,14 @@ void Team::serve(int member) {
   Spin spin;
   auto idle_since = std::chrono::steady_clock::now();
   for (unsigned idle = 0;; ++idle) {
-    const std::uint64_t sequence = state_->sequence.load(std::memory_order_acquire);
-    if (sequence != served && (sequence & 1u) == 0) {
-      Round round;
-      round.sequence = sequence;
-      round.fn = state_->fn.load(std::memory_order_relaxed);
-      round.count = state_->count.load(std::memory_order_relaxed);
-      round.after = state_->after.load(std::memory_order_relaxed);
-      round.stages = std::min(state_->stages.load(std::memory_order_relaxed), kMaxStages);
-      for (std::size_t s = 0; s <= round.stages; ++s) {
-        round.stage_first[s] = state_->stage_first[s].load(std::memory_order_relaxed);
-      }
+    const std::uint64_t stage = state_->sequence.load(std::memory_order_acquire);
+    if (stage != served && (stage & 1u) == 0) {
+      const RangeFn* fn = state_->fn.load(std::memory_order_relaxed);
+      const std::size_t count = state_->count.load(std::memory_order_relaxed);
       std::atomic_thread_fence(std::memory_order_acquire);
-      if (state_->sequence.load(std::memory_order_relaxed) != sequence) continue;  // rewritten meanwhile
-      served = sequence;
-      take(member, round);  // fn and after are read only for a block taken: the round is live
+      if (state_->sequence.load(std::memory_order_relaxed) != stage) continue;  // rewritten meanwhile
+      served = stage;
+      take(member, stage, fn, count);  // fn is called only for a block taken: the stage is live
       spin.reset();
       idle = 0;
       idle_since = std::chrono::steady_clock::now();

@@ -16,7 +16,6 @@
 #include <array>
 #include <atomic>
 #include <memory>
-#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -308,52 +307,6 @@ TEST(Team, EveryBlockRunsOnceAndTheWorkersLoopsJoinTheTeam) {
       EXPECT_EQ(runs[k], kCalls * (loops + (k < 5 ? 1 : 0))) << "block " << k << ", " << threads << " threads";
     }
     for (const int n : indices) EXPECT_EQ(n, kCalls);
-  }
-}
-
-// forBlocksAfter: every block runs once, and only after each block it waits
-// for has finished (each block marks itself done on leaving; each checks its
-// waits on entering). Random stages and waits; members late or early (four
-// members on two cores) take the paths where a waiting member runs an
-// unclaimed block itself. No timing is asserted.
-TEST(Team, ABlockStartsOnlyAfterTheBlocksItWaitsFor) {
-  std::mt19937 random(7);
-  for (const int threads : {2, 4}) {
-    Workers workers(threads);
-    std::array<std::atomic<int>, Team::kMaxBlocks> finished{};  // the round that last finished block k
-    std::array<int, Team::kMaxBlocks> runs{};
-    std::atomic<int> early{0};  // blocks that found a wait unfinished
-    for (int round = 1; round <= 300; ++round) {
-      const std::size_t stages = 1 + random() % Team::kMaxStages;
-      std::vector<std::uint32_t> stage_first(stages + 1, 0);
-      for (std::size_t s = 1; s <= stages; ++s) {
-        stage_first[s] = std::min<std::uint32_t>(stage_first[s - 1] + random() % 12, Team::kMaxBlocks);
-      }
-      const std::size_t count = stage_first[stages];
-      std::vector<std::uint64_t> after(count, 0);
-      std::size_t stage = 0;
-      for (std::size_t k = 0; k < count; ++k) {
-        while (k >= stage_first[stage + 1]) ++stage;
-        for (std::size_t j = 0; j < stage_first[stage]; ++j) {  // blocks of earlier stages only
-          if (random() % 3 == 0) after[k] |= std::uint64_t{1} << j;
-        }
-      }
-      runs.fill(0);
-      workers.withTeam([&](Team& team) {
-        team.forBlocksAfter(count, after.data(), stage_first.data(), stages, [&](std::size_t k, std::size_t end) {
-          EXPECT_EQ(end, k + 1);
-          ++runs[k];
-          for (std::size_t j = 0; j < count; ++j) {
-            if (((after[k] >> j) & 1u) != 0 && finished[j].load(std::memory_order_acquire) != round) ++early;
-          }
-          volatile double work = 0.0;  // some blocks long, so members overtake each other
-          for (std::size_t i = 0; i < 2000 * (k % 5); ++i) work = work + 1.0;
-          finished[k].store(round, std::memory_order_release);
-        });
-      });
-      for (std::size_t k = 0; k < count; ++k) EXPECT_EQ(runs[k], 1) << "block " << k << ", round " << round;
-    }
-    EXPECT_EQ(early.load(), 0) << threads << " threads";
   }
 }
 
