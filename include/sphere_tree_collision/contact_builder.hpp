@@ -68,8 +68,6 @@ class PairGeometry {
   // Surface of a node towards a direction in its own body frame.
   double localSupportA(std::int32_t node, const Vec3& dir_a) const;
   double localSupportB(std::int32_t node, const Vec3& dir_b) const;
-  double axisSupportA(std::int32_t node, int axis, double sign) const;  // along sign x A's axis
-  double axisSupportB(std::int32_t node, int axis, double sign) const;  // along sign x B's axis
   Vec3 faceContactPoint(const ContactCandidate& c) const;
   // A face normal's tangents and its directions in both body frames. A
   // pair's face candidates mostly share one normal: the last one is kept.

@@ -39,11 +39,6 @@ struct ShapeBounds {
     const double box = box_offset[i].dot(direction_body) + box_half[i].dot(direction_body.cwiseAbs());
     return std::min(tree->node(node).radius, box);
   }
-  // support() towards sign (+-1) x body axis `axis`: the same value, read off the box.
-  double axisSupport(std::int32_t node, int axis, double sign) const {
-    const std::size_t i = static_cast<std::size_t>(node);
-    return std::min(tree->node(node).radius, sign * box_offset[i][axis] + box_half[i][axis]);
-  }
 };
 // voxels == nullptr: boxes are the spheres' cubes (support = r). body_origin:
 // the grid-frame point the tree was built about (ShapeInfo::body_origin).

@@ -52,7 +52,7 @@ struct NodeBox {
   Vec3 offset = Vec3::Zero(), half = Vec3::Zero();
   double radius = 0.0;
   bool has_box = false;
-  // Support towards sign x its own axis `axis` (ShapeBounds::axisSupport).
+  // Support towards sign x its own axis `axis`: what ShapeBounds::support gives that unit axis.
   double along(int axis, double sign) const {
     return has_box ? std::min(radius, sign * offset[axis] + half[axis]) : radius;
   }
@@ -97,16 +97,6 @@ inline double PairGeometry::localSupportA(std::int32_t node, const Vec3& dir_a) 
 
 inline double PairGeometry::localSupportB(std::int32_t node, const Vec3& dir_b) const {
   return bounds_b_ != nullptr ? bounds_b_->support(node, dir_b) : tree_b_.node(node).radius;
-}
-
-// localSupportA/B along sign x body axis `axis`: the box's extent that way,
-// the same value as the dot products give a unit axis.
-inline double PairGeometry::axisSupportA(std::int32_t node, int axis, double sign) const {
-  return bounds_a_ != nullptr ? bounds_a_->axisSupport(node, axis, sign) : tree_a_.node(node).radius;
-}
-
-inline double PairGeometry::axisSupportB(std::int32_t node, int axis, double sign) const {
-  return bounds_b_ != nullptr ? bounds_b_->axisSupport(node, axis, sign) : tree_b_.node(node).radius;
 }
 
 ContactCandidate PairGeometry::candidate(std::int32_t node_a, std::int32_t node_b) const {
