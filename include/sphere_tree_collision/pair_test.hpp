@@ -71,6 +71,11 @@ class PairTest {
   // then); without one, the test uses and clears its own. No allocation once warm.
   void reset(const PairBody& a, const PairBody& b, PairArena* arena = nullptr);
 
+  // A pair whose contacts are carried over from an earlier tick
+  // (PairContactCache): Colliding at once, with no sphere tested, its last
+  // pair the deepest leaf pair found then and its deepest level that one's.
+  void resumeColliding(const PairBody& a, const PairBody& b, PairArena* arena, const SpherePair& leaf, int level);
+
   // Descend one level: test every sphere hit's target against its test list.
   // Outcomes (paper 3.4.1): a leaf-leaf intersection -> Colliding; no
   // intersection at all -> Separate; otherwise new hits (crossover between

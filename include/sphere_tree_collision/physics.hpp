@@ -6,6 +6,7 @@
 #include "sphere_tree_collision/contact_builder.hpp"
 #include "sphere_tree_collision/contact_solver.hpp"
 #include "sphere_tree_collision/continuous.hpp"
+#include "sphere_tree_collision/pair_contact_cache.hpp"
 #include "sphere_tree_collision/response_options.hpp"
 #include "sphere_tree_collision/shape_bounds.hpp"
 #include "sphere_tree_collision/static_cover.hpp"
@@ -37,6 +38,10 @@ struct StepContext {
   std::size_t pair_count = 0;
   const std::vector<std::array<std::uint32_t, 2>>* pair_bodies = nullptr;
   const std::vector<double>* priorities = nullptr;
+  // Per pair: its PairContactCache entry when its contacts are carried over
+  // this tick (its test resumed Colliding), else PairContactCache::kNone
+  // (respond; nullptr: every pair's contacts are built).
+  const std::vector<std::uint32_t>* reused = nullptr;
   bool accept_unresolved = true;  // policy accept: unresolved pairs give contacts too
   SolveBudget budget;             // what the solver may spend (respond)
   std::vector<Contact>* contacts = nullptr;  // respond's output
@@ -76,19 +81,38 @@ class Physics {
   const PhysicsReport& lastReport() const { return report_; }
   void forget() { solver_.forget(); }
 
+  // Whether the response carries contacts over (ResponseOptions::reuse_tolerance).
+  static bool reusesContacts(const ResponseOptions& options) {
+    return options.enabled && options.reuse_tolerance > 0.0;
+  }
+  // Last tick's cache entry of the pair of bodies ia, ib (dense indices, in
+  // the test's order) when it may be carried over now, else
+  // PairContactCache::kNone. Reads ids, bodies, body_shapes, shape_bounds;
+  // safe from many threads at once.
+  std::uint32_t reusableEntry(const StepContext& step, std::uint32_t ia, std::uint32_t ib) const;
+  const PairContactCache& pairCache() const { return pair_cache_; }
+  // Drops the carried contacts: the next tick builds every pair's (a static
+  // body came or went, so covered faces may have changed; or the options did).
+  void forgetReuse() { pair_cache_.clear(); }
+
  private:
+  // Also records the pairs' cache entries into `reuse` when step.reused is set.
   void appendContacts(const StepContext& step, std::size_t first, std::size_t last, ContactBuilder& builder,
-                      std::vector<Contact>& out) const;
+                      std::vector<Contact>& out, PairContactCache::Pending& reuse) const;
+  ReuseBody reuseBody(const StepContext& step, std::uint32_t index) const;
 
   // A builder (its scratch) and the contacts of each chunk of the pairs
   // (parallel contact building); capacity kept between ticks.
   std::vector<ContactBuilder> builders_;
   struct alignas(64) ChunkContacts {  // a line of its own: its end moves with each contact
     std::vector<Contact> contacts;
+    PairContactCache::Pending reuse;  // the chunk's pairs' cache entries for the next tick
   };
   std::vector<ChunkContacts> chunk_contacts_;
   std::size_t builder_turn_ = 0;
   ContactSolver solver_;
+  PairContactCache pair_cache_;  // contacts carried over between ticks
+  std::vector<const PairContactCache::Pending*> reuse_pending_;  // the chunks' entries, for commit
   double gravity_speed_ = 0.0;  // |g| dt of the last integrate
   std::vector<Pose> start_;
   std::vector<const ShapeBounds*> body_bounds_;

@@ -50,6 +50,15 @@ struct ResponseOptions {
   // than this fraction of its smallest leaf radius in one tick.
   double sweep_threshold = 0.5;
   bool gyroscopic = true;               // implicit-midpoint w x Iw (see dynamics.hpp)
+  // A colliding pair's contacts are kept from tick to tick, and the pair
+  // skips the narrow phase and contact building, while no point of either
+  // body moves relative to the other by more than this fraction of the
+  // smaller leaf radius of the two since they were built
+  // (pair_contact_cache.hpp). 0: every pair is tested and built every tick.
+  // In [0, 1]; only with the response enabled. Off by default: the carried
+  // contacts lag the bodies by up to the drift, which changes how piles
+  // creep and settle (docs/response.md: reusing a pair's contacts).
+  double reuse_tolerance = 0.0;
   // With threads > 1: a solver stage (contact_partition.hpp) of fewer
   // manifolds than this runs on the calling thread, a bigger one's blocks on
   // the workers (each hand-off may wake a worker; docs/architecture.md). >= 1.

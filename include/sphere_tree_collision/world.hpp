@@ -104,6 +104,7 @@ struct TickReport {
   std::size_t entities = 0;
   std::size_t broad_pairs = 0;
   std::size_t colliding = 0;            // resolved colliding at the leaves
+  std::size_t reused = 0;               // of those, resumed with last tick's contacts (no sphere tested)
   std::size_t separate = 0;             // resolved separate
   std::size_t unresolved = 0;           // left unresolved at interruption
   std::size_t unresolved_accepted = 0;  // of those, accepted as colliding (policy accept)
@@ -243,7 +244,7 @@ class World {
   void broadPhase(TickReport& report);   // also sets up the pair tests of its pairs
   void continuousCollision(TickReport& report);
   // Returns the clock when the scheduler stopped (what follows is not interruptible).
-  double narrowPhase(const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
+  double narrowPhase(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
   void response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report);
   void quarantine(TickReport& report);  // first and last: removes bodies beyond the limits
   // After the response: bodies hit harder than their strength are queued in
@@ -306,6 +307,7 @@ class World {
   std::size_t pair_count_ = 0;
   std::vector<std::array<std::uint32_t, 2>> pair_bodies_;  // dense indices of each pair test's bodies
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
+  std::vector<std::uint32_t> pair_reused_;  // each pair's carried-over contacts (PairContactCache), or kNone
   std::vector<Contact> contacts_;
   Physics physics_;  // integration and response (response.hpp), warm-start state
   Islands islands_;  // which bodies sleep, indexed like bodies_

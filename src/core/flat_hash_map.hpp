@@ -58,6 +58,12 @@ class FlatHashMap {
     if (n * 2 > slots_.size()) grow(n * 2);
   }
   std::size_t size() const { return size_; }
+  // Empties the map and keeps its capacity.
+  void clear() {
+    if (size_ == 0) return;
+    for (Slot& s : slots_) s.key = kEmpty;
+    size_ = 0;
+  }
 
  private:
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};

@@ -98,6 +98,20 @@ void PairTest::reset(const PairBody& a, const PairBody& b, PairArena* arena) {
   sphere_tests_ = 0;
 }
 
+void PairTest::resumeColliding(const PairBody& a, const PairBody& b, PairArena* arena, const SpherePair& leaf,
+                               int level) {
+  reset(a, b, arena);
+  hits_count_ = 0;  // the root hit reset() made stays unused in the arena
+  PairArena& store = this->arena();
+  last_begin_ = store.pairs_used;
+  last_count_ = 1;
+  *roomFor(store.pairs, store.pairs_used, 1) = leaf;
+  ++store.pairs_used;
+  status_ = PairStatus::Colliding;
+  next_tests_ = 0;
+  deepest_level_ = level;
+}
+
 int PairTest::step() {
   if (resolved()) return 0;
 

@@ -55,9 +55,23 @@ void Physics::sweep(const StepContext& step) {
                                   options.sweep_threshold, sweep_scratch_, step.workers);
 }
 
+ReuseBody Physics::reuseBody(const StepContext& step, std::uint32_t index) const {
+  const ShapeBounds& bounds = (*step.shape_bounds)[(*step.body_shapes)[index]];
+  const BodyState& body = (*step.bodies)[index];
+  // Its velocity as the last tick's response left it: without this tick's
+  // gravity, which a body resting on another never gets to act on.
+  const Vec3 v = body.is_static ? Vec3::Zero() : Vec3(body.linear_velocity - step.gravity * step.dt);
+  return ReuseBody{(*step.ids)[index], &body.pose, v, body.angular_velocity, bounds.bound_radius};
+}
+
+std::uint32_t Physics::reusableEntry(const StepContext& step, std::uint32_t ia, std::uint32_t ib) const {
+  return pair_cache_.find(reuseBody(step, ia), reuseBody(step, ib), step.dt);
+}
+
 // The contacts of pairs [first, last) appended to `out` in pair order.
 void Physics::appendContacts(const StepContext& step, std::size_t first, std::size_t last,
-                             ContactBuilder& builder, std::vector<Contact>& out) const {
+                             ContactBuilder& builder, std::vector<Contact>& out,
+                             PairContactCache::Pending& reuse) const {
   const ResponseOptions& options = *step.options;
   const std::vector<PairTest>& tests = *step.tests;
   const std::vector<std::array<std::uint32_t, 2>>& pair_bodies = *step.pair_bodies;
@@ -68,15 +82,34 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
   build.max_contacts_per_pair = options.max_contacts_per_pair;
   build.accept_unresolved = step.accept_unresolved;
   build.face_normals = options.face_normals;
+  reuse.clear();
   for (std::size_t i = first; i < last; ++i) {
     const std::uint32_t ia = pair_bodies[i][0];
     const std::uint32_t ib = pair_bodies[i][1];
     const std::size_t before = out.size();
+    const std::uint32_t entry = step.reused != nullptr ? (*step.reused)[i] : PairContactCache::kNone;
+    if (entry != PairContactCache::kNone) {  // its test resumed Colliding: last tick's contacts, placed anew
+      Contact base;
+      base.a = tests[i].bodyA().id;
+      base.b = tests[i].bodyB().id;
+      base.index_a = ia;
+      base.index_b = ib;
+      base.priority = priorities[i];
+      pair_cache_.place(entry, base, *tests[i].bodyA().pose, *tests[i].bodyB().pose, out);
+      pair_cache_.carry(entry, reuse);
+      continue;
+    }
     const StaticCover* cover = step.static_cover;
+    const ShapeBounds& bounds_a = shape_bounds[body_shapes[ia]];
+    const ShapeBounds& bounds_b = shape_bounds[body_shapes[ib]];
     builder.append(tests[i], ia, ib, priorities[i],
-                   BodySurface{&shape_bounds[body_shapes[ia]], cover != nullptr ? cover->of(ia) : nullptr},
-                   BodySurface{&shape_bounds[body_shapes[ib]], cover != nullptr ? cover->of(ib) : nullptr}, build,
-                   out);
+                   BodySurface{&bounds_a, cover != nullptr ? cover->of(ia) : nullptr},
+                   BodySurface{&bounds_b, cover != nullptr ? cover->of(ib) : nullptr}, build, out);
+    if (step.reused != nullptr && tests[i].status() == PairStatus::Colliding && out.size() > before) {
+      const double tolerance = options.reuse_tolerance * std::min(bounds_a.min_leaf_radius, bounds_b.min_leaf_radius);
+      PairContactCache::record(tests[i], reuseBody(step, ia), reuseBody(step, ib), tolerance, out.data() + before,
+                               out.data() + out.size(), reuse);
+    }
     if (out.size() == before && sweep_hit_of_pair_[i] >= 0) {
       // The sweep held a body back at this pair's first touch but the test
       // (interrupted, or not accepted) gave no contact: the hit is the contact,
@@ -112,12 +145,12 @@ void Physics::respond(const StepContext& step) {
   // contacts, in the same order, whatever the thread count).
   // A few chunks a thread: a pile's colliding pairs bunch in the pair list.
   const std::size_t threads = step.workers != nullptr ? static_cast<std::size_t>(step.workers->threads()) : 1;
-  const std::size_t chunks = threads > 1 ? kChunksPerThread * threads : 1;
-  if (chunks == 1 || count < kPairsPerTask) {
-    appendContacts(step, 0, count, builders_.empty() ? builders_.emplace_back() : builders_[0], contacts);
+  const std::size_t chunks = threads > 1 && count >= kPairsPerTask ? kChunksPerThread * threads : 1;
+  if (builders_.size() < chunks) builders_.resize(chunks);
+  if (chunk_contacts_.size() < chunks) chunk_contacts_.resize(chunks);
+  if (chunks == 1) {
+    appendContacts(step, 0, count, builders_[0], contacts, chunk_contacts_[0].reuse);
   } else {
-    if (builders_.size() < chunks) builders_.resize(chunks);
-    if (chunk_contacts_.size() < chunks) chunk_contacts_.resize(chunks);
     // The builders take turns at the chunks, so each one's scratch grows to
     // what any part of the pair list needs and then allocates no more.
     ++builder_turn_;
@@ -125,12 +158,20 @@ void Physics::respond(const StepContext& step) {
       std::vector<Contact>& chunk = chunk_contacts_[k].contacts;
       chunk.clear();
       const auto [first, last] = chunkRange(count, k, chunks);
-      appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk);
+      appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk, chunk_contacts_[k].reuse);
     });
     for (std::size_t k = 0; k < chunks; ++k) {
       const std::vector<Contact>& chunk = chunk_contacts_[k].contacts;
       contacts.insert(contacts.end(), chunk.begin(), chunk.end());
     }
+  }
+  // The next tick's cache: this tick's entries, in pair order.
+  if (step.reused != nullptr) {
+    reuse_pending_.clear();
+    for (std::size_t k = 0; k < chunks; ++k) reuse_pending_.push_back(&chunk_contacts_[k].reuse);
+    pair_cache_.commit(reuse_pending_.data(), chunks);
+  } else {
+    pair_cache_.clear();
   }
   report_.solve = SolveStats{};
   if (!options.enabled) return;

@@ -39,6 +39,9 @@ void validateResponseOptions(const ResponseOptions& o) {
   if (!(o.sweep_threshold > 0.0 && std::isfinite(o.sweep_threshold))) {
     throw InputError("response.sweep_threshold", "must be finite and > 0");
   }
+  if (!(o.reuse_tolerance >= 0.0 && o.reuse_tolerance <= 1.0)) {
+    throw InputError("response.reuse_tolerance", "must be in [0, 1]");
+  }
 }
 
 }  // namespace stc

@@ -178,6 +178,7 @@ EntityId World::addEntity(const EntitySpec& spec) {
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
   islands_.add(info.bounding_radius);
   ++next_id_;
+  if (spec.is_static) physics_.forgetReuse();  // its neighbours' covered faces change
   invalidateLastTick();
   return id;
 }
@@ -192,6 +193,7 @@ bool World::removeEntity(EntityId id) {
     const std::uint32_t other = index_of_->find(pair.first == id ? pair.second : pair.first);
     if (other != detail::FlatHashMap::kMissing) islands_.wake(other);  // missing: removed since the last update
   }
+  if (bodies_[index].is_static) physics_.forgetReuse();  // its neighbours' covered faces change
   islands_.remove(index, last);
   static_cover_.remove(index, last);
   broad_phase_.remove(id);
@@ -237,6 +239,7 @@ void World::clear() {
   broad_phase_ = SweepAndPrune();
   islands_.clear();
   static_cover_.clear();
+  physics_.forgetReuse();
   invalidateLastTick();
 }
 
@@ -251,6 +254,7 @@ void World::setScheduler(const SchedulerOptions& options) {
 void World::setResponse(const ResponseOptions& options) {
   validateResponseOptions(options);
   config_.response = options;
+  physics_.forgetReuse();  // contacts built under the options before
   if (!options.enabled) islands_.wakeAll();  // detection alone: every pair is tested again
 }
 
@@ -313,7 +317,7 @@ TickReport World::step(double dt, const Budget& budget) {
     t2 = clock_();
     continuousCollision(report);
     t2s = clock_();
-    scheduled = narrowPhase(budget, tick_end, t2s, report);
+    scheduled = narrowPhase(dt, budget, tick_end, t2s, report);
     t3 = clock_();
     if (timed_tick) report.response_budget_s = std::max(tick_end.at() - t3, 0.0);
     response(dt, budget, tick_end, report);
@@ -346,6 +350,7 @@ StepContext World::physicsStep() {
   step.pair_count = pair_count_;
   step.pair_bodies = &pair_bodies_;
   step.priorities = &pair_priority_;
+  step.reused = Physics::reusesContacts(config_.response) ? &pair_reused_ : nullptr;
   step.accept_unresolved = config_.unresolved_policy == UnresolvedPolicy::Accept;
   step.contacts = &contacts_;
   step.workers = &workers_;
@@ -422,6 +427,7 @@ void World::broadPhase(TickReport& report) {
     pair_tests_.resize(pairs.size());
     pair_bodies_.resize(pairs.size());
     pair_priority_.resize(pairs.size());
+    pair_reused_.resize(pairs.size());
   }
   // A moving body reached a sleeping island: it woke, its pairs are tested too.
   if (setUpPairTests()) setUpPairTests();
@@ -451,7 +457,7 @@ void World::continuousCollision(TickReport& /*report*/) {
   physics_.sweep(physicsStep());
 }
 
-double World::narrowPhase(const Budget& budget, const Deadline& tick_end, double start,
+double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_end, double start,
                           TickReport& report) {
   // Its own limit, or what the tick leaves after the reserve for what follows.
   double end = std::numeric_limits<double>::infinity();
@@ -464,6 +470,10 @@ double World::narrowPhase(const Budget& budget, const Deadline& tick_end, double
   const bool gaze = perception_.hasFixation();
   // Each chunk: reset its tests into its arena, then its scheduler over them
   // under its share of the sphere tests; every chunk watches the deadline.
+  // A pair whose contacts last tick left valid resumes Colliding: no sphere
+  // test, its contacts carried over (pair_contact_cache.hpp).
+  StepContext step = physicsStep();
+  step.dt = dt;
   const std::size_t chunks = narrow_chunks_.size();
   workers_.forChunks(chunks, [&](std::size_t k, std::size_t) {
     NarrowChunk& chunk = narrow_chunks_[k];
@@ -471,8 +481,17 @@ double World::narrowPhase(const Budget& budget, const Deadline& tick_end, double
     chunk.arena.clear();
     for (std::size_t i = first; i < last; ++i) {
       const std::uint32_t ia = pair_bodies_[i][0], ib = pair_bodies_[i][1];
-      pair_tests_[i].reset(PairBody{ids_[ia], &shapes_[body_shapes_[ia]].tree, &bodies_[ia].pose},
-                           PairBody{ids_[ib], &shapes_[body_shapes_[ib]].tree, &bodies_[ib].pose}, &chunk.arena);
+      const PairBody a{ids_[ia], &shapes_[body_shapes_[ia]].tree, &bodies_[ia].pose};
+      const PairBody b{ids_[ib], &shapes_[body_shapes_[ib]].tree, &bodies_[ib].pose};
+      const std::uint32_t entry =
+          step.reused != nullptr ? physics_.reusableEntry(step, ia, ib) : PairContactCache::kNone;
+      pair_reused_[i] = entry;
+      if (entry == PairContactCache::kNone) {
+        pair_tests_[i].reset(a, b, &chunk.arena);
+      } else {
+        const PairContactCache::Entry& e = physics_.pairCache().entry(entry);
+        pair_tests_[i].resumeColliding(a, b, &chunk.arena, e.leaf, e.level);
+      }
     }
     BudgetTracker tracker(chunkShare(budget.sphere_tests, k, chunks), Deadline(&clock_, end));
     chunk.stats = chunk.scheduler->run(pair_tests_.data() + first, last - first,
@@ -491,7 +510,10 @@ double World::narrowPhase(const Budget& budget, const Deadline& tick_end, double
     const PairTest& test = pair_tests_[i];
     pair_priority_[i] = 0.0;
     switch (test.status()) {
-      case PairStatus::Colliding: ++report.colliding; break;
+      case PairStatus::Colliding:
+        ++report.colliding;
+        if (pair_reused_[i] != PairContactCache::kNone) ++report.reused;
+        break;
       case PairStatus::Separate: ++report.separate; break;
       case PairStatus::Unresolved: ++report.unresolved; break;
     }
