@@ -190,5 +190,33 @@ TEST(WorldAllocations, AFormingPileAllocatesInFewTicks) {
   EXPECT_LE(allocating, new_highs / 2);
 }
 
+// Contacts carried over (ResponseOptions::reuse_tolerance): a settling pile
+// (sleeping off, so its pairs stay in the tick) whose pairs go from built to
+// reused and back; the cache's entries, points and index keep their capacity.
+TEST(WorldAllocations, ReusedContactsDoNotAllocate) {
+  for (const int threads : {1, 2}) {
+    SceneParams params;
+    params.entities = 125;
+    WorldConfig config;
+    config.threads = threads;
+    config.sleeping.enabled = false;
+    config.response.reuse_tolerance = 0.05;
+    SceneWorld scene = makeSceneWorld(SceneKind::CubeBox, params, config);
+    for (int t = 0; t < 300; ++t) scene.world.step(scene.spec.dt, Budget::unlimited());
+    std::size_t reused = 0, colliding = 0;
+    g_allocations = 0;
+    g_counting = true;
+    for (int t = 0; t < 60; ++t) {
+      const TickReport r = scene.world.step(scene.spec.dt, Budget::unlimited());
+      reused += r.reused;
+      colliding += r.colliding;
+    }
+    g_counting = false;
+    EXPECT_EQ(g_allocations, 0) << threads << " threads";
+    EXPECT_GT(reused, 0u) << threads << " threads";
+    EXPECT_LT(reused, colliding) << threads << " threads: some pairs are built too";
+  }
+}
+
 }  // namespace
 }  // namespace stc

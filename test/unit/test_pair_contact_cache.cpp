@@ -1,0 +1,363 @@
+// Contacts carried over between ticks (PairContactCache,
+// ResponseOptions::reuse_tolerance): when an entry is found, where its
+// contacts are placed again, and what a World does with it.
+#include "sphere_tree_collision/contact_builder.hpp"
+#include "sphere_tree_collision/dynamics.hpp"
+#include "sphere_tree_collision/pair_contact_cache.hpp"
+#include "sphere_tree_collision/scenes.hpp"
+#include "sphere_tree_collision/world.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+using namespace stc;
+
+namespace {
+
+constexpr double kDt = 1.0 / 60.0;
+
+// Two 40 cm cubes of 10 cm voxels; B beside A along +x, overlapping it by
+// 1 cm, tested to the leaves; its contacts built and recorded in a cache.
+struct CachedCubes {
+  VoxelShape shape = VoxelShape::create(4, 4, 4, 0.1, std::vector<std::uint8_t>(64, 1));
+  Vec3 origin = Vec3::Constant(0.2);
+  SphereTree tree = SphereTree::build(shape, origin);
+  ShapeBounds bounds = makeShapeBounds(tree, &shape, origin);
+  Pose pose_a, pose_b;
+  std::vector<Contact> built;
+  PairContactCache cache;
+  double tolerance = 0.0;
+
+  CachedCubes() {
+    pose_b.position = Vec3(0.39, 0.0, 0.0);
+    built = build(pose_b);
+    tolerance = 0.05 * bounds.min_leaf_radius;
+    PairTest test = tested(pose_b);
+    PairContactCache::Pending pending;
+    PairContactCache::record(test, body(0, pose_a), body(1, pose_b), tolerance, built.data(),
+                             built.data() + built.size(), pending);
+    const PairContactCache::Pending* all[] = {&pending};
+    cache.commit(all, 1);
+  }
+  PairTest tested(const Pose& b) const {
+    PairTest test;
+    test.reset(PairBody{0, &tree, &pose_a}, PairBody{1, &tree, &b});
+    while (!test.resolved()) test.step();
+    return test;
+  }
+  // The contacts ContactBuilder makes with B at `b`.
+  std::vector<Contact> build(const Pose& b) const {
+    const PairTest test = tested(b);
+    std::vector<Contact> out;
+    ContactBuilder builder;
+    builder.append(test, 0, 1, 0.0, &bounds, &bounds, ContactBuildOptions{}, out);
+    return out;
+  }
+  ReuseBody body(EntityId id, const Pose& pose, const Vec3& v = Vec3::Zero(), const Vec3& w = Vec3::Zero()) const {
+    return ReuseBody{id, &pose, v, w, bounds.bound_radius};
+  }
+  std::uint32_t find(const Pose& b, const Vec3& vb = Vec3::Zero(), const Vec3& wb = Vec3::Zero()) const {
+    return cache.find(body(0, pose_a), body(1, b, vb, wb), kDt);
+  }
+  std::vector<Contact> place(std::uint32_t entry, const Pose& b) const {
+    Contact base;
+    base.a = 0;
+    base.b = 1;
+    base.index_b = 1;
+    std::vector<Contact> out;
+    cache.place(entry, base, pose_a, b, out);
+    return out;
+  }
+};
+
+Pose shifted(const Pose& p, const Vec3& by) {
+  Pose out = p;
+  out.position += by;
+  return out;
+}
+
+}  // namespace
+
+TEST(PairContactCache, PlacedAtTheSamePosesTheContactsAreTheBuiltOnes) {
+  CachedCubes cubes;
+  ASSERT_FALSE(cubes.built.empty());
+  ASSERT_EQ(cubes.cache.size(), 1u);
+  const std::uint32_t entry = cubes.find(cubes.pose_b);
+  ASSERT_NE(entry, PairContactCache::kNone);
+  const std::vector<Contact> placed = cubes.place(entry, cubes.pose_b);
+  ASSERT_EQ(placed.size(), cubes.built.size());
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    EXPECT_LT((placed[i].point - cubes.built[i].point).norm(), 1e-12);
+    EXPECT_LT((placed[i].normal - cubes.built[i].normal).norm(), 1e-12);
+    EXPECT_NEAR(placed[i].separation, cubes.built[i].separation, 1e-12);
+    EXPECT_NEAR(placed[i].depth, cubes.built[i].depth, 1e-12);
+    EXPECT_EQ(placed[i].node_a, cubes.built[i].node_a);  // the feature ids the warm start matches
+    EXPECT_EQ(placed[i].node_b, cubes.built[i].node_b);
+    EXPECT_TRUE(placed[i].resolved);
+  }
+}
+
+TEST(PairContactCache, PlacedAfterADriftTheContactsMoveWithTheBodies) {
+  CachedCubes cubes;
+  // B pressed 0.6 tolerance further into A and slid 0.3 along the face: the
+  // face contacts' separations drop by exactly that much, as a fresh build's.
+  const Vec3 drift(-0.6 * cubes.tolerance, 0.3 * cubes.tolerance, 0.0);
+  const Pose moved = shifted(cubes.pose_b, drift);
+  const std::uint32_t entry = cubes.find(moved);
+  ASSERT_NE(entry, PairContactCache::kNone);
+  const std::vector<Contact> placed = cubes.place(entry, moved);
+  const std::vector<Contact> fresh = cubes.build(moved);
+  ASSERT_EQ(placed.size(), cubes.built.size());
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    EXPECT_NEAR(placed[i].normal.x(), 1.0, 1e-12);  // A's face normal
+    EXPECT_NEAR(placed[i].separation, cubes.built[i].separation + drift.x(), 1e-12);
+    EXPECT_NEAR(placed[i].separation, fresh[0].separation, 1e-9);
+    // The point stays halfway between the surface points, which moved with their bodies.
+    EXPECT_LT((placed[i].point - (cubes.built[i].point + 0.5 * drift)).norm(), 1e-12);
+  }
+}
+
+TEST(PairContactCache, DriftTurnOrSpeedBeyondTheToleranceRebuild) {
+  CachedCubes cubes;
+  const double tol = cubes.tolerance;
+  EXPECT_NE(cubes.find(shifted(cubes.pose_b, Vec3(0.0, 0.0, 0.9 * tol))), PairContactCache::kNone);
+  EXPECT_EQ(cubes.find(shifted(cubes.pose_b, Vec3(0.0, 0.0, 1.1 * tol))), PairContactCache::kNone);
+  // A turn moves B's far corners by the chord at its bound radius.
+  const double r = cubes.bounds.bound_radius;
+  for (const double share : {0.9, 1.1}) {
+    Pose turned = cubes.pose_b;
+    turned.orientation = Quat(Eigen::AngleAxisd(2.0 * std::asin(share * tol / (2.0 * r)), Vec3::UnitZ()));
+    EXPECT_EQ(cubes.find(turned) != PairContactCache::kNone, share < 1.0) << share;
+  }
+  // Moving now at a speed that would take it past the tolerance within
+  // kMotionTicks ticks: built anew, though it has not drifted yet.
+  const double too_fast = 1.1 * tol / (PairContactCache::kMotionTicks * kDt);
+  EXPECT_NE(cubes.find(cubes.pose_b, Vec3(0.0, 0.9 * too_fast / 1.1, 0.0)), PairContactCache::kNone);
+  EXPECT_EQ(cubes.find(cubes.pose_b, Vec3(0.0, too_fast, 0.0)), PairContactCache::kNone);
+  EXPECT_EQ(cubes.find(cubes.pose_b, Vec3::Zero(), Vec3(0.0, 0.0, too_fast / r)), PairContactCache::kNone);
+  // Both at that speed together: no relative motion.
+  const Vec3 v(0.0, too_fast, 0.0);
+  EXPECT_NE(cubes.cache.find(cubes.body(0, cubes.pose_a, v), cubes.body(1, cubes.pose_b, v), kDt),
+            PairContactCache::kNone);
+}
+
+TEST(PairContactCache, OnlyTheSamePairInTheSameOrderAndNeverANaNPose) {
+  CachedCubes cubes;
+  EXPECT_EQ(cubes.cache.find(cubes.body(1, cubes.pose_b), cubes.body(0, cubes.pose_a), kDt), PairContactCache::kNone);
+  EXPECT_EQ(cubes.cache.find(cubes.body(0, cubes.pose_a), cubes.body(2, cubes.pose_b), kDt), PairContactCache::kNone);
+  Pose nan = cubes.pose_b;
+  nan.position.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(cubes.find(nan), PairContactCache::kNone);
+  cubes.cache.clear();
+  EXPECT_EQ(cubes.find(cubes.pose_b), PairContactCache::kNone);
+}
+
+TEST(PairContactCache, ACarriedEntryKeepsTheReferenceItWasBuiltAt) {
+  CachedCubes cubes;
+  // 0.6 tolerance a tick, twice: the second is 1.2 from where the contacts
+  // were built, though only 0.6 from the tick before.
+  const Vec3 step(0.0, 0.6 * cubes.tolerance, 0.0);
+  const Pose once = shifted(cubes.pose_b, step);
+  const std::uint32_t entry = cubes.find(once);
+  ASSERT_NE(entry, PairContactCache::kNone);
+  PairContactCache::Pending pending;
+  cubes.cache.carry(entry, pending);
+  const PairContactCache::Pending* all[] = {&pending};
+  cubes.cache.commit(all, 1);
+  ASSERT_NE(cubes.find(once), PairContactCache::kNone);
+  EXPECT_EQ(cubes.find(shifted(once, step)), PairContactCache::kNone);
+  // The carried points are the built ones.
+  const std::vector<Contact> placed = cubes.place(cubes.find(cubes.pose_b), cubes.pose_b);
+  ASSERT_EQ(placed.size(), cubes.built.size());
+  for (std::size_t i = 0; i < placed.size(); ++i) EXPECT_LT((placed[i].point - cubes.built[i].point).norm(), 1e-12);
+}
+
+TEST(PairContactCache, AResumedTestIsCollidingAtItsLeafPairWithNoSphereTested) {
+  CachedCubes cubes;
+  const PairTest tested = cubes.tested(cubes.pose_b);
+  const PairContactCache::Entry& e = cubes.cache.entry(cubes.find(cubes.pose_b));
+  EXPECT_EQ(e.leaf.a, tested.lastPair().a);
+  EXPECT_EQ(e.leaf.b, tested.lastPair().b);
+  PairTest resumed;
+  resumed.resumeColliding(PairBody{0, &cubes.tree, &cubes.pose_a}, PairBody{1, &cubes.tree, &cubes.pose_b}, nullptr,
+                          e.leaf, e.level);
+  EXPECT_EQ(resumed.status(), PairStatus::Colliding);
+  EXPECT_EQ(resumed.sphereTests(), 0);
+  EXPECT_EQ(resumed.nextStepTests(), 0);
+  EXPECT_EQ(resumed.step(), 0);
+  EXPECT_EQ(resumed.deepestLevel(), tested.deepestLevel());
+  // What perception and the reports read of it: the leaf pair's.
+  EXPECT_LT((resumed.centreOfCollision() - tested.centreOfCollision()).norm(), 1e-12);
+  EXPECT_NEAR(resumed.gapBound(), tested.gapBound(), 1e-12);
+}
+
+// ---------------------------------------------------------------------------------
+// Through the World
+
+namespace {
+
+// A 40 cm cube (8 voxels of 5 cm) dropped 1 cm onto a static plate, g = 9.81.
+World cubeOnPlate(double reuse_tolerance, int threads = 1) {
+  WorldConfig config;
+  config.gravity = Vec3(0.0, 0.0, -9.81);
+  config.response.reuse_tolerance = reuse_tolerance;
+  config.sleeping.enabled = false;  // its pair stays in the tick
+  config.threads = threads;
+  World w(config);
+  PresetParams p;
+  p.resolution = 8;
+  p.voxel_size = 0.05;
+  const ShapeId cube = w.addShape("cube", makePreset("cube", p));
+  p.resolution = 16;
+  const ShapeId plate = w.addShape("plate", makePreset("cube", p));
+  EntitySpec floor;
+  floor.shape = plate;
+  floor.is_static = true;
+  floor.pose.position = Vec3(0.0, 0.0, -0.4);  // top face at z = 0
+  w.addEntity(floor);
+  EntitySpec box;
+  box.shape = cube;
+  box.pose.position = Vec3(0.0, 0.0, 0.21);
+  w.addEntity(box);
+  return w;
+}
+
+}  // namespace
+
+TEST(PairContactCache, ARestingCubeReusesItsContactsAndRestsWhereItWouldHave) {
+  World reusing = cubeOnPlate(0.05);
+  World building = cubeOnPlate(0.0);
+  std::size_t reused = 0, built_reused = 0;
+  std::int64_t reused_tests = 0, built_tests = 0;
+  for (int t = 0; t < 180; ++t) {
+    const TickReport r = reusing.step(kDt, Budget::unlimited());
+    const TickReport b = building.step(kDt, Budget::unlimited());
+    ASSERT_EQ(r.colliding + r.separate + r.unresolved, reusing.pairCount());
+    if (t < 120) continue;
+    reused += r.reused;
+    built_reused += b.reused;
+    reused_tests += r.sphere_tests;
+    built_tests += b.sphere_tests;
+    if (r.reused > 0) {
+      // The solver matched every carried point to last tick's impulse.
+      EXPECT_EQ(reusing.physicsReport().solve.warm_started, reusing.physicsReport().solve.contacts);
+    }
+  }
+  EXPECT_GT(reused, 50u);  // of 60 resting ticks
+  EXPECT_EQ(built_reused, 0u);
+  EXPECT_LT(reused_tests, built_tests / 5);
+  const BodyState& a = reusing.bodies()[1];
+  const BodyState& b = building.bodies()[1];
+  // At rest, where the cube that rebuilt its contacts every tick rests (to a
+  // tenth of a millimetre, within the 2 mm tolerance), not turned.
+  EXPECT_LT(a.linear_velocity.norm(), 1e-3);
+  EXPECT_LT(a.angular_velocity.norm(), 1e-2);
+  EXPECT_LT((a.pose.position - b.pose.position).norm(), 1e-4);
+  EXPECT_LT(a.pose.orientation.angularDistance(b.pose.orientation), 1e-3);
+}
+
+TEST(PairContactCache, AMovedBodyNewOptionsOrANewStaticBodyRebuild) {
+  World w = cubeOnPlate(0.05);
+  for (int t = 0; t < 150; ++t) w.step(kDt, Budget::unlimited());
+  ASSERT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
+  w.bodies()[1].pose.position.x() += 0.01;  // an edit: 1 cm aside
+  EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
+  ASSERT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
+  w.setResponse(w.config().response);
+  EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
+  ASSERT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
+  EntitySpec far;  // a static body far away: covered faces may change anywhere
+  far.shape = w.bodyShapes()[1];
+  far.is_static = true;
+  far.pose.position = Vec3(10.0, 0.0, 0.0);
+  w.addEntity(far);
+  EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
+  EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
+  // Off: built every tick.
+  ResponseOptions off = w.config().response;
+  off.reuse_tolerance = 0.0;
+  w.setResponse(off);
+  for (int t = 0; t < 10; ++t) EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
+  // Detection alone: nothing is carried, the test answers every tick.
+  ResponseOptions detect = w.config().response;
+  detect.reuse_tolerance = 0.05;
+  detect.enabled = false;
+  w.setResponse(detect);
+  for (int t = 0; t < 10; ++t) EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
+}
+
+TEST(PairContactCache, ThreadCountDoesNotChangeTheResult) {
+  // A cube pile settling with reuse: 1 and 2 threads, bit for bit.
+  SceneParams params;
+  params.entities = 64;
+  std::vector<std::vector<BodyState>> finals;
+  std::size_t reused = 0;
+  for (const int threads : {1, 2}) {
+    WorldConfig config;
+    config.threads = threads;
+    config.response.reuse_tolerance = 0.05;
+    SceneWorld scene = makeSceneWorld(SceneKind::CubeBox, params, config);
+    for (int t = 0; t < 300; ++t) reused += scene.world.step(scene.spec.dt, Budget::unlimited()).reused;
+    finals.push_back(scene.world.bodies());
+  }
+  EXPECT_GT(reused, 0u);
+  ASSERT_EQ(finals[0].size(), finals[1].size());
+  for (std::size_t i = 0; i < finals[0].size(); ++i) {
+    EXPECT_EQ(finals[0][i].pose.position, finals[1][i].pose.position) << i;
+    EXPECT_EQ(finals[0][i].pose.orientation.coeffs(), finals[1][i].pose.orientation.coeffs()) << i;
+    EXPECT_EQ(finals[0][i].linear_velocity, finals[1][i].linear_velocity) << i;
+  }
+}
+
+TEST(PairContactCache, ABallRollingDownASlopeIsNotHeldBack) {
+  // The slope of test_physics (10 degrees, rolling resistance 0.1 < tan 10):
+  // a = 5 g (sin t - c cos t) / 7. A steadily rolling ball is built anew
+  // (kMotionTicks), so its contacts never lag it for long: within 10 %.
+  const double slope = 10.0 * M_PI / 180.0, c = 0.1, dt = 1.0 / 120.0;
+  WorldConfig config;
+  config.gravity = 9.81 * Vec3(std::sin(slope), 0.0, -std::cos(slope));
+  config.response.reuse_tolerance = 0.05;
+  World w(config);
+  PresetParams p;
+  p.resolution = 8;
+  p.voxel_size = 250.0;
+  Material m{0.0, 0.8};
+  m.rolling_resistance = c;
+  EntitySpec ground;
+  ground.shape = w.addShape("globe", makePreset("sphere", p));
+  ground.is_static = true;
+  ground.material = m;
+  ground.pose.position = Vec3(0.0, 0.0, -1000.0);
+  w.addEntity(ground);
+  p.voxel_size = 0.05;
+  EntitySpec ball;
+  ball.shape = w.addShape("ball", makePreset("sphere", p));
+  ball.material = m;
+  ball.pose.position = Vec3(0.0, 0.0, 0.2);
+  w.addEntity(ball);
+  std::size_t reused = 0;
+  for (int i = 0; i < 120; ++i) reused += w.step(dt, Budget::unlimited()).reused;
+  const double a = 5.0 * 9.81 * (std::sin(slope) - c * std::cos(slope)) / 7.0;
+  EXPECT_GT(reused, 0u);  // while it starts, slowly
+  EXPECT_NEAR(w.bodies()[1].pose.position.x(), 0.5 * a, 0.1 * 0.5 * a);
+  EXPECT_NEAR(w.bodies()[1].linear_velocity.x(), a, 0.1 * a);
+}
+
+TEST(PairContactCache, BadTolerancesAreRejectedNamingTheField) {
+  for (const double bad : {-0.01, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
+    ResponseOptions o;
+    o.reuse_tolerance = bad;
+    try {
+      validateResponseOptions(o);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), "response.reuse_tolerance");
+    }
+    World w;
+    EXPECT_THROW(w.setResponse(o), InputError);
+    EXPECT_EQ(w.config().response.reuse_tolerance, 0.0);  // unchanged
+  }
+}
