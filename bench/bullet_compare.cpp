@@ -18,7 +18,8 @@
 // Ends with one SUMMARY line per scene: this package's thread-CPU p50 and
 // p99, Bullet's best (lowest) thread-CPU p50 and the ratio of the two p50s.
 //
-// Usage: bench_bullet_compare [--seconds S] [--settle S] [--scenes LIST] [--variants LIST] [--markdown FILE]
+// Usage: bench_bullet_compare [--seconds S] [--settle S] [--scenes LIST] [--variants LIST] [--iterations N]
+//                             [--reuse T] [--markdown FILE]
 //   --seconds   simulated time per run (default 10)
 //   --settle    simulated time run first, untimed (default 0): with it the timed
 //               ticks are those of a settling scene, where both engines put
@@ -32,6 +33,9 @@
 //               (ResponseOptions::iterations; default: the World's, 20). Bullet
 //               runs its default 10 always: --iterations 10 compares the two
 //               at the same solver effort. The SUMMARY lines say which was used.
+//   --reuse T   this package carries a resting pair's contacts over while its bodies
+//               drift less than T of a leaf radius (ResponseOptions::reuse_tolerance;
+//               default: the World's, 0 = off). The SUMMARY lines say so.
 // Where the response's time goes (instruction counts, stable on a loaded machine;
 // docs/response.md, "Cost of the response"):
 //   valgrind --tool=callgrind --toggle-collect='stc::Physics::respond*'
@@ -128,12 +132,35 @@ class MotionCheck {
   std::size_t samples_ = 0;
 };
 
-// iterations > 0: this package's solver iterations instead of the default.
-SceneWorld sceneWorld(const Case& c, int iterations = 0) {
+// What this package's runs change from the World's defaults.
+struct PackageOptions {
+  int iterations = 0;      // > 0: solver iterations instead of the default
+  double reuse = -1.0;     // >= 0: ResponseOptions::reuse_tolerance
+  std::string label() const {
+    std::string out = "this package";
+    if (iterations > 0) out += ", " + std::to_string(iterations) + " iterations";
+    if (reuse >= 0.0) out += ", reuse " + shortNumber(reuse);
+    return out;
+  }
+  std::string summary() const {
+    std::string out;
+    if (iterations > 0) out += " iterations=" + std::to_string(iterations);
+    if (reuse >= 0.0) out += " reuse=" + shortNumber(reuse);
+    return out;
+  }
+  static std::string shortNumber(double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", x);
+    return buf;
+  }
+};
+
+SceneWorld sceneWorld(const Case& c, const PackageOptions& package = PackageOptions{}) {
   SceneParams params;
   params.entities = c.bodies;
   WorldConfig config;
-  if (iterations > 0) config.response.iterations = iterations;
+  if (package.iterations > 0) config.response.iterations = package.iterations;
+  if (package.reuse >= 0.0) config.response.reuse_tolerance = package.reuse;
   return makeSceneWorld(c.kind, params, config);
 }
 
@@ -142,8 +169,8 @@ void timeTick(Run& run, double wall0, double cpu0) {
   run.cpu.push_back(stc_bench::threadCpuSeconds() - cpu0);
 }
 
-Run runPackage(const Case& c, int ticks, int settle_ticks, int iterations) {
-  SceneWorld scene = sceneWorld(c, iterations);
+Run runPackage(const Case& c, int ticks, int settle_ticks, const PackageOptions& package) {
+  SceneWorld scene = sceneWorld(c, package);
   World& world = scene.world;
   const SceneSpec& spec = scene.spec;
   for (int t = 0; t < settle_ticks; ++t) world.step(spec.dt, Budget::unlimited());
@@ -157,7 +184,7 @@ Run runPackage(const Case& c, int ticks, int settle_ticks, int iterations) {
     }
   };
   Run run;
-  run.engine = iterations > 0 ? "this package, " + std::to_string(iterations) + " iterations" : "this package";
+  run.engine = package.label();
   MotionCheck check(spec.bounds, spec.dt);
   read();
   check.start(positions);
@@ -409,7 +436,7 @@ struct Options {
   double seconds = 10.0;
   double settle = 0.0;
   bool bullet_only = false;
-  int iterations = 0;  // 0: the World's default
+  PackageOptions package;
   std::vector<Case> cases;
   std::vector<BulletShape> variants{BulletShape::Compound, BulletShape::Hull};
   std::string markdown;
@@ -447,8 +474,11 @@ Options parse(int argc, char** argv) {
     } else if (a == "--bullet-only") {
       o.bullet_only = true;
     } else if (a == "--iterations") {
-      o.iterations = std::stoi(args.required());
-      if (o.iterations < 1) throw InputError("--iterations", "must be >= 1");
+      o.package.iterations = std::stoi(args.required());
+      if (o.package.iterations < 1) throw InputError("--iterations", "must be >= 1");
+    } else if (a == "--reuse") {
+      o.package.reuse = std::stod(args.required());
+      if (!(o.package.reuse >= 0.0 && o.package.reuse <= 1.0)) throw InputError("--reuse", "must be in [0, 1]");
     } else if (a == "--markdown") {
       o.markdown = args.required();
     } else {
@@ -479,7 +509,7 @@ int main(int argc, char** argv) {
   for (const Case& c : opt.cases) {
     std::printf("## %s (load %.2f)\n", label(c).c_str(), loadAverage());
     std::fflush(stdout);
-    const Run ours = opt.bullet_only ? Run{} : runPackage(c, ticks, settle_ticks, opt.iterations);
+    const Run ours = opt.bullet_only ? Run{} : runPackage(c, ticks, settle_ticks, opt.package);
     std::string rows = opt.bullet_only ? std::string() : runRow(c, ours);
     std::printf("%s", rows.c_str());
     std::fflush(stdout);
@@ -504,7 +534,7 @@ int main(int argc, char** argv) {
                   "SUMMARY scene=%s bodies=%d p50_ms=%.3f p99_ms=%.3f bullet_best_p50_ms=%.3f "
                   "ratio_p50=%.3f%s\n",
                   toString(c.kind), c.bodies, 1e3 * p50, 1e3 * percentile(ours.cpu, 0.99), 1e3 * best,
-                  p50 / best, opt.iterations > 0 ? (" iterations=" + std::to_string(opt.iterations)).c_str() : "");
+                  p50 / best, opt.package.summary().c_str());
     summary += buf;
   }
   std::string md;

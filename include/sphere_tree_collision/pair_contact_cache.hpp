@@ -72,9 +72,9 @@ class PairContactCache {
   // by the drift either way; one moving steadily (a ball rolling) would
   // always have them behind, a bias in one direction (a torque against the
   // roll), so it is built anew while it moves that fast. A ball rolling down
-  // a slope against rolling resistance gains 4.5 % more speed in 1 s at 2
-  // ticks, 6.3 % at 1 and 12 % at 0 (test_physics' slope, reuse_tolerance
-  // 0.05), while 2 keeps most of what reuse saves on a pile.
+  // a slope against rolling resistance ends 1 s 4.6 % faster than theory at
+  // 2 ticks, 6.3 % at 1 and 12 % at 0 (2.7 % built every tick; test_physics'
+  // slope, reuse_tolerance 0.05; docs/response.md).
   static constexpr double kMotionTicks = 2.0;
 
   // Last tick's entry of the pair (a, b in this order) when no point of one

@@ -470,6 +470,10 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
   const bool gaze = perception_.hasFixation();
   // Each chunk: reset its tests into its arena, then its scheduler over them
   // under its share of the sphere tests; every chunk watches the deadline.
+  // The static bodies' covered faces, measured again only when a static body
+  // came, went or moved (for the contacts; here, before any pair's contacts
+  // are carried over, since those were built with the faces before).
+  if (static_cover_.update(bodies_, body_shapes_, cover_shapes_)) physics_.forgetReuse();
   // A pair whose contacts last tick left valid resumes Colliding: no sphere
   // test, its contacts carried over (pair_contact_cache.hpp).
   StepContext step = physicsStep();
@@ -538,7 +542,6 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
 // then impulses and position correction (contact_builder.hpp,
 // contact_solver.hpp), refined until the tick's deadline or the iteration budget.
 void World::response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report) {
-  static_cover_.update(bodies_, body_shapes_, cover_shapes_);  // rebuilds only when a static body changed
   StepContext step = physicsStep();
   step.dt = dt;
   step.budget.max_iterations = budget.solver_iterations;

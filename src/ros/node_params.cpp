@@ -24,7 +24,7 @@ const std::set<std::string>& knownParams() {
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
       "min_voxel_size", "max_voxel_size", "entity_states_rate", "publish_clock", "error_report",
-      "min_piece_voxels", "small_pieces", "strength_exponent", "threads",
+      "min_piece_voxels", "small_pieces", "strength_exponent", "threads", "reuse_tolerance",
       "diagnostic_period", "camera_info_topic"};  // diagnostic_period: read by diagnostic_updater
   return kNames;
 }
@@ -189,6 +189,11 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   // Threads of the tick: 0 = every core; checked as WorldConfig::threads is.
   readParam(nh, "threads", p.world.threads);
   stc::validateThreads(p.world.threads);
+  // A resting pair's contacts carried over (0 = off; docs/response.md).
+  double reuse = p.world.response.reuse_tolerance;
+  readParam(nh, "reuse_tolerance", reuse);
+  if (!(reuse >= 0.0 && reuse <= 1.0)) throw InputError("reuse_tolerance", "must be in [0, 1]");
+  p.world.response.reuse_tolerance = reuse;
   p.world.max_entities = static_cast<std::size_t>(
       intParamIn(nh, "max_entities", static_cast<int>(p.world.max_entities), 1, 10000000));
   int max_voxels = static_cast<int>(p.world.voxel_limits.max_voxels);

@@ -86,6 +86,8 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"tree_levels", 12}}, "tree_levels"},
       {world, {{"max_entities", 0}}, "max_entities"},
       {world, {{"threads", -1}}, "threads"},
+      {world, {{"reuse_tolerance", 1.5}}, "reuse_tolerance"},
+      {world, {{"reuse_tolerance", -0.1}}, "reuse_tolerance"},
       {world, {{"scene", "/nonexistent/scene.yaml"}}, "scene"},
       {world, {{"scene", bad_scene}}, "scene entities[0].position"},
       {world, {{"scene", "rockfal"}}, "scene"},

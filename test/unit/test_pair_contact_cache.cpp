@@ -273,7 +273,10 @@ TEST(PairContactCache, AMovedBodyNewOptionsOrANewStaticBodyRebuild) {
   far.shape = w.bodyShapes()[1];
   far.is_static = true;
   far.pose.position = Vec3(10.0, 0.0, 0.0);
-  w.addEntity(far);
+  const EntityId far_id = w.addEntity(far);
+  EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
+  ASSERT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
+  w.bodies()[*w.indexOf(far_id)].pose.position.y() += 1.0;  // a static body moved: the same
   EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
   EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
   // Off: built every tick.
