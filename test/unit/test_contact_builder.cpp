@@ -2,6 +2,7 @@
 // refining candidates (face normals), picking spread-out representatives,
 // clustering, and a cluster's normal and separation.
 #include "sphere_tree_collision/contact_builder.hpp"
+#include "solid_cube.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,11 +16,7 @@ using namespace stc;
 namespace {
 
 // Two 40 cm cubes of 10 cm voxels, B at `offset` (turned by `turn`), tested to the leaves.
-struct TwoCubes {
-  VoxelShape shape = VoxelShape::create(4, 4, 4, 0.1, std::vector<std::uint8_t>(64, 1));
-  Vec3 origin = Vec3::Constant(0.2);
-  SphereTree tree = SphereTree::build(shape, origin);
-  ShapeBounds bounds = makeShapeBounds(tree, &shape, origin);
+struct TwoCubes : stc_test::SolidCube {
   Pose pose_a, pose_b;
   PairTest test;
 

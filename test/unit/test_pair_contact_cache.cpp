@@ -6,6 +6,7 @@
 #include "sphere_tree_collision/pair_contact_cache.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "solid_cube.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,11 +22,7 @@ constexpr double kDt = 1.0 / 60.0;
 
 // Two 40 cm cubes of 10 cm voxels; B beside A along +x, overlapping it by
 // 1 cm, tested to the leaves; its contacts built and recorded in a cache.
-struct CachedCubes {
-  VoxelShape shape = VoxelShape::create(4, 4, 4, 0.1, std::vector<std::uint8_t>(64, 1));
-  Vec3 origin = Vec3::Constant(0.2);
-  SphereTree tree = SphereTree::build(shape, origin);
-  ShapeBounds bounds = makeShapeBounds(tree, &shape, origin);
+struct CachedCubes : stc_test::SolidCube {
   Pose pose_a, pose_b;
   std::vector<Contact> built;
   PairContactCache cache;
