@@ -324,6 +324,7 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.entities = static_cast<std::uint32_t>(r.entities);
   s.broad_pairs = static_cast<std::uint32_t>(r.broad_pairs);
   s.colliding = static_cast<std::uint32_t>(r.colliding);
+  s.reused = static_cast<std::uint32_t>(r.reused);
   s.separate = static_cast<std::uint32_t>(r.separate);
   s.unresolved = static_cast<std::uint32_t>(r.unresolved);
   s.unresolved_accepted = static_cast<std::uint32_t>(r.unresolved_accepted);

@@ -123,7 +123,8 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
 TEST(BadParams, AGoodSetKeepsRunning) {
   const Case good{"collision_world_node",
                   {{"rate", 30}, {"scheduler", "round_robin"}, {"marker_levels", list({0, 3})}, {"tick_budget", 16.7},
-                   {"camera_position", list({0, -3, 1})}, {"camera_look_at", list({0, 0, 0.5})}},
+                   {"camera_position", list({0, -3, 1})}, {"camera_look_at", list({0, 0, 0.5})},
+                   {"reuse_tolerance", 0.05}},
                   ""};
   const auto [status, output] = run(good, 1000, 3.0);
   EXPECT_FALSE(status.has_value()) << "exited with " << status.value_or(-1) << ":\n" << output;

@@ -168,6 +168,8 @@ TEST(Smoke, TickStatsAndContactsEveryTick) {
     EXPECT_GT(stats.all[i].tick, stats.all[i - 1].tick);
     EXPECT_GT(stats.all[i].header.stamp, stats.all[i - 1].header.stamp);
   }
+  // Contacts are carried over only when asked for (~reuse_tolerance, off by default).
+  for (const auto& s : stats.all) EXPECT_EQ(s.reused, 0u) << "tick " << s.tick;
   // The gaze of the marker test has expired: no projection work from then on.
   ASSERT_TRUE(stc_test::spinUntil([&] { return !stats.last.gaze_active; }, stc_test::kLivenessSeconds));
   const std::uint64_t expired_at = stats.last.tick;
