@@ -39,12 +39,12 @@ class PairContactCache {
     std::int32_t node_a = 0, node_b = 0;
     int level = 0;
   };
-  // A pair's contacts as built, and the pose of B in A's frame (and of A in
-  // B's) then. Carried over unchanged while it is reused.
+  // A pair's contacts as built, and the pose of B in A's frame then.
+  // Carried over unchanged while it is reused.
   struct Entry {
     std::uint64_t key = 0;  // entity ids a, b packed
-    Vec3 b_in_a, a_in_b;
-    Quat a_to_b;            // conjugate(q_a) q_b
+    Vec3 b_in_a;            // B's origin in A's frame
+    Quat a_to_b;            // conjugate(q_a) q_b: B's orientation in A's frame
     double tolerance = 0.0; // metres any point of one body may drift relative to the other
     SpherePair leaf;        // the test's deepest leaf pair then (PairTest::resumeColliding)
     int level = 0;

@@ -50,7 +50,8 @@ std::uint32_t PairContactCache::find(const ReuseBody& a, const ReuseBody& b, dou
                             spin * a.radius;
   const double ahead = kMotionTicks * dt;
   const double seen_from_a = (originIn(pa, pb) - e.b_in_a).norm() + chord * b.radius + ahead * speed_in_a;
-  const double seen_from_b = (originIn(pb, pa) - e.a_in_b).norm() + chord * a.radius + ahead * speed_in_b;
+  const Vec3 a_in_b = -(e.a_to_b.conjugate() * e.b_in_a);  // A's origin in B's frame then
+  const double seen_from_b = (originIn(pb, pa) - a_in_b).norm() + chord * a.radius + ahead * speed_in_b;
   // Not `>`: a NaN pose never reuses.
   return std::min(seen_from_a, seen_from_b) <= e.tolerance ? index : kNone;
 }
@@ -84,7 +85,6 @@ void PairContactCache::record(const PairTest& test, const ReuseBody& a, const Re
   Entry e;
   e.key = keyOf(a.id, b.id);
   e.b_in_a = originIn(pa, pb);
-  e.a_in_b = originIn(pb, pa);
   e.a_to_b = pa.orientation.conjugate() * pb.orientation;
   e.tolerance = tolerance;
   e.leaf = test.lastPair();
