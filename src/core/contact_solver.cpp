@@ -32,8 +32,6 @@ constexpr std::size_t kManifoldsPerTask = 128;  // manifolds' rolling resistance
 // A pair's points kept for the warm start: one bit each in warmStart's `used`.
 constexpr std::uint32_t kCachedPointsPerPair = 32;
 
-std::uint64_t pairKey(EntityId a, EntityId b) { return (std::uint64_t{a} << 32) | std::uint64_t{b}; }
-
 // Relative velocity of b's point to a's point.
 STC_HOT_INLINE Vec3 relativeVelocity(const ContactSolver::Row& row, const Vec3& va, const Vec3& wa, const Vec3& vb,
                              const Vec3& wb) {
@@ -397,7 +395,7 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
       const std::uint32_t first = manifold_start_[m];
       const std::uint32_t last = manifold_start_[m + 1];
       const Contact& c0 = contacts[info_[first].contact];
-      const std::uint64_t key = pairKey(c0.a, c0.b);
+      const std::uint64_t key = entityPairKey(c0.a, c0.b);
       const auto found = std::lower_bound(cache_manifolds_.begin(), cache_manifolds_.end(), key,
                                           [](const CachedManifold& x, std::uint64_t k) { return x.pair < k; });
       if (found == cache_manifolds_.end() || found->pair != key) continue;
@@ -753,7 +751,7 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
         c.normal_impulse = row.lambda[0] + row.bounce_impulse;
         c.friction_impulse = row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
         if (r == manifold_start_[m]) {
-          manifold.pair = pairKey(c.a, c.b);
+          manifold.pair = entityPairKey(c.a, c.b);
           manifold.index_a = row.a;
           manifold.index_b = row.b;
         }

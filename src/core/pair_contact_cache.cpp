@@ -10,8 +10,6 @@
 namespace stc {
 namespace {
 
-std::uint64_t keyOf(EntityId a, EntityId b) { return (static_cast<std::uint64_t>(a) << 32) | b; }
-
 // The pose of `other` in `frame`'s frame: its origin there.
 Vec3 originIn(const Pose& frame, const Pose& other) {
   return frame.orientation.conjugate() * (other.position - frame.position);
@@ -27,7 +25,7 @@ PairContactCache& PairContactCache::operator=(PairContactCache&&) noexcept = def
 
 std::uint32_t PairContactCache::find(const ReuseBody& a, const ReuseBody& b, double dt) const {
   if (entries_.empty()) return kNone;
-  const std::uint32_t index = index_->find(keyOf(a.id, b.id));
+  const std::uint32_t index = index_->find(entityPairKey(a.id, b.id));
   if (index == detail::FlatHashMap::kMissing) return kNone;
   const Entry& e = entries_[index];
   // How far the relative pose moved since the entry was made: a point of B at
@@ -83,7 +81,7 @@ void PairContactCache::record(const PairTest& test, const ReuseBody& a, const Re
   const Pose& pa = *a.pose;
   const Pose& pb = *b.pose;
   Entry e;
-  e.key = keyOf(a.id, b.id);
+  e.key = entityPairKey(a.id, b.id);
   e.b_in_a = originIn(pa, pb);
   e.a_to_b = pa.orientation.conjugate() * pb.orientation;
   e.tolerance = tolerance;
