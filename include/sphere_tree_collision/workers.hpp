@@ -46,18 +46,27 @@ class Team {
  public:
   static constexpr std::size_t kMaxBlocks = 64;  // of one forBlocks round
   int members() const { return members_; }
+  // How a member takes blocks besides its own share's (the k with
+  // k * members / count == member).
+  enum class Claim : std::uint8_t {
+    // Its whole own share first, then runs it: the same bodies stage after
+    // stage stay on one core (the solver's slabs, the loops that fill them).
+    OwnShareWhole,
+    // Its own share one block at a time, then the others' from their ends:
+    // a member that finishes early takes over the rest of a slower one's
+    // share (blocks of uneven cost: a pile bunches in the pair list).
+    Balanced,
+  };
   // fn(k, k + 1) once for each block k in [0, count), each by one member, who
-  // first claims its whole own share (the k with k * members / count ==
-  // member: the same bodies stage after stage) and runs it, then takes any
-  // block left; returns when all are done. Only the thread that called
-  // withTeam may call it.
-  void forBlocks(std::size_t count, RangeFn fn);
+  // takes its own share as `claim` says and then any block left; returns when
+  // all are done. Only the thread that called withTeam may call it.
+  void forBlocks(std::size_t count, RangeFn fn, Claim claim = Claim::OwnShareWhole);
 
  private:
   friend class Workers;
   struct State;
   explicit Team(State* state, int members) : state_(state), members_(members) {}
-  void take(int member, std::uint64_t stage, const RangeFn* fn, std::size_t count);  // claim and run
+  void take(int member, std::uint64_t stage, const RangeFn* fn, std::size_t count, Claim claim);  // claim and run
   void serve(int member);  // a worker member: run stages until the team stops
   State* state_;           // null with one member
   int members_;
@@ -75,8 +84,9 @@ class Workers {
   // fn over [0, n) in pieces of at least `grain` indices, on the arena's
   // threads (the caller among them); returns when all are done.
   void forEach(std::size_t n, std::size_t grain, RangeFn fn) const;
-  // fn(k, k + 1) for each chunk k in [0, chunks), each one task.
-  void forChunks(std::size_t chunks, RangeFn fn) const;
+  // fn(k, k + 1) for each chunk k in [0, chunks), each one task; on the
+  // team, taken as `claim` says.
+  void forChunks(std::size_t chunks, RangeFn fn, Team::Claim claim = Team::Claim::OwnShareWhole) const;
   // body(team) on the calling thread while the arena's other threads serve
   // as team members, spinning between stages; returns when body has. Within
   // body, forEach and forChunks run on the team too, and a nested withTeam

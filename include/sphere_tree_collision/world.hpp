@@ -227,9 +227,10 @@ class World {
   // Narrow-phase results of the last step: pairTests()[0..pairCount()).
   const std::vector<PairTest>& pairTests() const { return pair_tests_; }
   std::size_t pairCount() const { return pair_count_; }
-  // The narrow phase's chunks: pairs chunkRange(pairCount(), k, narrowChunks())
-  // were stepped by chunk k's scheduler under chunkShare(budget, k, ...).
-  std::size_t narrowChunks() const { return narrow_chunks_.size(); }
+  // The last narrow phase's chunks (narrow_chunks.hpp; threads() before the
+  // first): pairs chunkRange(pairCount(), k, narrowChunks()) were stepped by
+  // chunk k's scheduler under chunkShare(budget, k, ...).
+  std::size_t narrowChunks() const { return narrow_chunks_used_; }
   // Threads the tick runs on (WorldConfig::threads resolved: 0 -> the cores).
   int threads() const { return workers_.threads(); }
   const std::vector<Contact>& contacts() const { return contacts_; }
@@ -297,11 +298,12 @@ class World {
 
   SweepAndPrune broad_phase_;
   std::vector<Aabb> boxes_;  // this tick's box of each body, by dense index (pooled)
-  // The narrow phase's chunks, one per thread (narrow_chunks.hpp): a
+  // The narrow phase's chunks, as many as it ever cuts (narrow_chunks.hpp): a
   // scheduler each and the arena of its pair tests' hits; in a vector made
   // once, so the arenas keep their address when the World is moved (the pair
   // tests point at them).
   std::vector<NarrowChunk> narrow_chunks_;
+  std::size_t narrow_chunks_used_ = 1;  // by the last narrow phase
   Perception perception_;
   std::vector<PairTest> pair_tests_;  // pooled: capacity kept between ticks
   std::size_t pair_count_ = 0;

@@ -9,9 +9,10 @@ std::vector<NarrowChunk> makeNarrowChunks(std::size_t chunks, const SchedulerOpt
   return out;
 }
 
-ScheduleStats mergedStats(const std::vector<NarrowChunk>& chunks) {
+ScheduleStats mergedStats(const std::vector<NarrowChunk>& chunks, std::size_t count) {
   ScheduleStats total;
-  for (const NarrowChunk& chunk : chunks) {
+  for (std::size_t k = 0; k < count; ++k) {
+    const NarrowChunk& chunk = chunks[k];
     total.sphere_tests += chunk.stats.sphere_tests;
     total.interrupted = total.interrupted || chunk.stats.interrupted;
     total.overhead_seconds += chunk.stats.overhead_seconds;

@@ -159,7 +159,7 @@ void Physics::respond(const StepContext& step) {
       chunk.clear();
       const auto [first, last] = chunkRange(count, k, chunks);
       appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk, chunk_contacts_[k].reuse);
-    });
+    }, Team::Claim::Balanced);
     for (std::size_t k = 0; k < chunks; ++k) {
       const std::vector<Contact>& chunk = chunk_contacts_[k].contacts;
       contacts.insert(contacts.end(), chunk.begin(), chunk.end());

@@ -75,6 +75,7 @@ struct Team::State {
   std::atomic<const RangeFn*> fn{nullptr};
   std::atomic<std::size_t> count{0};
   std::atomic<std::size_t> done{0};
+  std::atomic<Team::Claim> claim{Team::Claim::OwnShareWhole};
   std::array<std::atomic<std::uint64_t>, kMaxBlocks> taken{};
   std::atomic<bool> open{false};      // a withTeam call is running
   std::atomic<bool> shutdown{false};  // the Workers are going
@@ -123,14 +124,14 @@ void Workers::forEach(std::size_t n, std::size_t grain, RangeFn fn) const {
   });
 }
 
-void Workers::forChunks(std::size_t chunks, RangeFn fn) const {
+void Workers::forChunks(std::size_t chunks, RangeFn fn, Team::Claim claim) const {
   if (chunks == 0) return;
   if (!arena_ || chunks == 1) {
     for (std::size_t k = 0; k < chunks; ++k) fn(k, k + 1);
     return;
   }
   if (arena_->running) {
-    arena_->team.forBlocks(chunks, fn);
+    arena_->team.forBlocks(chunks, fn, claim);
     return;
   }
   arena_->arena.execute([&] {
@@ -142,7 +143,7 @@ void Workers::forChunks(std::size_t chunks, RangeFn fn) const {
   });
 }
 
-void Team::take(int member, std::uint64_t stage, const RangeFn* fn, std::size_t count) {
+void Team::take(int member, std::uint64_t stage, const RangeFn* fn, std::size_t count, Claim claim_mode) {
   const auto claim = [&](std::size_t k) {
     std::uint64_t was = state_->taken[k].load(std::memory_order_relaxed);
     while (was < stage) {
@@ -154,10 +155,21 @@ void Team::take(int member, std::uint64_t stage, const RangeFn* fn, std::size_t 
     (*fn)(k, k + 1);
     state_->done.fetch_add(1, std::memory_order_release);
   };
-  // The own share is claimed whole before any of it runs: a busy member's
-  // next block stays its own (taking it would move its data between cores).
   const std::size_t first = (static_cast<std::size_t>(member) * count + members_ - 1) / members_;
   const std::size_t last = (static_cast<std::size_t>(member + 1) * count + members_ - 1) / members_;
+  if (claim_mode == Claim::Balanced) {
+    for (std::size_t k = first; k < last; ++k) {
+      if (claim(k)) run(k);
+    }
+    // The others' shares from their ends, where their members get to last.
+    for (std::size_t i = 1; i <= count - (last - first); ++i) {
+      const std::size_t k = (first + count - i) % count;
+      if (claim(k)) run(k);
+    }
+    return;
+  }
+  // The own share is claimed whole before any of it runs: a busy member's
+  // next block stays its own (taking it would move its data between cores).
   std::uint64_t own = 0;  // bit k - first: claimed (at most kMaxBlocks)
   for (std::size_t k = first; k < last; ++k) {
     if (claim(k)) own |= std::uint64_t{1} << (k - first);
@@ -171,7 +183,7 @@ void Team::take(int member, std::uint64_t stage, const RangeFn* fn, std::size_t 
   }
 }
 
-void Team::forBlocks(std::size_t count, RangeFn fn) {
+void Team::forBlocks(std::size_t count, RangeFn fn, Claim claim) {
   if (state_ == nullptr || count < 2) {
     for (std::size_t k = 0; k < count; ++k) fn(k, k + 1);
     return;
@@ -185,9 +197,10 @@ void Team::forBlocks(std::size_t count, RangeFn fn) {
     std::atomic_thread_fence(std::memory_order_release);
     state_->fn.store(&round_fn, std::memory_order_relaxed);
     state_->count.store(round, std::memory_order_relaxed);
+    state_->claim.store(claim, std::memory_order_relaxed);
     state_->done.store(0, std::memory_order_relaxed);
     state_->sequence.store(odd + 1, std::memory_order_release);
-    take(0, odd + 1, &round_fn, round);
+    take(0, odd + 1, &round_fn, round, claim);
     Spin spin;
     while (state_->done.load(std::memory_order_acquire) < round) spin.wait();
   }
@@ -202,10 +215,11 @@ void Team::serve(int member) {
     if (stage != served && (stage & 1u) == 0) {
       const RangeFn* fn = state_->fn.load(std::memory_order_relaxed);
       const std::size_t count = state_->count.load(std::memory_order_relaxed);
+      const Claim claim = state_->claim.load(std::memory_order_relaxed);
       std::atomic_thread_fence(std::memory_order_acquire);
       if (state_->sequence.load(std::memory_order_relaxed) != stage) continue;  // rewritten meanwhile
       served = stage;
-      take(member, stage, fn, count);  // fn is called only for a block taken: the stage is live
+      take(member, stage, fn, count, claim);  // fn is called only for a block taken: the stage is live
       spin.reset();
       idle = 0;
       idle_since = std::chrono::steady_clock::now();

@@ -4,6 +4,7 @@
 #include "flat_hash_map.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -67,7 +68,9 @@ bool isElongated(const VoxelShape& shape) {
 World::World(const WorldConfig& config)
     : config_(config),
       workers_(config.threads),
-      narrow_chunks_(makeNarrowChunks(static_cast<std::size_t>(workers_.threads()), config.scheduler)) {
+      narrow_chunks_(makeNarrowChunks(narrowChunkCount(static_cast<std::size_t>(workers_.threads()), false),
+                                      config.scheduler)),
+      narrow_chunks_used_(static_cast<std::size_t>(workers_.threads())) {
   index_of_ = std::make_unique<detail::FlatHashMap>();
   validateLimits(config_.limits);
   validateGravity(config_.gravity, config_.limits);
@@ -478,7 +481,11 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
   // test, its contacts carried over (pair_contact_cache.hpp).
   StepContext step = physicsStep();
   step.dt = dt;
-  const std::size_t chunks = narrow_chunks_.size();
+  const bool limited = end < std::numeric_limits<double>::infinity() ||
+                       budget.sphere_tests < std::numeric_limits<std::int64_t>::max();
+  const std::size_t chunks = narrowChunkCount(static_cast<std::size_t>(workers_.threads()), limited);
+  assert(chunks <= narrow_chunks_.size());
+  narrow_chunks_used_ = chunks;
   workers_.forChunks(chunks, [&](std::size_t k, std::size_t) {
     NarrowChunk& chunk = narrow_chunks_[k];
     const auto [first, last] = chunkRange(pair_count_, k, chunks);
@@ -501,8 +508,8 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
     chunk.stats = chunk.scheduler->run(pair_tests_.data() + first, last - first,
                                        PairBodies{pair_bodies_.data() + first, bodies_.size()},
                                        gaze ? &perception_ : nullptr, tracker);
-  });
-  const ScheduleStats stats = mergedStats(narrow_chunks_);
+  }, limited ? Team::Claim::OwnShareWhole : Team::Claim::Balanced);
+  const ScheduleStats stats = mergedStats(narrow_chunks_, chunks);
   const double scheduled = clock_();
   report.sphere_tests = stats.sphere_tests;
   report.interrupted = stats.interrupted;

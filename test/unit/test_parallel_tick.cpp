@@ -15,8 +15,10 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -290,10 +292,12 @@ TEST(Team, EveryBlockRunsOnceAndTheWorkersLoopsJoinTheTeam) {
       workers.withTeam([&](Team& team) {
         EXPECT_EQ(team.members(), threads);
         for (const std::size_t count : counts) {
-          team.forBlocks(count, [&](std::size_t k, std::size_t end) {
-            EXPECT_EQ(end, k + 1);
-            ++runs[k];
-          });
+          for (const Team::Claim claim : {Team::Claim::OwnShareWhole, Team::Claim::Balanced}) {
+            team.forBlocks(count, [&](std::size_t k, std::size_t end) {
+              EXPECT_EQ(end, k + 1);
+              ++runs[k];
+            }, claim);
+          }
         }
         workers.forEach(indices.size(), 10, [&](std::size_t begin, std::size_t end) {
           for (std::size_t i = begin; i < end; ++i) ++indices[i];
@@ -304,10 +308,37 @@ TEST(Team, EveryBlockRunsOnceAndTheWorkersLoopsJoinTheTeam) {
     }
     for (std::size_t k = 0; k < runs.size(); ++k) {
       const int loops = static_cast<int>(std::count_if(counts.begin(), counts.end(), [&](std::size_t c) { return c > k; }));
-      EXPECT_EQ(runs[k], kCalls * (loops + (k < 5 ? 1 : 0))) << "block " << k << ", " << threads << " threads";
+      EXPECT_EQ(runs[k], kCalls * (2 * loops + (k < 5 ? 1 : 0))) << "block " << k << ", " << threads << " threads";
     }
     for (const int n : indices) EXPECT_EQ(n, kCalls);
   }
+}
+
+// Balanced: a member stuck in its first block does not keep the rest of its
+// share; the other member, done with its own, takes it from the end.
+TEST(Team, ABalancedLoopLetsAFreeMemberTakeTheRestOfABusyOnesShare) {
+  Workers workers(2);
+  constexpr std::size_t kBlocks = 8;  // member 0's share: 0-3
+  std::array<std::atomic<int>, kBlocks> ran_on_caller{};
+  std::atomic<bool> last_of_share_done{false};
+  const std::thread::id caller = std::this_thread::get_id();
+  workers.withTeam([&](Team& team) {
+    team.forBlocks(kBlocks, [&](std::size_t k, std::size_t) {
+      if (k == 0) {
+        // Waits for block 3, which only the other member can run now. The
+        // bound only keeps a broken claim from hanging the suite.
+        const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        while (!last_of_share_done.load() && std::chrono::steady_clock::now() < give_up) std::this_thread::yield();
+      }
+      ran_on_caller[k] = std::this_thread::get_id() == caller ? 1 : 0;
+      if (k == 3) last_of_share_done = true;
+    }, Team::Claim::Balanced);
+  });
+  EXPECT_TRUE(last_of_share_done.load());
+  // Whoever ran block 0 (the caller, unless it lost its core that long) had
+  // to see block 3 done first; the caller runs its share in order, so block 3
+  // was the other member's.
+  EXPECT_EQ(ran_on_caller[3].load(), 0) << "block 3 waited for its own member";
 }
 
 TEST(Team, AThrowLeavesTheWorkersUsable) {
