@@ -287,8 +287,9 @@ STC_WIDE void pushBatchesOf(ContactSolver::WidePush* wide_rows, const ContactSol
 }
 
 // Compiled for AVX2 too where the compiler can pick at load time (the same
-// operations either way, no FMA: the same bits).
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+// operations either way, no FMA: the same bits). Not under ThreadSanitizer:
+// the loader runs the clones' resolver before the sanitizer is up, and it crashes.
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__) && !defined(__SANITIZE_THREAD__)
 #define STC_WIDE_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define STC_WIDE_CLONES
