@@ -49,6 +49,6 @@ std::vector<NarrowChunk> makeNarrowChunks(std::size_t chunks, const SchedulerOpt
 
 // The first `count` chunks' stats as one run's: tests and overhead summed, interrupted and
 // used_perception when any chunk was.
-ScheduleStats mergedStats(const std::vector<NarrowChunk>& chunks, std::size_t count);  // of chunks [0, count)
+ScheduleStats mergedStats(const std::vector<NarrowChunk>& chunks, std::size_t count);
 
 }  // namespace stc
