@@ -158,20 +158,22 @@ STC_WIDE void relaxWide(ContactSolver::WideRow& row, const double (&mass)[3][kLa
 // the cache; a pass that waits for them one batch at a time stalls on each.
 constexpr std::size_t kBodiesAhead = 2;
 
-// Asks for the lines of a batch's bodies: those it writes for writing, so
-// they arrive owned; a static body's, which threads only read, for reading.
+// Asks for one body's line: for writing when the pass writes it, so it
+// arrives owned; a static body's, which threads only read, for reading (the
+// hint must be a constant, hence the branch).
+STC_WIDE void prefetchMotion(const ContactSolver::Motion& body, bool for_writing) {
+  if (for_writing) {
+    __builtin_prefetch(&body, 1);
+  } else {
+    __builtin_prefetch(&body, 0);
+  }
+}
+
+// Asks for the lines of a batch's bodies.
 STC_WIDE void prefetchBodies(const ContactSolver::WideBatch& ahead, const ContactSolver::Motion* motion) {
   for (std::uint32_t l = 0; l < ahead.lanes; ++l) {
-    if (ahead.write_a[l]) {
-      __builtin_prefetch(&motion[ahead.body_a[l]], 1);
-    } else {
-      __builtin_prefetch(&motion[ahead.body_a[l]], 0);
-    }
-    if (ahead.write_b[l]) {
-      __builtin_prefetch(&motion[ahead.body_b[l]], 1);
-    } else {
-      __builtin_prefetch(&motion[ahead.body_b[l]], 0);
-    }
+    prefetchMotion(motion[ahead.body_a[l]], ahead.write_a[l]);
+    prefetchMotion(motion[ahead.body_b[l]], ahead.write_b[l]);
   }
 }
 
