@@ -238,8 +238,8 @@ class ContactSolver {
   }
   void forEachStageOfLevel(std::size_t level, RangeFn manifolds);
   // The blocks runs[0, count) of one stage: on the team when there are two
-  // or more and they hold task_manifolds_ or more, else in turn here.
-  void runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds) const;
+  // or more and they hold `least` (task_manifolds_ when 0) or more, else in turn here.
+  void runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds, std::size_t least = 0) const;
   // step(r, a, b) over the rows r of manifolds [first, end), a and b the
   // pair's entries of `motion` copied in, then written back (a static body's
   // never is: blocks do not hold it apart).
@@ -264,6 +264,7 @@ class ContactSolver {
                            double seconds_left) const;
   void propagateShock(const ResponseOptions& options);
   void collide(const ResponseOptions& options, SolveStats& stats);
+  void waveRuns();  // collide(): each pass run's rows of the wave, in wave_runs_
   int solvePositions(const ResponseOptions& options, const Deadline& deadline);
   // One split-impulse step of a row: its pseudo-impulse towards info.push,
   // the relative motion read from a and b, `mass` along n, applied to out_a
@@ -316,6 +317,8 @@ class ContactSolver {
   std::vector<std::uint32_t> order_, active_, level_start_;
   std::vector<std::uint32_t> wave_rows_, last_wave_rows_, next_wave_rows_;  // collide(): by wave
   std::vector<std::array<std::uint32_t, 2>> row_bodies_;  // collide(): each row's bodies, compact
+  std::vector<std::uint8_t> wave_flag_;                   // collide(): per row, in the next wave
+  std::vector<ManifoldRun> wave_runs_;                    // collide(): per pass run, its wave rows
   std::vector<std::uint8_t> moved_;                       // collide(): bodies the last two waves moved
   std::vector<Motion> motion_;  // solver velocities, one per body
   std::vector<Motion> delta_;   // Jacobi: impulses of one iteration, applied together

@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cassert>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace stc {
@@ -29,6 +31,9 @@ namespace {
 constexpr int kUnreached = std::numeric_limits<int>::max();
 constexpr std::size_t kRowsPerTask = 256;       // rows prepared by one task, at least
 constexpr std::size_t kManifoldsPerTask = 128;  // manifolds' rolling resistance or cache, at least
+// A restitution wave's stage goes to the team from this many rows per
+// manifold a solver stage needs (a bounce step is about a row's work).
+constexpr std::size_t kWaveRowsPerManifold = 4;
 // A pair's points kept for the warm start: one bit each in warmStart's `used`.
 constexpr std::uint32_t kCachedPointsPerPair = 32;
 
@@ -61,6 +66,24 @@ STC_HOT_INLINE void applyFriction(const ContactSolver::Row& row, double d1, doub
   b.v += row.inv_mb * p;
   a.w -= d1 * row.ang_a[1] + d2 * row.ang_a[2];
   b.w += d1 * row.ang_b[1] + d2 * row.ang_b[2];
+}
+
+// Appends to `out`, ascending, the indices whose flag is set; eight flags
+// at a time, as a wave's rows are few among many.
+void appendFlagged(const std::vector<std::uint8_t>& flags, std::vector<std::uint32_t>& out) {
+  const std::size_t n = flags.size();
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, flags.data() + i, sizeof word);
+    if (word == 0) continue;
+    for (std::size_t k = i; k < i + 8; ++k) {
+      if (flags[k] != 0) out.push_back(static_cast<std::uint32_t>(k));
+    }
+  }
+  for (; i < n; ++i) {
+    if (flags[i] != 0) out.push_back(static_cast<std::uint32_t>(i));
+  }
 }
 
 STC_HOT_INLINE void applyNormal(const ContactSolver::Row& row, double impulse, ContactSolver::Motion& a,
@@ -145,6 +168,10 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   // both warm-start buffers, as they swap every tick).
   for (std::vector<std::uint32_t>* v : {&wave_rows_, &last_wave_rows_, &next_wave_rows_}) growCapacity(*v, rows_.size());
   growCapacity(row_bodies_, rows_.size());
+  growCapacity(wave_flag_, rows_.size());
+  growCapacity(wave_runs_, pass_runs_.size());
+  row_bodies_.resize(rows_.size());
+  wave_flag_.resize(rows_.size());
   for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_, &merged_manifolds_}) {
     growCapacity(*v, rows_.size());
   }
@@ -208,6 +235,12 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     } else {
       info.push = s > 0.0 ? -s / dt : 0.0;  // pseudo-velocities may close a gap, never open one
     }
+    // Restitution's wave 0 (collide): closing faster than the threshold and than its gap.
+    info.bounced = info.restitution > 0.0 && info.approach < -std::max(options.restitution_threshold, row.speculative);
+    info.wave = info.bounced ? 0 : -1;
+    info.bounce_from = info.approach;
+    wave_flag_[r] = info.bounced ? 1 : 0;
+    row_bodies_[r] = {row.a, row.b};
   };
   forEachIndex(workers_, order_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) prepareRow(r);
@@ -548,41 +581,52 @@ void ContactSolver::collide(const ResponseOptions& options, SolveStats& stats) {
     const Motion& b = motion_[row.b];
     return relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n);
   };
+  // Wave 0 was classified with the rows (prepare).
   wave_rows_.clear();
-  for (std::uint32_t r = 0; r < rows_.size(); ++r) {
-    const Row& row = rows_[r];
-    RowInfo& info = info_[r];
-    info.bounced = info.restitution > 0.0 && info.approach < -std::max(options.restitution_threshold, row.speculative);
-    info.wave = info.bounced ? 0 : -1;
-    info.bounce_from = info.approach;
-    if (info.bounced) wave_rows_.push_back(r);
-  }
+  appendFlagged(wave_flag_, wave_rows_);
   if (wave_rows_.empty()) return;
   // A row whose bodies did not move since it was last looked at still
   // separates: after each wave only the rows of the bodies it and the wave
   // before moved are looked at, found in a compact copy of the rows' bodies.
   last_wave_rows_.clear();
-  row_bodies_.resize(rows_.size());
-  for (std::size_t r = 0; r < rows_.size(); ++r) row_bodies_[r] = {rows_[r].a, rows_[r].b};
   moved_.assign(motion_.size(), 0);
   const auto movable = [](double inv_mass, const Vec3& angular) { return inv_mass != 0.0 || !angular.isZero(0.0); };
+  // One bounce step of a row. An immovable body is left alone: blocks of a
+  // stage may share one, and adding nothing to it changes nothing.
+  const auto bounce = [&](std::uint32_t r) {
+    RowInfo& info = info_[r];
+    Row& row = rows_[r];
+    const double target = -info.restitution * info.bounce_from;
+    const double impulse = std::max(0.0, info.lambda_wave + row.mass[0] * (target - normalVelocity(row)));
+    const double delta = impulse - info.lambda_wave;
+    info.lambda_wave = impulse;
+    row.bounce_impulse += delta;
+    Motion unused;  // an immovable body's share goes here
+    applyNormal(row, delta, movable(row.inv_ma, row.ang_a[0]) ? out[row.a] : unused,
+                movable(row.inv_mb, row.ang_b[0]) ? out[row.b] : unused);
+  };
+  const auto bounceRows = [&](std::size_t first, std::size_t end) {
+    for (std::size_t i = first; i < end; ++i) bounce(wave_rows_[i]);
+  };
   for (int wave = 0; wave < options.iterations && !wave_rows_.empty(); ++wave) {
     for (const std::uint32_t r : wave_rows_) {
       ++stats.bounced;
       info_[r].lambda_wave = 0.0;
     }
+    // The wave's rows block by block (wave_rows_ ascends, as the rows do):
+    // the blocks of a stage share no movable body, so a stage's blocks run
+    // side by side and every body meets its rows in the one-thread order.
+    if (!jacobi) waveRuns();
     for (int it = 0; it < options.iterations; ++it) {
-      for (const std::uint32_t r : wave_rows_) {
-        RowInfo& info = info_[r];
-        Row& row = rows_[r];
-        const double target = -info.restitution * info.bounce_from;
-        const double impulse = std::max(0.0, info.lambda_wave + row.mass[0] * (target - normalVelocity(row)));
-        const double delta = impulse - info.lambda_wave;
-        info.lambda_wave = impulse;
-        row.bounce_impulse += delta;
-        applyNormal(row, delta, out[row.a], out[row.b]);
+      if (jacobi) {
+        bounceRows(0, wave_rows_.size());
+        commitJacobi(motion_);
+        continue;
       }
-      if (jacobi) commitJacobi(motion_);
+      for (std::size_t st = 0; st + 1 < pass_stage_start_.size(); ++st) {
+        runStage(wave_runs_.data() + pass_stage_start_[st], pass_stage_start_[st + 1] - pass_stage_start_[st],
+                 bounceRows, kWaveRowsPerManifold * task_manifolds_);
+      }
     }
     // The last wave's rows too: its own rows were not looked at after it.
     for (const auto* list : {&wave_rows_, &last_wave_rows_}) {
@@ -592,26 +636,46 @@ void ContactSolver::collide(const ResponseOptions& options, SolveStats& stats) {
         if (movable(row.inv_mb, row.ang_b[0])) moved_[row.b] = 1;
       }
     }
-    next_wave_rows_.clear();
-    for (std::uint32_t r = 0; r < row_bodies_.size(); ++r) {
-      if (!moved_[row_bodies_[r][0]] && !moved_[row_bodies_[r][1]]) continue;
-      RowInfo& info = info_[r];
-      if (info.wave == wave || info.restitution <= 0.0) continue;
-      const Row& row = rows_[r];
-      const double vn = normalVelocity(row);
-      if (vn < -std::max(options.restitution_threshold, row.speculative)) {
-        info.wave = wave + 1;
-        info.bounce_from = vn;
-        info.bounced = true;
-        next_wave_rows_.push_back(r);
+    // The next wave's rows, looked for in pieces on the workers (each row
+    // writes only itself; the motion is not changed meanwhile).
+    forEachIndex(workers_, row_bodies_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t r = begin; r < end; ++r) {
+        wave_flag_[r] = 0;
+        if (!moved_[row_bodies_[r][0]] && !moved_[row_bodies_[r][1]]) continue;
+        RowInfo& info = info_[r];
+        if (info.wave == wave || info.restitution <= 0.0) continue;
+        const Row& row = rows_[r];
+        const double vn = normalVelocity(row);
+        if (vn < -std::max(options.restitution_threshold, row.speculative)) {
+          info.wave = wave + 1;
+          info.bounce_from = vn;
+          info.bounced = true;
+          wave_flag_[r] = 1;
+        }
       }
-    }
+    });
+    next_wave_rows_.clear();
+    appendFlagged(wave_flag_, next_wave_rows_);
     for (const auto* list : {&wave_rows_, &last_wave_rows_}) {
       for (const std::uint32_t r : *list) moved_[rows_[r].a] = moved_[rows_[r].b] = 0;
     }
     last_wave_rows_.swap(wave_rows_);
     wave_rows_.swap(next_wave_rows_);
   }
+}
+
+// For each run of a pass (a non-empty block), its rows in wave_rows_:
+// wave_runs_[k] is [first, end) of wave_rows_ (both ascend).
+void ContactSolver::waveRuns() {
+  wave_runs_.resize(pass_runs_.size());
+  std::size_t i = 0;
+  for (std::size_t k = 0; k < pass_runs_.size(); ++k) {
+    const std::uint32_t row_end = manifold_start_[pass_runs_[k].end];
+    const std::size_t first = i;
+    while (i < wave_rows_.size() && wave_rows_[i] < row_end) ++i;
+    wave_runs_[k] = ManifoldRun{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(i)};
+  }
+  assert(i == wave_rows_.size());
 }
 
 STC_HOT_INLINE void ContactSolver::pushStep(const Row& row, RowInfo& info, const Motion& a, const Motion& b,
@@ -825,13 +889,13 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
     keepHeldManifolds(bodies);  // only the sleepers' manifolds stay
     return stats;
   }
-  collide(options, stats);
   // Refineable: the first velocity pass always runs; timed, it prices the
   // further iterations against the deadline. `run` carries the iterations
   // afforded to every later stage.
-  // The warm start and the passes run on a team: the workers stay awake
-  // from stage to stage.
+  // The restitution waves, the warm start and the passes run on a team: the
+  // workers stay awake from stage to stage.
   const auto warmAndIterate = [&] {
+    collide(options, stats);
     if (options.warm_starting) warmStart(contacts, bodies, stats);
     iterate(options, budget, stats);
   };

@@ -94,10 +94,10 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const s
   if (!level_stage_start_.empty()) level_stage_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
 }
 
-void ContactSolver::runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds) const {
+void ContactSolver::runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds, std::size_t least) const {
   std::size_t total = 0;
   for (std::size_t k = 0; k < count; ++k) total += runs[k].end - runs[k].first;
-  if (team_ == nullptr || count < 2 || total < task_manifolds_) {
+  if (team_ == nullptr || count < 2 || total < (least > 0 ? least : task_manifolds_)) {
     for (std::size_t k = 0; k < count; ++k) manifolds(runs[k].first, runs[k].end);
     return;
   }
