@@ -220,7 +220,6 @@ class ContactSolver {
   void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
                const ResponseOptions& options, double dt, SolveStats& stats);
   void orderFromTheGround(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
-  int levelOf(const Contact& c) const;  // after orderFromTheGround: min of the bodies' depths
   // After orderFromTheGround: order_ regrouped block by block, manifold by
   // manifold; manifold_start_, manifolds_, a pass's and the shock levels'
   // runs of manifolds (contact_solver_blocks.cpp).
@@ -325,6 +324,7 @@ class ContactSolver {
   std::vector<Motion> pseudo_;  // split-impulse pseudo-velocities
   std::vector<int> contact_count_;
   std::vector<int> depth_, adjacency_start_, fill_;  // contact graph, for the row order
+  std::vector<int> contact_level_;  // orderFromTheGround: per active contact, the lower body's depth
   std::vector<std::uint32_t> adjacency_, queue_;
   std::vector<CachedPoint> cache_, next_cache_;
   std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // sorted by pair

@@ -136,18 +136,25 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
                             const std::vector<Contact>& contacts, const ResponseOptions& options,
                             double dt, SolveStats& stats) {
   const std::size_t body_count = bodies.size();
-  motion_.resize(body_count);
-  pseudo_.assign(body_count, Motion{});
-  contact_count_.assign(body_count, 0);
-  for (std::size_t i = 0; i < body_count; ++i) {
-    motion_[i].v = bodies[i].linear_velocity;
-    motion_[i].w = bodies[i].angular_velocity;
-  }
   const bool jacobi = options.solver == SolverKind::Jacobi;
-  if (jacobi) delta_.assign(body_count, Motion{});
-  for (const Contact& c : contacts) {
-    ++contact_count_[c.index_a];
-    ++contact_count_[c.index_b];
+  motion_.resize(body_count);
+  pseudo_.resize(body_count);
+  if (jacobi) delta_.resize(body_count);
+  // Each body's solver velocities from its state alone: in pieces on the workers.
+  forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      motion_[i].v = bodies[i].linear_velocity;
+      motion_[i].w = bodies[i].angular_velocity;
+      pseudo_[i] = Motion{};
+      if (jacobi) delta_[i] = Motion{};
+    }
+  });
+  if (jacobi) {  // mass splitting counts the contacts on each body
+    contact_count_.assign(body_count, 0);
+    for (const Contact& c : contacts) {
+      ++contact_count_[c.index_a];
+      ++contact_count_[c.index_b];
+    }
   }
   const auto inverseMass = [&](std::uint32_t i) { return bodies[i].is_static ? 0.0 : bodies[i].inv_mass; };
   active_.clear();
@@ -337,13 +344,16 @@ void ContactSolver::orderFromTheGround(const std::vector<BodyState>& bodies, con
     }
   }
   // Stable counting sort by level. Unreached contacts go last.
+  growCapacity(contact_level_, contacts.size());
+  contact_level_.resize(contacts.size());
   int top = 0;
   for (const std::uint32_t ci : active_) {
-    const int level = levelOf(contacts[ci]);
+    const int level = std::min(depth_[contacts[ci].index_a], depth_[contacts[ci].index_b]);
+    contact_level_[ci] = level;
     if (level != kUnreached) top = std::max(top, level);
   }
   const auto bucket = [&](std::uint32_t ci) {
-    const int level = levelOf(contacts[ci]);
+    const int level = contact_level_[ci];
     return static_cast<std::size_t>(level == kUnreached ? top + 1 : level);
   };
   level_start_.assign(static_cast<std::size_t>(top) + 3, 0);
@@ -353,7 +363,6 @@ void ContactSolver::orderFromTheGround(const std::vector<BodyState>& bodies, con
   for (const std::uint32_t ci : active_) order_[level_start_[bucket(ci)]++] = ci;
 }
 
-int ContactSolver::levelOf(const Contact& c) const { return std::min(depth_[c.index_a], depth_[c.index_b]); }
 
 template <typename Step>
 void ContactSolver::overManifolds(std::size_t first, std::size_t end, std::vector<Motion>& motion, Step&& step) {
@@ -935,12 +944,14 @@ void ContactSolver::iterate(const ResponseOptions& options, const SolveBudget& b
   // it. With 1 cm between four light cubes under a 1000:1 cube the scene
   // blew up from the second tick at 20 iterations (test_stability).
   unpack();
-  for (std::size_t r = 0; r < rows_.size(); ++r) {
-    RowInfo& info = info_[r];
-    info.lambda_main = rows_[r].lambda[0];
-    info.friction_main[0] = rows_[r].lambda[1];
-    info.friction_main[1] = rows_[r].lambda[2];
-  }
+  forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      RowInfo& info = info_[r];
+      info.lambda_main = rows_[r].lambda[0];
+      info.friction_main[0] = rows_[r].lambda[1];
+      info.friction_main[1] = rows_[r].lambda[2];
+    }
+  });
   if (options.shock_propagation) {
     propagateShock(run);
     unpack();  // the impulses the contacts report include the sweep's

@@ -25,7 +25,7 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const s
   growCapacity(levels_, order_.size());
   for (std::size_t p = 0; p < order_.size(); ++p) {
     const Contact& c = contacts[order_[p]];
-    const int level = levelOf(c);
+    const int level = contact_level_[order_[p]];
     if (levels_.empty() || levels_.back() != level) levels_.push_back(level);
     if (p > 0) {
       const Contact& previous = contacts[order_[p - 1]];
@@ -86,7 +86,7 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const s
     for (std::uint32_t b = 0; b < block_count; ++b) {
       if (b % slabs == 0) level_stage_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
       std::uint32_t end = cursor_[b];
-      while (end < block_manifold_start_[b + 1] && levelOf(contacts[order_[manifold_start_[end]]]) == level) ++end;
+      while (end < block_manifold_start_[b + 1] && contact_level_[order_[manifold_start_[end]]] == level) ++end;
       if (end > cursor_[b]) level_runs_.push_back(ManifoldRun{cursor_[b], end});
       cursor_[b] = end;
     }
