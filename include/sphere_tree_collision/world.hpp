@@ -308,7 +308,7 @@ class World {
   std::vector<PairTest> pair_tests_;  // pooled: capacity kept between ticks
   std::size_t pair_count_ = 0;
   std::vector<std::array<std::uint32_t, 2>> pair_bodies_;  // dense indices of each pair test's bodies
-  std::vector<std::uint8_t> pair_setup_;  // setUpPairTests: per broad-phase pair, tested / beside a held body
+  std::vector<std::uint8_t> pair_tested_;  // setUpPairTests: per broad-phase pair, not static-static
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
   std::vector<std::uint32_t> pair_reused_;  // each pair's carried-over contacts (PairContactCache), or kNone
   std::vector<Contact> contacts_;

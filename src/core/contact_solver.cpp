@@ -207,7 +207,7 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     const double split_b = jacobi ? std::max(1, contact_count_[row.b]) : 1.0;
     const int da = depth_[row.a];
     const int db = depth_[row.b];
-    info.level = std::min(da, db);
+    info.level = contact_level_[ci];
     // Shock propagation holds the body nearer the ground for what rests on it.
     info.move_a = !(da < db);
     info.move_b = !(db < da);

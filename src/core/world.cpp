@@ -441,21 +441,16 @@ void World::broadPhase(TickReport& report) {
 bool World::setUpPairTests() {
   pair_count_ = 0;
   if (islands_.quiet()) return false;  // all asleep: every pair is held-held or held-static
-  // Each pair's dense indices (a hash look-up each, at random) and what the
-  // pass below does with it, in pieces on the workers: each writes its own slots.
+  // Each pair's dense indices (a hash look-up each, at random) and whether
+  // it is tested, in pieces on the workers: each writes its own slots.
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
-  const std::vector<std::uint8_t>& held = islands_.held();
-  constexpr std::uint8_t kTested = 1, kHeldBeside = 2;
-  pair_setup_.resize(pairs.size());
+  pair_tested_.resize(pairs.size());
   workers_.forEach(pairs.size(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const auto ia = static_cast<std::uint32_t>(index_of_->find(pairs[k].first));
       const auto ib = static_cast<std::uint32_t>(index_of_->find(pairs[k].second));
       pair_bodies_[k] = {ia, ib};
-      std::uint8_t setup = 0;
-      if (!(bodies_[ia].is_static && bodies_[ib].is_static)) setup |= kTested;  // else nothing can change (or asleep)
-      if (held[ia] != held[ib]) setup |= kHeldBeside;  // may wake the held one
-      pair_setup_[k] = setup;
+      pair_tested_[k] = !(bodies_[ia].is_static && bodies_[ib].is_static);  // else nothing can change (or asleep)
     }
   });
   // In pair order: the wakes, and the tested pairs packed to the front
@@ -463,8 +458,8 @@ bool World::setUpPairTests() {
   bool woke = false;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const std::array<std::uint32_t, 2> bodies = pair_bodies_[k];
-    if (pair_setup_[k] & kHeldBeside) woke |= islands_.noteOverlap(bodies[0], bodies[1], bodies_);
-    if (pair_setup_[k] & kTested) pair_bodies_[pair_count_++] = bodies;
+    woke |= islands_.noteOverlap(bodies[0], bodies[1], bodies_);
+    if (pair_tested_[k] != 0) pair_bodies_[pair_count_++] = bodies;
   }
   if (woke) islands_.releaseWoken(bodies_);
   return woke;
