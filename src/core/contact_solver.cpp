@@ -168,17 +168,17 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   stats.slabs = partition_.slabs();
   stats.crossing_manifolds = partition_.crossing();
 
-  rows_.resize(order_.size());
-  info_.resize(order_.size());
+  resizeRewritten(rows_, order_.size());
+  resizeRewritten(info_, order_.size());
   // Everything sized by the rows grows with them, in the same tick (no
   // allocation in a later tick whose waves or manifolds happen to be larger;
   // both warm-start buffers, as they swap every tick).
-  for (std::vector<std::uint32_t>* v : {&wave_rows_, &last_wave_rows_, &next_wave_rows_}) growCapacity(*v, rows_.size());
-  growCapacity(row_bodies_, rows_.size());
-  growCapacity(wave_flag_, rows_.size());
-  growCapacity(wave_runs_, pass_runs_.size());
-  row_bodies_.resize(rows_.size());
-  wave_flag_.resize(rows_.size());
+  for (std::vector<std::uint32_t>* v : {&wave_rows_, &last_wave_rows_, &next_wave_rows_}) {
+    growCapacityRewritten(*v, rows_.size());
+  }
+  growCapacityRewritten(wave_runs_, pass_runs_.size());
+  resizeRewritten(row_bodies_, rows_.size());
+  resizeRewritten(wave_flag_, rows_.size());
   for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_, &merged_manifolds_}) {
     growCapacity(*v, rows_.size());
   }

@@ -327,11 +327,11 @@ void ContactSolver::batchManifolds() {
   // manifold, and its wide rows are at most its manifolds' rows. The batches
   // are cleared first: a growth copies nothing of the last tick's.
   batches_.clear();
-  growCapacity(batch_start_, rows_.size() + 1);
-  growCapacity(batches_, rows_.size());
-  growCapacity(wide_rows_, rows_.size());
-  growCapacity(wide_shock_mass_, rows_.size());
-  growCapacity(wide_push_, rows_.size());
+  growCapacityRewritten(batch_start_, rows_.size() + 1);
+  growCapacityRewritten(batches_, rows_.size());
+  growCapacityRewritten(wide_rows_, rows_.size());
+  growCapacityRewritten(wide_shock_mass_, rows_.size());
+  growCapacityRewritten(wide_push_, rows_.size());
   batch_start_.assign(manifolds_.size() + 1, 0);
   body_batch_.assign(motion_.size(), 0);
   // A block's manifolds are in the order from the ground; each level's run

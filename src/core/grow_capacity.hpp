@@ -16,4 +16,22 @@ void growCapacity(std::vector<T>& v, std::size_t n) {
   if (v.capacity() < n) v.reserve(std::max(n, v.capacity() + v.capacity() / 2));
 }
 
+// The same for a buffer whose elements are all written again after it is
+// sized (this tick's rows, a run's queues): a growth drops the old ones
+// first, so it copies nothing (copying 10,000 cubes' rows to their grown
+// buffers made one tick of the forming pile 60 % slower).
+template <typename T>
+void growCapacityRewritten(std::vector<T>& v, std::size_t n) {
+  if (v.capacity() >= n) return;
+  v.clear();
+  growCapacity(v, n);
+}
+
+// ... and sized to n.
+template <typename T>
+void resizeRewritten(std::vector<T>& v, std::size_t n) {
+  growCapacityRewritten(v, n);
+  v.resize(n);
+}
+
 }  // namespace stc

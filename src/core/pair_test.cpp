@@ -30,13 +30,6 @@ struct DeepestPair {
   }
 };
 
-// Make room for `extra` more elements after `used` (grows only, geometrically).
-template <typename T>
-T* roomFor(std::vector<T>& v, std::size_t used, std::size_t extra) {
-  if (v.size() < used + extra) v.resize(std::max(used + extra, 2 * v.size()));
-  return v.data() + used;
-}
-
 // Tests a target against one test list. Every candidate is written and the
 // write index advances only on an intersection: no unpredictable branch per
 // sphere test. The tree side and whether the target is a leaf are template
@@ -80,13 +73,15 @@ void PairTest::reset(const PairBody& a, const PairBody& b, PairArena* arena) {
   a_ = a;
   b_ = b;
   shared_arena_ = arena;
-  if (!arena) own_arena_.clear();
+  if (!arena) {
+    if (!own_arena_ || own_arena_.use_count() > 1) own_arena_ = std::make_shared<PairArena>();
+    own_arena_->clear();
+  }
   PairArena& store = this->arena();
   // Paper: the root of tree A is the target, the root of tree B the test list.
-  hits_begin_ = store.hits_used;
+  *store.hits.room(1, hits_begin_) = SphereHit{0, 0, 1, 0};
+  store.hits.commit(1);
   hits_count_ = 1;
-  *roomFor(store.hits, store.hits_used, 1) = SphereHit{0, 0, 1, 0};
-  ++store.hits_used;
   last_begin_ = last_count_ = best_last_ = 0;
   best_valid_ = false;
   status_ = PairStatus::Unresolved;
@@ -103,10 +98,9 @@ void PairTest::resumeColliding(const PairBody& a, const PairBody& b, PairArena* 
   reset(a, b, arena);
   hits_count_ = 0;  // the root hit reset() made stays unused in the arena
   PairArena& store = this->arena();
-  last_begin_ = store.pairs_used;
+  *store.pairs.room(1, last_begin_) = leaf;
+  store.pairs.commit(1);
   last_count_ = 1;
-  *roomFor(store.pairs, store.pairs_used, 1) = leaf;
-  ++store.pairs_used;
   status_ = PairStatus::Colliding;
   next_tests_ = 0;
   deepest_level_ = level;
@@ -136,15 +130,14 @@ int PairTest::step() {
   // with room for the worst case (every test intersects) made first.
   PairArena& store = arena();
   const auto most = static_cast<std::size_t>(next_tests_);  // tests if every hit is done
-  const std::size_t new_hits_begin = store.hits_used;
-  const std::size_t pairs_begin = store.pairs_used;
-  SphereHit* hit_out = roomFor(store.hits, new_hits_begin, most);
-  SpherePair* pair_out = roomFor(store.pairs, pairs_begin, most);
-  const SphereHit* hits = store.hits.data();  // after the growth above
+  std::size_t new_hits_begin = 0, pairs_begin = 0;
+  SphereHit* hit_out = store.hits.room(most, new_hits_begin);
+  SpherePair* pair_out = store.pairs.room(most, pairs_begin);
+  const SphereHit* hits = store.hits.at(hits_begin_);
   std::size_t hit_count = 0, leaf_pairs = 0;
   int tests = 0;
 
-  for (std::size_t h = hits_begin_; h < hits_begin_ + hits_count_; ++h) {
+  for (std::size_t h = 0; h < hits_count_; ++h) {
     if (first_contact_only_ && leaf_pairs > 0) break;  // the answer is known
     const SphereHit& hit = hits[h];
     tests += hit.test_count;
@@ -192,7 +185,7 @@ int PairTest::step() {
                        nodes[1][pair_out[0].b].centre).norm();
     }
     pair_count = hit_count;
-    store.hits_used = new_hits_begin + hit_count;
+    store.hits.commit(hit_count);
     hits_begin_ = new_hits_begin;
     hits_count_ = hit_count;
   } else {
@@ -202,7 +195,7 @@ int PairTest::step() {
     next_tests_ = 0;
     return tests;
   }
-  store.pairs_used = pairs_begin + pair_count;
+  store.pairs.commit(pair_count);
   last_begin_ = pairs_begin;
   last_count_ = pair_count;
   return tests;

@@ -133,7 +133,12 @@ void Physics::respond(const StepContext& step) {
   const ResponseOptions& options = *step.options;
   const std::size_t count = step.pair_count;
   std::vector<Contact>& contacts = *step.contacts;
+  // Room for last tick's count and an eighth more, made while the vector is
+  // empty: a pile's contacts grow a little most ticks, and growing as they
+  // are appended copied the tick's contacts so far each time.
+  const std::size_t last_count = contacts.size();
   contacts.clear();
+  growCapacity(contacts, last_count + last_count / 8);
   growCapacity(sweep_hit_of_pair_, count);  // assign alone would reallocate to the exact count
   sweep_hit_of_pair_.assign(count, -1);
   for (const std::uint32_t body : sweep_scratch_.clamped) {

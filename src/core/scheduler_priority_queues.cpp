@@ -45,6 +45,8 @@
 // projection work.
 #include "scheduler_detail.hpp"
 
+#include "grow_capacity.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cassert>
@@ -244,7 +246,7 @@ ScheduleStats PriorityQueueScheduler::run(PairTest* tests, std::size_t count,
   // the storage only grows, with the pair count.
   const auto queues = static_cast<std::size_t>(queue_count_);
   stride_ = count + 1;
-  if (slots_.size() < stride_ * queues) slots_.resize(stride_ * queues);
+  if (slots_.size() < stride_ * queues) resizeRewritten(slots_, stride_ * queues);
   for (int q = 0; q < queue_count_; ++q) ends_[static_cast<std::size_t>(q)] = queueBegin(q);
   stats.used_perception = perceptionActive(perception) && queue_count_ > 1 && bodies.of_pair != nullptr;
   if (stats.used_perception) {

@@ -2,6 +2,7 @@
 #include "sphere_tree_collision/world.hpp"
 
 #include "flat_hash_map.hpp"
+#include "grow_capacity.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -426,11 +427,11 @@ void World::broadPhase(TickReport& report) {
   report.broad_pairs = broad_phase_.pairs().size();
 
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
-  if (pair_tests_.size() < pairs.size()) {  // pool grows only
-    pair_tests_.resize(pairs.size());
-    pair_bodies_.resize(pairs.size());
-    pair_priority_.resize(pairs.size());
-    pair_reused_.resize(pairs.size());
+  if (pair_tests_.size() < pairs.size()) {  // pool grows only; last tick's tests are not read again
+    resizeRewritten(pair_tests_, pairs.size());
+    resizeRewritten(pair_bodies_, pairs.size());
+    resizeRewritten(pair_priority_, pairs.size());
+    resizeRewritten(pair_reused_, pairs.size());
   }
   // A moving body reached a sleeping island: it woke, its pairs are tested too.
   if (setUpPairTests()) setUpPairTests();

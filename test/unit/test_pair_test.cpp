@@ -361,6 +361,42 @@ TEST_F(Cubes, PairTestsSharingAnArenaInterleaveCorrectly) {
   }
 }
 
+// The arena's runs never move: a run taken before the store grew (many
+// blocks later, and a run longer than any block) still holds what was
+// written to it, at the same address, until clear(); after clear() the
+// blocks are reused and nothing more is allocated for the same runs.
+TEST(RunBlocks, RunsStayWhereTheyWereWrittenWhileTheStoreGrows) {
+  RunBlocks<SpherePair> store;
+  std::vector<std::pair<std::size_t, const SpherePair*>> runs;
+  const std::size_t long_run = 3 * RunBlocks<SpherePair>::kBlockElements;
+  auto takeAll = [&] {
+    runs.clear();
+    for (std::int32_t r = 0; r < 400; ++r) {
+      const std::size_t most = r == 200 ? long_run : 1000 + static_cast<std::size_t>(r);
+      std::size_t handle = 0;
+      SpherePair* out = store.room(most, handle);
+      const std::size_t used = most - static_cast<std::size_t>(r % 7);  // commit less than the room asked
+      for (std::size_t i = 0; i < used; ++i) out[i] = SpherePair{r, static_cast<std::int32_t>(i)};
+      store.commit(used);
+      runs.emplace_back(handle, out);
+    }
+  };
+  takeAll();
+  const std::size_t grown = store.capacity();
+  EXPECT_GE(grown, long_run + 399 * 1000);
+  for (std::int32_t r = 0; r < 400; ++r) {
+    const auto [handle, address] = runs[static_cast<std::size_t>(r)];
+    EXPECT_EQ(store.at(handle), address) << "run " << r;
+    const std::size_t used = (r == 200 ? long_run : 1000 + static_cast<std::size_t>(r)) - static_cast<std::size_t>(r % 7);
+    EXPECT_EQ(address[0].a, r);
+    EXPECT_EQ(address[used - 1].a, r) << "run " << r;
+    EXPECT_EQ(address[used - 1].b, static_cast<std::int32_t>(used - 1)) << "run " << r;
+  }
+  store.clear();
+  takeAll();
+  EXPECT_EQ(store.capacity(), grown);  // the same runs fit in the same blocks
+}
+
 // Unequal heights: a one-level sphere against a four-level rock. The
 // sphere's root stays the target whichever side it is on.
 TEST(PairTestUnequalHeights, LeafTargetStaysUntilTheOtherTreesLeaves) {
