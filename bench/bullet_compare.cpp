@@ -11,8 +11,9 @@
 // Materials combine as in this package: restitution max, friction sqrt(a b),
 // rolling resistance the larger (see combinedRolling).
 //
-// Per tick: wall and thread-CPU time of one step, this package's phase
-// split (TickReport), and sanity figures over the movers: mean stored speed
+// Per tick: wall and thread-CPU time of one step, each engine's phase split
+// (this package's TickReport; Bullet's own profile zones: its collision
+// detection, its constraint solve, the rest), and sanity figures over the movers: mean stored speed
 // against mean |dx|/dt (they agree when stored velocity is real motion),
 // final mean speed, bodies out of the scene's bounds (at the end; ever).
 // Ends with one SUMMARY line per scene: this package's thread-CPU p50 and
@@ -38,7 +39,7 @@
 //               default: the World's, 0 = off). The SUMMARY lines say so.
 // Where the response's time goes (instruction counts, stable on a loaded machine;
 // docs/response.md, "Cost of the response"):
-//   valgrind --tool=callgrind --toggle-collect='stc::Physics::respond*'
+//   valgrind --tool=callgrind --toggle-collect='stc::Physics::buildContacts*' --toggle-collect='stc::Physics::solve*'
 //     bench_bullet_compare --seconds 3 --scenes rockfall:1000 --variants ""
 //   (one command line; callgrind_annotate --inclusive=yes on its output file)
 #include "sphere_tree_collision/scenes.hpp"
@@ -54,6 +55,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -79,7 +81,12 @@ const std::vector<Case> kDefaultCases{{SceneKind::CornerDrift, 500},
 struct Run {
   std::string engine;
   std::vector<double> wall, cpu;                          // s per tick
-  std::vector<double> integrate, broad, narrow, response; // s per tick (this package)
+  // Wall s per tick of each phase. This package: integrate, broad, sweep,
+  // narrow, building the contacts and the solve. Bullet: its collision
+  // detection in `narrow` (broad and narrow phase and its contact manifolds),
+  // its constraint solve in `solve`, all else (integration, islands,
+  // activation) in `integrate`.
+  std::vector<double> integrate, broad, sweep, narrow, building, solve;
   std::vector<double> contacts;                           // per tick (this package)
   double stored_speed = 0.0;  // mean over ticks and movers of |v|
   double moved_speed = 0.0;   // mean over ticks and movers of |dx| / dt
@@ -194,8 +201,10 @@ Run runPackage(const Case& c, int ticks, int settle_ticks, const PackageOptions&
     timeTick(run, wall0, cpu0);
     run.integrate.push_back(r.integrate_s);
     run.broad.push_back(r.broad_s);
+    run.sweep.push_back(r.sweep_s);
     run.narrow.push_back(r.narrow_s);
-    run.response.push_back(r.response_s);
+    run.building.push_back(r.contacts_s);
+    run.solve.push_back(r.response_s - r.contacts_s);
     run.contacts.push_back(static_cast<double>(r.contacts));
     run.sleeping = static_cast<int>(r.sleeping);
     read();
@@ -231,6 +240,56 @@ btScalar combinedRolling(const btCollisionObject* a, const btCollisionObject* b)
 btScalar combinedSpinning(const btCollisionObject* a, const btCollisionObject* b) {
   return std::max(a->getSpinningFriction(), b->getSpinningFriction());
 }
+
+// Where Bullet's step goes, from its own profile zones (BT_PROFILE, which
+// calls the zone hooks whether or not the library was built to profile):
+// the wall time inside its collision detection and inside its constraint
+// solve, summed over one step. One thread: the hooks keep a stack of the
+// zones entered.
+class BulletZones {
+ public:
+  BulletZones() : enter_before_(btGetCurrentEnterProfileZoneFunc()), leave_before_(btGetCurrentLeaveProfileZoneFunc()) {
+    depth = 0;
+    btSetCustomEnterProfileZoneFunc(&enter);
+    btSetCustomLeaveProfileZoneFunc(&leave);
+  }
+  ~BulletZones() {
+    btSetCustomEnterProfileZoneFunc(enter_before_);
+    btSetCustomLeaveProfileZoneFunc(leave_before_);
+  }
+  BulletZones(const BulletZones&) = delete;
+  BulletZones& operator=(const BulletZones&) = delete;
+  static void startStep() { detection_s = solve_s = 0.0; }
+  static double detection_s, solve_s;
+
+ private:
+  enum Kind { kOther, kDetection, kSolve };
+  struct Open {
+    Kind kind;
+    double since;
+  };
+  static constexpr int kDepth = 64;
+  static void enter(const char* name) {
+    Kind kind = kOther;
+    if (std::strcmp(name, "performDiscreteCollisionDetection") == 0) kind = kDetection;
+    if (std::strcmp(name, "solveConstraints") == 0) kind = kSolve;
+    if (depth < kDepth) open[depth] = {kind, kind == kOther ? 0.0 : stc_bench::wallSeconds()};
+    ++depth;
+  }
+  static void leave() {
+    if (depth == 0) return;
+    --depth;
+    if (depth >= kDepth || open[depth].kind == kOther) return;
+    (open[depth].kind == kDetection ? detection_s : solve_s) += stc_bench::wallSeconds() - open[depth].since;
+  }
+  btEnterProfileZoneFunc* enter_before_;
+  btLeaveProfileZoneFunc* leave_before_;
+  static Open open[kDepth];
+  static int depth;
+};
+double BulletZones::detection_s = 0.0, BulletZones::solve_s = 0.0;
+BulletZones::Open BulletZones::open[BulletZones::kDepth];
+int BulletZones::depth = 0;
 
 // One voxel shape as Bullet sees it: Bullet wants the body frame on the
 // principal axes of inertia, so points are taken from this package's body
@@ -385,10 +444,15 @@ Run runBullet(const Case& c, int ticks, int settle_ticks, BulletShape kind) {
   std::vector<Vec3> positions, velocities;
   scene->read(positions, velocities);
   check.start(positions);
+  const BulletZones zones;
   for (int t = 0; t < ticks; ++t) {
+    BulletZones::startStep();
     const double wall0 = stc_bench::wallSeconds(), cpu0 = stc_bench::threadCpuSeconds();
     scene->step(spec.dt);
     timeTick(run, wall0, cpu0);
+    run.narrow.push_back(BulletZones::detection_s);
+    run.solve.push_back(BulletZones::solve_s);
+    run.integrate.push_back(run.wall.back() - BulletZones::detection_s - BulletZones::solve_s);
     scene->read(positions, velocities);
     check.tick(positions, velocities);
   }
@@ -419,16 +483,34 @@ std::string runRow(const Case& c, const Run& r) {
   return buf;
 }
 
+std::string phaseCell(const std::vector<double>& v) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.2f / %.2f", 1e3 * percentile(v, 0.5), 1e3 * meanOf(v));
+  return b;
+}
+
 std::string phaseRow(const Case& c, const Run& r) {
   char buf[512];
-  auto cell = [](const std::vector<double>& v) {
-    char b[64];
-    std::snprintf(b, sizeof b, "%.2f / %.2f", 1e3 * percentile(v, 0.5), 1e3 * meanOf(v));
-    return std::string(b);
-  };
-  std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %.0f |\n", label(c).c_str(),
-                cell(r.integrate).c_str(), cell(r.broad).c_str(), cell(r.narrow).c_str(),
-                cell(r.response).c_str(), cell(r.wall).c_str(), percentile(r.contacts, 0.5));
+  std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %s | %s | %.0f |\n", label(c).c_str(),
+                phaseCell(r.integrate).c_str(), phaseCell(r.broad).c_str(), phaseCell(r.sweep).c_str(),
+                phaseCell(r.narrow).c_str(), phaseCell(r.building).c_str(), phaseCell(r.solve).c_str(),
+                phaseCell(r.wall).c_str(), percentile(r.contacts, 0.5));
+  return buf;
+}
+
+// Bullet's split beside this package's: its collision detection against this
+// package's broad phase, sweep, narrow phase and contacts; solve against solve.
+std::string bulletPhaseRow(const Case& c, const Run& ours, const Run& theirs) {
+  std::vector<double> detection(ours.wall.size());
+  for (std::size_t t = 0; t < detection.size(); ++t) {
+    detection[t] = ours.broad[t] + ours.sweep[t] + ours.narrow[t] + ours.building[t];
+  }
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %s | %s |\n", label(c).c_str(),
+                theirs.engine.c_str(), phaseCell(theirs.narrow).c_str(), phaseCell(theirs.solve).c_str(),
+                phaseCell(theirs.integrate).c_str(), phaseCell(theirs.wall).c_str(),
+                ours.wall.empty() ? "-" : phaseCell(detection).c_str(),
+                ours.wall.empty() ? "-" : phaseCell(ours.solve).c_str());
   return buf;
 }
 
@@ -501,8 +583,12 @@ int main(int argc, char** argv) {
       "stored speed | \\|dx\\|/dt | final speed | out of bounds (end / ever) | asleep |\n"
       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::string phases_md =
-      "| scene | integrate | broad | narrow | response | whole tick | contacts p50 |\n"
-      "|---|---|---|---|---|---|---|\n";
+      "| scene | integrate | broad | sweep | narrow | contacts | solve | whole tick | contacts p50 |\n"
+      "|---|---|---|---|---|---|---|---|---|\n";
+  std::string bullet_phases_md =
+      "| scene | engine | collision detection | solve | the rest | whole tick | "
+      "this package's detection (broad + sweep + narrow + contacts) | this package's solve |\n"
+      "|---|---|---|---|---|---|---|---|\n";
   std::string summary;
   std::printf("# bench_bullet_compare: %.1f s simulated per run (%d ticks at 60 Hz) after %.1f s untimed, load %.2f\n",
               opt.seconds, ticks, opt.settle, loadAverage());
@@ -520,6 +606,7 @@ int main(int argc, char** argv) {
       std::printf("%s", row.c_str());
       std::fflush(stdout);
       rows += row;
+      bullet_phases_md += bulletPhaseRow(c, ours, theirs);
       const double p50 = percentile(theirs.cpu, 0.5);
       if (!(best <= p50)) best = p50;
     }
@@ -544,7 +631,8 @@ int main(int argc, char** argv) {
                 "tick; speeds in m/s, means over movers and ticks.\n\n",
                 opt.seconds, ticks, opt.settle);
   md = std::string(head) + runs_md +
-       "\nThis package's phases, ms per tick (p50 / mean, wall time):\n\n" + phases_md;
+       "\nThis package's phases, ms per tick (p50 / mean, wall time):\n\n" + phases_md +
+       "\nBullet's phases (its profile zones), ms per tick (p50 / mean, wall time):\n\n" + bullet_phases_md;
   std::printf("\n%s\nload at the end %.2f\n%s", md.c_str(), loadAverage(), summary.c_str());
   if (!opt.markdown.empty()) std::ofstream(opt.markdown) << md << "\n```\n" << summary << "```\n";
   return 0;

@@ -70,7 +70,7 @@ std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vect
 // the discrete step resolves is left to it). The body is put back at its
 // earliest hit (position lerp, orientation slerp). Its velocity is kept: the
 // narrow phase of the same tick finds the contact there, and the response
-// turns the approach (Physics::respond adds the hit as a contact when the
+// turns the approach (Physics::buildContacts adds the hit as a contact when the
 // narrow phase gave that pair none). scratch.hits and scratch.clamped say
 // where. Pairs already overlapping at the start are resting contacts, left to
 // the solver.

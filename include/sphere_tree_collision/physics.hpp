@@ -1,4 +1,4 @@
-// The World's physics: integrate and respond, keeping what lasts between
+// The World's physics: integrate, sweep, contacts and solve, keeping what lasts between
 // ticks (warm-start impulses by entity id, sweep data, scratch), and the
 // step context its phases read.
 #pragma once
@@ -40,17 +40,17 @@ struct StepContext {
   const std::vector<double>* priorities = nullptr;
   // Per pair: its PairContactCache entry when its contacts are carried over
   // this tick (its test resumed Colliding), else PairContactCache::kNone
-  // (respond; nullptr: every pair's contacts are built).
+  // (buildContacts; nullptr: every pair's contacts are built).
   const std::vector<std::uint32_t>* reused = nullptr;
   bool accept_unresolved = true;  // policy accept: unresolved pairs give contacts too
-  SolveBudget budget;             // what the solver may spend (respond)
-  std::vector<Contact>* contacts = nullptr;  // respond's output
+  SolveBudget budget;             // what the solver may spend (solve)
+  std::vector<Contact>* contacts = nullptr;  // buildContacts' output, solve's input
   const Workers* workers = nullptr;  // threads of the parallel loops (nullptr: the caller's alone)
   // Entity ids by dense index, and the bodies held asleep this tick: the
-  // solver keeps sleeping pairs' warm-start impulses (respond; nullptr: not).
+  // solver keeps sleeping pairs' warm-start impulses (solve; nullptr: not).
   const std::vector<EntityId>* ids = nullptr;
   const std::vector<std::uint8_t>* held_asleep = nullptr;
-  // Static bodies' covered faces, kept out of contact normals (respond's contacts; nullptr: none).
+  // Static bodies' covered faces, kept out of contact normals (buildContacts; nullptr: none).
   const StaticCover* static_cover = nullptr;
 };
 
@@ -74,10 +74,13 @@ class Physics {
   // their broad-phase partners pair_bodies[0..pair_count) (sweepFastBodies).
   // Reads options, bodies, pair_bodies, pair_count.
   void sweep(const StepContext& step);
-  // Tick phase 4: contacts of tests[0..pair_count) (pair_bodies: the same
+  // Tick phase 4a: contacts of tests[0..pair_count) (pair_bodies: the same
   // pairs the sweep saw), plus the sweep's hit for a pair whose test gave no
-  // contact, into contacts; then impulses when options->enabled, within budget.
-  void respond(const StepContext& step);
+  // contact, into contacts.
+  void buildContacts(const StepContext& step);
+  // Tick phase 4b, after buildContacts: impulses on those contacts when
+  // options->enabled, within budget.
+  void solve(const StepContext& step);
   const PhysicsReport& lastReport() const { return report_; }
   void forget() { solver_.forget(); }
 

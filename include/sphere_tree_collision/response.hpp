@@ -4,7 +4,7 @@
 //   contact_builder.hpp   contacts from the intersecting sphere pairs of a PairTest
 //   contact_solver.hpp    impulses, restitution, friction, position correction
 //   continuous.hpp        the swept test that stops fast bodies at their first contact
-//   physics.hpp           the World's integrate, sweep and respond phases (StepContext)
+//   physics.hpp           the World's integrate, sweep, contact and solve phases (StepContext)
 // Everything but physics.hpp also works without a World, on flat arrays.
 #pragma once
 

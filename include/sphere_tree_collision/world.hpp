@@ -86,6 +86,7 @@ struct TickReport {
   // Phase wall times, seconds (on the World's clock, see World::setClock).
   double integrate_s = 0.0, broad_s = 0.0, narrow_s = 0.0, response_s = 0.0, total_s = 0.0;
   double sweep_s = 0.0;  // continuous collision of fast bodies, between broad and narrow phase
+  double contacts_s = 0.0;  // of response_s: building the contacts (the rest is the solve)
   // What each phase got of the budget. Integrate and the broad phase cannot be
   // interrupted: they get what they use. The narrow phase gets Budget::seconds
   // or what the tick budget leaves after them and the reserve, whichever is

@@ -129,8 +129,7 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
   }
 }
 
-void Physics::respond(const StepContext& step) {
-  const ResponseOptions& options = *step.options;
+void Physics::buildContacts(const StepContext& step) {
   const std::size_t count = step.pair_count;
   std::vector<Contact>& contacts = *step.contacts;
   // Room for last tick's count and an eighth more, made while the vector is
@@ -178,13 +177,18 @@ void Physics::respond(const StepContext& step) {
   } else {
     pair_cache_.clear();
   }
+}
+
+void Physics::solve(const StepContext& step) {
+  const ResponseOptions& options = *step.options;
+  std::vector<Contact>& contacts = *step.contacts;
   report_.solve = SolveStats{};
   if (!options.enabled) return;
-  ResponseOptions solve = options;
-  solve.restitution_threshold = std::max(options.restitution_threshold, kRestingFallTicks * gravity_speed_);
+  ResponseOptions run = options;
+  run.restitution_threshold = std::max(options.restitution_threshold, kRestingFallTicks * gravity_speed_);
   solver_.setWorkers(step.workers, static_cast<std::size_t>(options.solver_task_manifolds));
   solver_.keepWhileHeld(step.ids, step.held_asleep);
-  report_.solve = solver_.solve(*step.bodies, contacts, solve, step.dt, step.budget);
+  report_.solve = solver_.solve(*step.bodies, contacts, run, step.dt, step.budget);
 }
 
 }  // namespace stc

@@ -565,7 +565,10 @@ void World::response(double dt, const Budget& budget, const Deadline& tick_end, 
   step.dt = dt;
   step.budget.max_iterations = budget.solver_iterations;
   step.budget.deadline = tick_end;
-  physics_.respond(step);
+  const double t_contacts = clock_();
+  physics_.buildContacts(step);
+  report.contacts_s = clock_() - t_contacts;
+  physics_.solve(step);
   const SolveStats& stats = physics_.lastReport().solve;
   report.velocity_passes = stats.velocity_passes;
   report.position_passes = stats.position_passes;

@@ -212,6 +212,18 @@ TEST(TickBudget, NarrowPhaseGetsWhatTheFixedPhasesAndTheReserveLeave) {
   EXPECT_NEAR(w.step(kDt, both).narrow_budget_s, 1e-4, 1e-15);
 }
 
+// The response's time is its contacts' building and the solve: the report
+// names the first (contacts_s), on the World's clock like every phase.
+TEST(TickBudget, ResponseTimeIsBuildingTheContactsAndTheSolve) {
+  World w = pile(60);
+  for (int i = 0; i < 3; ++i) {
+    const TickReport r = w.step(kDt, Budget::unlimited());
+    ASSERT_GT(r.contacts, 0u);
+    EXPECT_GT(r.contacts_s, 0.0);
+    EXPECT_LT(r.contacts_s, r.response_s) << "the solve after it is timed in response_s too";
+  }
+}
+
 TEST(TickBudget, SpentTickStillRespondsAndStaysFiniteAndInTheBox) {
   // The tick is over before the narrow phase starts: every pair is accepted
   // unresolved and the solver runs its mandatory pass, tick after tick.
