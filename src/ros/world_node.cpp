@@ -312,9 +312,11 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.header.frame_id = params_.world_frame;
   s.tick = tick_;
   s.integrate_ms = (r.integrate_s + r.sweep_s) * 1e3;  // includes the swept test (run after the broad phase)
+  s.sweep_ms = r.sweep_s * 1e3;
   s.broad_ms = r.broad_s * 1e3;
   s.narrow_ms = r.narrow_s * 1e3;
   s.response_ms = r.response_s * 1e3;
+  s.contacts_ms = r.contacts_s * 1e3;
   s.total_ms = r.total_s * 1e3;
   s.scheduling_overhead_ms = r.scheduling_overhead_s * 1e3;
   s.budget_ms = std::isfinite(budget_.seconds) ? budget_.seconds * 1e3 : -1.0;  // nothing non-finite is published

@@ -170,6 +170,14 @@ TEST(Smoke, TickStatsAndContactsEveryTick) {
   }
   // Contacts are carried over only when asked for (~reuse_tolerance, off by default).
   for (const auto& s : stats.all) EXPECT_EQ(s.reused, 0u) << "tick " << s.tick;
+  // The parts a phase's time is split into lie within it (test_tick_budget
+  // checks that building contacts is timed).
+  for (const auto& s : stats.all) {
+    EXPECT_GE(s.sweep_ms, 0.0);
+    EXPECT_LE(s.sweep_ms, s.integrate_ms) << "tick " << s.tick;
+    EXPECT_GE(s.contacts_ms, 0.0);
+    EXPECT_LE(s.contacts_ms, s.response_ms) << "tick " << s.tick;
+  }
   // The gaze of the marker test has expired: no projection work from then on.
   ASSERT_TRUE(stc_test::spinUntil([&] { return !stats.last.gaze_active; }, stc_test::kLivenessSeconds));
   const std::uint64_t expired_at = stats.last.tick;
