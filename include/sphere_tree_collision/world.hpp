@@ -247,7 +247,7 @@ class World {
   void continuousCollision(TickReport& report);
   // Returns the clock when the scheduler stopped (what follows is not interruptible).
   double narrowPhase(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
-  void response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report);
+  void response(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
   void quarantine(TickReport& report);  // first and last: removes bodies beyond the limits
   // After the response: bodies hit harder than their strength are queued in
   // pending_breaks_. A break is made once its pieces' trees exist; a tree is

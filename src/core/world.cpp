@@ -324,7 +324,7 @@ TickReport World::step(double dt, const Budget& budget) {
     scheduled = narrowPhase(dt, budget, tick_end, t2s, report);
     t3 = clock_();
     if (timed_tick) report.response_budget_s = std::max(tick_end.at() - t3, 0.0);
-    response(dt, budget, tick_end, report);
+    response(dt, budget, tick_end, t3, report);
     t4 = clock_();
     t5 = fracture(t4, tick_end, report);
   });
@@ -560,14 +560,13 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
 // Contacts from the deepest sphere pairs of each colliding or accepted pair,
 // then impulses and position correction (contact_builder.hpp,
 // contact_solver.hpp), refined until the tick's deadline or the iteration budget.
-void World::response(double dt, const Budget& budget, const Deadline& tick_end, TickReport& report) {
+void World::response(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report) {
   StepContext step = physicsStep();
   step.dt = dt;
   step.budget.max_iterations = budget.solver_iterations;
   step.budget.deadline = tick_end;
-  const double t_contacts = clock_();
   physics_.buildContacts(step);
-  report.contacts_s = clock_() - t_contacts;
+  report.contacts_s = clock_() - start;
   physics_.solve(step);
   const SolveStats& stats = physics_.lastReport().solve;
   report.velocity_passes = stats.velocity_passes;
