@@ -50,7 +50,7 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-// A leaf's voxel box in the world.
+// A node's box in the world.
 struct WorldBox {
   Vec3 centre, half;
   Mat3 axes;  // columns: the box's axes (its body's)
@@ -81,14 +81,8 @@ bool boxesOverlap(const WorldBox& a, const WorldBox& b, double gap) {
   return true;
 }
 
-WorldBox leafBox(const PairBody& body, const ShapeBounds& bounds, std::int32_t node) {
-  const Mat3 axes = body.pose->orientation.toRotationMatrix();
-  const auto i = static_cast<std::size_t>(node);
-  return WorldBox{body.pose->position + axes * (body.tree->node(node).centre + bounds.box_offset[i]),
-                  bounds.box_half[i], axes};
-}
-
-// The box of a node's leaves' boxes in the world (a leaf's own box for a leaf).
+// The box of a node's leaves' boxes in the world (ShapeBounds::leaves_centre
+// and leaves_half; a leaf's own voxel box for a leaf).
 WorldBox nodeBox(const PairBody& body, const ShapeBounds& bounds, std::int32_t node) {
   const Mat3 axes = body.pose->orientation.toRotationMatrix();
   const auto i = static_cast<std::size_t>(node);
@@ -166,8 +160,8 @@ int main(int argc, char** argv) {
       model_box_tests += w.box_tests;
     }
     for (const SpherePair& p : test.lastPairs()) {
-      const WorldBox a = leafBox(test.bodyA(), bounds_a, p.a);
-      const WorldBox b = leafBox(test.bodyB(), bounds_b, p.b);
+      const WorldBox a = nodeBox(test.bodyA(), bounds_a, p.a);
+      const WorldBox b = nodeBox(test.bodyB(), bounds_b, p.b);
       const double gap = opt.margin * std::min(a.half.minCoeff(), b.half.minCoeff());
       ++leaf_pairs;
       overlapping += boxesOverlap(a, b, 0.0) ? 1 : 0;
