@@ -81,6 +81,8 @@ class ContactSolver {
   void forget() {  // drop warm-start impulses
     cache_.clear();
     cache_manifolds_.clear();
+    held_points_.clear();
+    held_manifolds_.clear();
   }
   // Threads of the velocity, shock and position iterations (nullptr: the
   // caller's alone); the result is the same whatever they are
@@ -214,9 +216,13 @@ class ContactSolver {
     Vec3 rolling = Vec3::Zero();             // its rolling-resistance impulse, world frame
   };
   static bool byPair(const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; }
-  // Into the next cache (after the solved manifolds): last tick's manifolds
-  // of sleeping pairs (keepWhileHeld), then the caches swapped.
+  // The held store (keepWhileHeld) keeps what still sleeps and gains last
+  // solve's manifolds whose pairs now do; then this solve's cache replaces
+  // last solve's.
   void keepHeldManifolds(const std::vector<BodyState>& bodies);
+  // A pair's manifold for the warm start: of last solve, else of the held
+  // store (the two never hold one pair); nullptr when neither has it.
+  const CachedManifold* findCached(std::uint64_t pair, const CachedPoint*& points) const;
   void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
                const ResponseOptions& options, double dt, SolveStats& stats);
   void orderFromTheGround(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
@@ -327,8 +333,13 @@ class ContactSolver {
   std::vector<int> contact_level_;  // orderFromTheGround: per active contact, the lower body's depth
   std::vector<std::uint32_t> adjacency_, queue_;
   std::vector<CachedPoint> cache_, next_cache_;
-  std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // sorted by pair
-  std::vector<CachedManifold> merged_manifolds_;  // keepHeldManifolds' merge (swapped with next_manifolds_)
+  std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // last solve's and this one's, sorted by pair
+  // Manifolds of sleeping pairs, sorted by pair, their points in held_points_.
+  // Kept apart from the solved ones, so a tick of a mostly sleeping pile
+  // copies none of them: only a wake or a despawn (an entry that no longer
+  // qualifies) compacts the store, and only a pair falling asleep adds to it.
+  std::vector<CachedPoint> held_points_, held_points_scratch_;
+  std::vector<CachedManifold> held_manifolds_, held_merge_;
   const std::vector<EntityId>* held_ids_ = nullptr;
   const std::vector<std::uint8_t>* held_ = nullptr;
   const Workers* workers_ = nullptr;

@@ -179,9 +179,7 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   growCapacityRewritten(wave_runs_, pass_runs_.size());
   resizeRewritten(row_bodies_, rows_.size());
   resizeRewritten(wave_flag_, rows_.size());
-  for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_, &merged_manifolds_}) {
-    growCapacity(*v, rows_.size());
-  }
+  for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_}) growCapacity(*v, rows_.size());
   for (std::vector<CachedPoint>* v : {&cache_, &next_cache_}) growCapacity(*v, rows_.size());
   // Each row from its contact alone: in pieces on the workers.
   const auto prepareRow = [&](std::size_t r) {
@@ -427,7 +425,7 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
 // nearest unused old point within half the gap bound (in A's frame).
 void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
                               SolveStats& stats) {
-  if (cache_manifolds_.empty()) return;
+  if (cache_manifolds_.empty() && held_manifolds_.empty()) return;
   std::atomic<std::size_t> by_feature{0}, started{0};
   // Stage by stage, as a pass: each body meets its manifolds in the same
   // order whatever the thread count, and a block's bodies stay on its thread.
@@ -438,9 +436,9 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
       const std::uint32_t last = manifold_start_[m + 1];
       const Contact& c0 = contacts[info_[first].contact];
       const std::uint64_t key = entityPairKey(c0.a, c0.b);
-      const auto found = std::lower_bound(cache_manifolds_.begin(), cache_manifolds_.end(), key,
-                                          [](const CachedManifold& x, std::uint64_t k) { return x.pair < k; });
-      if (found == cache_manifolds_.end() || found->pair != key) continue;
+      const CachedPoint* old = nullptr;
+      const CachedManifold* found = findCached(key, old);
+      if (found == nullptr) continue;
       Motion a = motion_[rows_[first].a];
       Motion b = motion_[rows_[first].b];
       if (any_rolling_ && rolling_[m].per_normal > 0.0) {
@@ -449,7 +447,6 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
         a.w -= roll.inv_ia * roll.lambda;
         b.w += roll.inv_ib * roll.lambda;
       }
-      const CachedPoint* old = cache_.data() + found->first;
       const std::uint32_t old_count = found->count;
       std::uint32_t used = 0;  // bit j: old point j taken (at most kCachedPointsPerPair)
       const BodyState& ba = bodies[rows_[first].a];
@@ -846,38 +843,77 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
   keepHeldManifolds(bodies);
 }
 
+const ContactSolver::CachedManifold* ContactSolver::findCached(std::uint64_t pair,
+                                                              const CachedPoint*& points) const {
+  const auto byKey = [](const CachedManifold& x, std::uint64_t k) { return x.pair < k; };
+  const auto solved = std::lower_bound(cache_manifolds_.begin(), cache_manifolds_.end(), pair, byKey);
+  if (solved != cache_manifolds_.end() && solved->pair == pair) {
+    points = cache_.data() + solved->first;
+    return &*solved;
+  }
+  const auto held = std::lower_bound(held_manifolds_.begin(), held_manifolds_.end(), pair, byKey);
+  if (held != held_manifolds_.end() && held->pair == pair) {
+    points = held_points_.data() + held->first;
+    return &*held;
+  }
+  return nullptr;
+}
+
 void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
-  const std::size_t solved = next_manifolds_.size();
-  if (held_ids_ != nullptr && held_ != nullptr) {
-    std::size_t cursor = 0;  // both lists are sorted by pair: one walk finds the solved ones
+  if (held_ids_ == nullptr || held_ == nullptr) {
+    held_manifolds_.clear();
+    held_points_.clear();
+  } else {
+    // Kept while both bodies are still there (a despawn moves indices: the
+    // ids must match) and out of the solve, one of them asleep; tested
+    // first, so an awake world pays two look-ups a manifold. A pair solved
+    // this tick has a movable body, so it never qualifies: the held store
+    // and the solved cache never share a pair.
+    const auto stillHeld = [&](const CachedManifold& m) {
+      const std::uint32_t ia = m.index_a, ib = m.index_b;
+      return ia < bodies.size() && ib < bodies.size() && ((*held_)[ia] != 0 || (*held_)[ib] != 0) &&
+             bodies[ia].is_static && bodies[ib].is_static &&
+             (*held_ids_)[ia] == static_cast<EntityId>(m.pair >> 32) &&
+             (*held_ids_)[ib] == static_cast<EntityId>(m.pair & 0xffffffffu);
+    };
+    // What no longer sleeps (woken, despawned) leaves the store; the rest
+    // stays where it is unless something left.
+    const std::size_t stored = held_manifolds_.size();
+    std::size_t kept = 0;
+    while (kept < stored && stillHeld(held_manifolds_[kept])) ++kept;
+    if (kept < stored) {
+      held_points_scratch_.clear();
+      std::size_t out = 0;
+      for (std::size_t k = 0; k < stored; ++k) {
+        CachedManifold m = held_manifolds_[k];
+        if (!stillHeld(m)) continue;
+        const std::uint32_t first = static_cast<std::uint32_t>(held_points_scratch_.size());
+        held_points_scratch_.insert(held_points_scratch_.end(), held_points_.begin() + m.first,
+                                    held_points_.begin() + m.first + m.count);
+        m.first = first;
+        held_manifolds_[out++] = m;
+      }
+      held_manifolds_.resize(out);
+      held_points_.swap(held_points_scratch_);
+    }
+    // Last solve's manifolds whose pairs now sleep join it (both lists are
+    // sorted by pair: one merge).
+    const std::size_t before = held_manifolds_.size();
     for (const CachedManifold& old : cache_manifolds_) {
-      // Both bodies still there (a despawn moves indices: the ids must
-      // match) and out of the solve, one of them asleep; tested first, so
-      // an awake world pays two look-ups a manifold, no search.
-      const std::uint32_t ia = old.index_a, ib = old.index_b;
-      if (ia >= bodies.size() || ib >= bodies.size() || ((*held_)[ia] == 0 && (*held_)[ib] == 0) ||
-          !bodies[ia].is_static || !bodies[ib].is_static ||
-          (*held_ids_)[ia] != static_cast<EntityId>(old.pair >> 32) ||
-          (*held_ids_)[ib] != static_cast<EntityId>(old.pair & 0xffffffffu)) {
-        continue;
-      }
-      while (cursor < solved && byPair(next_manifolds_[cursor], old)) ++cursor;
-      if (cursor < solved && next_manifolds_[cursor].pair == old.pair) {
-        continue;  // solved this tick: its new impulses are kept
-      }
-      CachedManifold kept = old;
-      kept.first = static_cast<std::uint32_t>(next_cache_.size());
-      next_cache_.insert(next_cache_.end(), cache_.begin() + old.first, cache_.begin() + old.first + old.count);
-      next_manifolds_.push_back(kept);
+      if (!stillHeld(old)) continue;
+      CachedManifold m = old;
+      m.first = static_cast<std::uint32_t>(held_points_.size());
+      held_points_.insert(held_points_.end(), cache_.begin() + old.first, cache_.begin() + old.first + old.count);
+      held_manifolds_.push_back(m);
     }
-    if (next_manifolds_.size() > solved) {
-      // Two sorted runs (the solved, then the kept in cache order): merged,
-      // not sorted again (a pile mostly asleep keeps most of its manifolds).
-      merged_manifolds_.resize(next_manifolds_.size());
-      std::merge(next_manifolds_.begin(), next_manifolds_.begin() + solved, next_manifolds_.begin() + solved,
-                 next_manifolds_.end(), merged_manifolds_.begin(), byPair);
-      next_manifolds_.swap(merged_manifolds_);
+    if (before > 0 && held_manifolds_.size() > before) {
+      held_merge_.resize(held_manifolds_.size());
+      std::merge(held_manifolds_.begin(), held_manifolds_.begin() + static_cast<std::ptrdiff_t>(before),
+                 held_manifolds_.begin() + static_cast<std::ptrdiff_t>(before), held_manifolds_.end(),
+                 held_merge_.begin(), byPair);
+      held_manifolds_.swap(held_merge_);
     }
+    assert(std::is_sorted(held_manifolds_.begin(), held_manifolds_.end(), byPair));
   }
   cache_.swap(next_cache_);
   cache_manifolds_.swap(next_manifolds_);
