@@ -25,6 +25,15 @@
 //             quantised monotonically to 8 bits (conservative);
 //   separate: each slot has a 64-bit Bloom mask of its current partners' slots.
 // Surviving events are applied after all lists are sorted.
+//
+// Boxes that did not move. A box set to the box it already had is not marked;
+// an update that touches few boxes sorts only the bands that hold a marked one
+// (the others are sorted and their endpoints current), quantises only the
+// marked and added boxes with the last full update's quantisers (any monotone
+// map keeps the filter conservative) and moves only them between bands; the
+// Bloom masks keep their stale bits until the next full update (a stale bit
+// only lets a swap through as a no-op event). The pairs, and their order, are
+// those of a full update.
 #include "sphere_tree_collision/sweep_and_prune.hpp"
 
 #include "flat_hash_map.hpp"
@@ -115,6 +124,7 @@ struct AxisLists {
   Quantiser band_of;  // coordinate on the band axis -> band
   std::vector<std::vector<Endpoint>> bands;
   std::vector<std::uint8_t> band_lost;  // by band: a box left it this update
+  std::vector<std::uint8_t> band_dirty;  // by band: holds a box that moved (incremental update)
   std::vector<std::uint16_t> lo, hi;    // by slot: bands the box is in now
   std::vector<std::uint16_t> new_lo, new_hi;  // by slot: bands it must be in
   double max_extent = 0.0;                    // on this axis, over boxes in use
@@ -134,6 +144,20 @@ struct SweepAndPrune::Impl {
   FlatHashMap slot_of_id;
   std::uint32_t last_set = ~0u;  // slot of the last setBox: callers often go in add order
   std::size_t live_at_banding = 0;  // boxes when the bands were last chosen
+
+  // Live boxes set to a new box since the last update() (by slot, and
+  // listed), until more moved than an incremental update takes.
+  std::vector<std::uint8_t> moved;
+  std::vector<std::uint32_t> moved_slots;
+  bool many_moved = false;
+  // The last full quantise's maps of each axis (for the filter ranges), and
+  // the updates since it.
+  Quantiser filter_q[3];
+  bool quantised = false;
+  int updates_since_full = 0;
+  // A full update at least this often: fresh quantisers and Bloom masks keep
+  // the filters sharp.
+  static constexpr int kFullEvery = 64;
 
   // Pair set: pairs (owned by SweepAndPrune) and pair_keys are parallel dense
   // arrays; pair_index maps a key to its index there.
@@ -276,6 +300,7 @@ struct SweepAndPrune::Impl {
       }
       lists[a].bands.resize(static_cast<std::size_t>(q.top) + 1);
       lists[a].band_lost.assign(lists[a].bands.size(), 0);
+      lists[a].band_dirty.assign(lists[a].bands.size(), 0);
       for (std::vector<Endpoint>& band : lists[a].bands) band.clear();
     }
     pairs.clear();
@@ -315,6 +340,7 @@ struct SweepAndPrune::Impl {
       // Zero or overflowing extent: scale 0 maps all to 0, still conservative.
       q[a].scale = extent > 0.0 && std::isfinite(extent) ? 255.0 / extent : 0.0;
       q[a].top = 255.0;
+      filter_q[a] = q[a];
       lists[a].max_extent = max_extent;
       lists[a].lo.resize(slots);
       lists[a].hi.resize(slots);
@@ -322,15 +348,49 @@ struct SweepAndPrune::Impl {
       lists[a].new_hi.resize(slots);
     }
     for (std::size_t s = 0; s < slots; ++s) {
-      if (!inUse(s)) continue;
-      std::uint32_t range[3];
-      for (int a = 0; a < 3; ++a) range[a] = q[a](spans[a][s].min) | (q[a](spans[a][s].max) << 8);
+      if (inUse(s)) quantiseBox(static_cast<std::uint32_t>(s));
+    }
+    quantised = true;
+  }
+
+  // One box's filter ranges (the saved quantisers) and the bands it must be in.
+  void quantiseBox(std::uint32_t s) {
+    std::uint32_t range[3];
+    for (int a = 0; a < 3; ++a) range[a] = filter_q[a](spans[a][s].min) | (filter_q[a](spans[a][s].max) << 8);
+    for (int a = 0; a < 3; ++a) {
+      spans[a][s].others = range[(a + 1) % 3] | (range[(a + 2) % 3] << 16);
+      const Span& band_span = spans[(a + 1) % 3][s];
+      lists[a].new_lo[s] = static_cast<std::uint16_t>(lists[a].band_of(band_span.min));
+      lists[a].new_hi[s] = static_cast<std::uint16_t>(lists[a].band_of(band_span.max));
+    }
+  }
+
+  // Few boxes moved or were added: those alone are quantised, and the bands
+  // holding a moved one are marked for sorting. max_extent stays an upper
+  // bound (it only grows here), which is all the sweeps need.
+  void quantiseMoved() {
+    for (AxisLists& list : lists) {
+      const std::size_t slots = state.size();
+      list.lo.resize(slots);
+      list.hi.resize(slots);
+      list.new_lo.resize(slots);
+      list.new_hi.resize(slots);
+    }
+    const auto one = [&](std::uint32_t s) {
+      quantiseBox(s);
       for (int a = 0; a < 3; ++a) {
-        spans[a][s].others = range[(a + 1) % 3] | (range[(a + 2) % 3] << 16);
-        const Span& band_span = spans[(a + 1) % 3][s];
-        lists[a].new_lo[s] = static_cast<std::uint16_t>(lists[a].band_of(band_span.min));
-        lists[a].new_hi[s] = static_cast<std::uint16_t>(lists[a].band_of(band_span.max));
+        lists[a].max_extent = std::max(lists[a].max_extent, spans[a][s].max - spans[a][s].min);
       }
+    };
+    for (std::uint32_t s : moved_slots) {
+      if (state[s] != SlotState::kLive) continue;
+      one(s);
+      for (AxisLists& list : lists) {
+        for (std::uint32_t b = list.lo[s]; b <= list.hi[s]; ++b) list.band_dirty[b] = 1;
+      }
+    }
+    for (std::uint32_t s : added) {
+      if (state[s] == SlotState::kAdded) one(s);
     }
   }
 
@@ -447,18 +507,25 @@ struct SweepAndPrune::Impl {
   // Move live boxes whose band range changed on list a (after the sort, which
   // saw their flips in the bands they leave): drop them from bands they left,
   // add them to bands they entered, finding their pairs there.
-  void moveBands(int a, std::vector<BroadPair>& pairs) {
+  // With `only_moved`, only the moved boxes are looked at (the others kept
+  // their bands); `entering` is sorted before use, so the order is free.
+  void moveBands(int a, std::vector<BroadPair>& pairs, bool only_moved) {
     AxisLists& list = lists[a];
-    for (std::size_t s = 0; s < state.size(); ++s) {
-      if (state[s] != SlotState::kLive) continue;
+    const auto move = [&](std::size_t s) {
+      if (state[s] != SlotState::kLive) return;
       const std::uint32_t lo = list.lo[s], hi = list.hi[s], nlo = list.new_lo[s], nhi = list.new_hi[s];
-      if (lo == nlo && hi == nhi) continue;
+      if (lo == nlo && hi == nhi) return;
       for (std::uint32_t b = lo; b <= hi; ++b)
         if (b < nlo || b > nhi) list.band_lost[b] = 1;
       for (std::uint32_t b = nlo; b <= nhi; ++b)
         if (b < lo || b > hi) entering.push_back((std::uint64_t{b} << 32) | s);
       list.lo[s] = static_cast<std::uint16_t>(nlo);
       list.hi[s] = static_cast<std::uint16_t>(nhi);
+    };
+    if (only_moved) {
+      for (std::uint32_t s : moved_slots) move(s);
+    } else {
+      for (std::size_t s = 0; s < state.size(); ++s) move(s);
     }
     for (std::size_t b = 0; b < list.bands.size(); ++b) {
       if (!list.band_lost[b]) continue;
@@ -517,6 +584,7 @@ void SweepAndPrune::add(EntityId id, const Aabb& box) {
     m.ids.emplace_back();
     m.state.emplace_back();
     m.partner_bloom.emplace_back();
+    m.moved.emplace_back();
   }
   m.setSpans(slot, box);
   m.ids[slot] = id;
@@ -554,21 +622,54 @@ void SweepAndPrune::setBox(EntityId id, const Aabb& box) {
   std::uint32_t slot = m.last_set + 1;
   if (slot >= m.ids.size() || m.ids[slot] != id || !m.inUse(slot)) slot = m.slotOfId(id);
   checkBox(box);
-  m.setSpans(slot, box);
   m.last_set = slot;
+  bool same = true;
+  for (int a = 0; a < 3; ++a) {
+    same = same && m.spans[a][slot].min == box.min[a] && m.spans[a][slot].max == box.max[a];
+  }
+  if (same) return;
+  m.setSpans(slot, box);
+  if (m.many_moved || m.state[slot] != SlotState::kLive || m.moved[slot] != 0) return;
+  if (8 * (m.moved_slots.size() + 1) > m.slot_of_id.size()) {
+    m.many_moved = true;  // the next update is a full one: no need to list more
+    return;
+  }
+  m.moved[slot] = 1;
+  m.moved_slots.push_back(slot);
 }
 
 void SweepAndPrune::update() {
   Impl& m = *impl_;
   if (!m.removed.empty()) m.dropRemoved(pairs_);
-  if (m.bandsStale()) m.chooseBands(pairs_);
-  m.rebuildBlooms();
-  m.quantise();
+  const bool rebanded = m.bandsStale();
+  if (rebanded) m.chooseBands(pairs_);
+  // Incremental while few boxes changed (a world mostly at rest, asleep or
+  // still): their bands alone are sorted.
+  const std::size_t touched = m.moved_slots.size() + m.added.size();
+  const bool incremental = !rebanded && !m.many_moved && m.quantised &&
+                           m.updates_since_full < Impl::kFullEvery && 8 * touched <= m.slot_of_id.size();
+  if (incremental) {
+    ++m.updates_since_full;
+    m.quantiseMoved();
+  } else {
+    m.updates_since_full = 0;
+    m.rebuildBlooms();
+    m.quantise();
+  }
   last_swaps_ = 0;
-  for (int a = 0; a < 3; ++a)
-    for (std::vector<Endpoint>& band : m.lists[a].bands) last_swaps_ += m.sortBand(band, m.spans[a].data());
+  for (int a = 0; a < 3; ++a) {
+    AxisLists& list = m.lists[a];
+    for (std::size_t b = 0; b < list.bands.size(); ++b) {
+      if (incremental && list.band_dirty[b] == 0) continue;
+      list.band_dirty[b] = 0;
+      last_swaps_ += m.sortBand(list.bands[b], m.spans[a].data());
+    }
+  }
   m.applyEvents(pairs_);
-  for (int a = 0; a < 3; ++a) m.moveBands(a, pairs_);
+  for (int a = 0; a < 3; ++a) m.moveBands(a, pairs_, incremental);
+  for (std::uint32_t slot : m.moved_slots) m.moved[slot] = 0;
+  m.moved_slots.clear();
+  m.many_moved = false;
   if (!m.added.empty()) {
     const std::size_t entities = m.slot_of_id.size();
     // Room for a typical pair count, so steady-state ticks rarely grow them.
