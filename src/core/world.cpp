@@ -211,6 +211,8 @@ bool World::removeEntity(EntityId id) {
     names_[index] = std::move(names_[last]);
     index_of_->set(ids_[index], static_cast<std::uint32_t>(index));
   }
+  pair_ids_seen_.clear();  // a dense index moved
+  pair_indices_seen_.clear();
   ids_.pop_back();
   bodies_.pop_back();
   body_shapes_.pop_back();
@@ -239,6 +241,8 @@ void World::clear() {
   box_modes_.clear();
   names_.clear();
   *index_of_ = detail::FlatHashMap();
+  pair_ids_seen_.clear();
+  pair_indices_seen_.clear();
   id_by_name_.clear();
   broad_phase_ = SweepAndPrune();
   islands_.clear();
@@ -442,16 +446,30 @@ void World::broadPhase(TickReport& report) {
 bool World::setUpPairTests() {
   pair_count_ = 0;
   if (islands_.quiet()) return false;  // all asleep: every pair is held-held or held-static
-  // Each pair's dense indices (a hash look-up each, at random) and whether
-  // it is tested, in pieces on the workers: each writes its own slots.
+  // Each pair's dense indices and whether it is tested, in pieces on the
+  // workers: each writes its own slots. The indices are last lookup's while
+  // the pair at that place is the same (no removal since: ids_seen emptied),
+  // else a hash look-up each, at random.
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
   pair_tested_.resize(pairs.size());
+  const std::size_t seen = pair_ids_seen_.size();
+  if (seen < pairs.size()) {
+    pair_ids_seen_.resize(pairs.size(), BroadPair{0, 0});  // {0, 0} is no pair: a miss
+    pair_indices_seen_.resize(pairs.size());
+  }
   workers_.forEach(pairs.size(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
-      const auto ia = static_cast<std::uint32_t>(index_of_->find(pairs[k].first));
-      const auto ib = static_cast<std::uint32_t>(index_of_->find(pairs[k].second));
-      pair_bodies_[k] = {ia, ib};
-      pair_tested_[k] = !(bodies_[ia].is_static && bodies_[ib].is_static);  // else nothing can change (or asleep)
+      const BroadPair pair = pairs[k];
+      std::array<std::uint32_t, 2>& indices = pair_indices_seen_[k];
+      if (!(pair_ids_seen_[k] == pair)) {
+        indices = {static_cast<std::uint32_t>(index_of_->find(pair.first)),
+                   static_cast<std::uint32_t>(index_of_->find(pair.second))};
+        pair_ids_seen_[k] = pair;
+      }
+      assert(indices[0] == index_of_->find(pair.first) && indices[1] == index_of_->find(pair.second));
+      pair_bodies_[k] = indices;
+      // Two static (or held) bodies: nothing can change.
+      pair_tested_[k] = !(bodies_[indices[0]].is_static && bodies_[indices[1]].is_static);
     }
   });
   // In pair order: the wakes, and the tested pairs packed to the front

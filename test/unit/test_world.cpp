@@ -1,5 +1,6 @@
 // World: entity validation and bookkeeping, kinematic integration, and the
 // narrow phase under a budget with the accept/reject policy.
+#include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <gtest/gtest.h>
@@ -226,6 +227,33 @@ TEST(World, RemoveSwapsTheLastIntoTheHoleAndClearKeepsShapes) {
   const TickReport r = w.step(0.01, Budget::unlimited());
   EXPECT_EQ(r.entities, 1u);
   EXPECT_EQ(r.broad_pairs, 0u);
+}
+
+// The broad phase's pairs keep their dense indices from tick to tick
+// (setUpPairTests), so a removal, which moves the last body into the hole,
+// must not leave a pair test reading another body's pose.
+TEST(World, PairTestsReadTheirOwnBodiesThroughRemovals) {
+  SceneParams params;
+  params.entities = 300;
+  SceneWorld scene = makeSceneWorld(SceneKind::PackedBox, params);
+  World& w = scene.world;
+  for (int t = 0; t < 10; ++t) w.step(1.0 / 60.0, Budget::unlimited());
+  std::size_t checked = 0;
+  for (int t = 0; t < 40; ++t) {
+    if (t % 4 == 1) ASSERT_TRUE(w.removeEntity(scene.spec.movers[static_cast<std::size_t>(t)]));
+    w.step(1.0 / 60.0, Budget::unlimited());
+    ASSERT_GT(w.pairCount(), 0u);
+    for (std::size_t k = 0; k < w.pairCount(); ++k) {
+      const PairTest& test = w.pairTests()[k];
+      for (const PairBody* body : {&test.bodyA(), &test.bodyB()}) {
+        const std::optional<std::size_t> index = w.indexOf(body->id);
+        ASSERT_TRUE(index.has_value()) << "tick " << t << ": pair " << k << " of a removed body";
+        ASSERT_EQ(body->pose, &w.bodies()[*index].pose) << "tick " << t << ": pair " << k;
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000u);
 }
 
 TEST(World, KinematicIntegrationMovesAndTurnsOnlyMovableBodies) {
