@@ -248,7 +248,9 @@ class World {
   // Returns the clock when the scheduler stopped (what follows is not interruptible).
   double narrowPhase(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
   void response(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
-  void quarantine(TickReport& report);  // first and last: removes bodies beyond the limits
+  // First and last: removes bodies beyond the limits; bodies flagged in
+  // `unchanged` (held through the tick) are not looked at again.
+  void quarantine(TickReport& report, const std::vector<std::uint8_t>* unchanged = nullptr);
   // After the response: bodies hit harder than their strength are queued in
   // pending_breaks_. A break is made once its pieces' trees exist; a tree is
   // built only when its estimated cost (tree_cost_) fits before the tick's
@@ -323,6 +325,7 @@ class World {
   SecondsClock clock_ = steadySeconds;
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step
+  std::vector<std::uint8_t> held_through_tick_;  // step: Islands::held() before endTick (pooled)
   // A break waiting for its pieces' trees: the plane in the body's grid
   // frame, so the split is the same whenever it is made.
   struct PendingBreak {

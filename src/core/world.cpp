@@ -341,8 +341,11 @@ TickReport World::step(double dt, const Budget& budget) {
   report.contacts = contacts_.size();
   report.entities = ids_.size();
   reserve_s_ = std::max(t4 - scheduled - report.response_refinement_s, kReserveDecay * reserve_s_);
+  // Held through the tick, a sleeper was neither moved nor solved: its state
+  // passed the first check unchanged (endTick releases the holds).
+  held_through_tick_ = islands_.held();
   islands_.endTick(bodies_, contacts_, dt, sleeping);
-  quarantine(report);
+  quarantine(report, &held_through_tick_);
   report.sleeping = islands_.sleepingCount();
   return report;
 }
@@ -596,9 +599,10 @@ void World::response(double dt, const Budget& budget, const Deadline& tick_end, 
 // solver blow-up, a fall forever) is removed here, before anything reads its
 // state, and named in quarantined(). Removing invalidates this tick's
 // contacts (they name dense indices); the rest of the world is untouched.
-void World::quarantine(TickReport& report) {
+void World::quarantine(TickReport& report, const std::vector<std::uint8_t>* unchanged) {
   const std::size_t first = quarantined_.size();
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (unchanged != nullptr && (*unchanged)[i] != 0) continue;
     if (bodies_[i].is_static) continue;  // never moves: checked at input
     const Quarantine reason = quarantineReason(bodies_[i], config_.limits);
     if (reason == Quarantine::None) continue;

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <vector>
 
 
@@ -253,6 +254,24 @@ TEST(Sleeping, EditThroughBodiesAndWakeWakeTheIsland) {
   EXPECT_TRUE(other.world.wake(woken));
   EXPECT_FALSE(other.world.isSleeping(woken));
   EXPECT_FALSE(other.world.wake(kInvalidEntity));
+}
+
+// A sleeper is not looked at again at the end of a tick it slept through
+// (World::quarantine): an edit to a bad state is still caught by the check
+// at the start of the next step, before anything touches it.
+TEST(Sleeping, SleeperEditedToANonFiniteStateIsQuarantinedBeforeItTouchesAnything) {
+  Pile pile = settledPile();
+  World& world = pile.world;
+  const EntityId id = pile.spec.movers.front();
+  world.bodies()[indexOf(world, id)].linear_velocity.x() = std::numeric_limits<double>::quiet_NaN();
+  const TickReport report = world.step(kDt, Budget::unlimited());
+  EXPECT_EQ(report.quarantined, 1u);
+  EXPECT_FALSE(world.indexOf(id).has_value());
+  for (const BodyState& body : world.bodies()) {
+    ASSERT_TRUE(body.pose.position.allFinite() && body.linear_velocity.allFinite());
+  }
+  for (int t = 0; t < 30; ++t) world.step(kDt, Budget::unlimited());
+  for (const BodyState& body : world.bodies()) ASSERT_TRUE(body.pose.position.allFinite());
 }
 
 // Woken, a pile starts from the impulses it fell asleep with, however long
