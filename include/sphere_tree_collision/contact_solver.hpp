@@ -328,6 +328,7 @@ class ContactSolver {
   std::vector<Motion> motion_;  // solver velocities, one per body
   std::vector<Motion> delta_;   // Jacobi: impulses of one iteration, applied together
   std::vector<Motion> pseudo_;  // split-impulse pseudo-velocities
+  std::vector<std::uint8_t> out_of_solve_;  // per body: static (or held) in this solve, compact
   std::vector<int> contact_count_;
   std::vector<int> depth_, adjacency_start_, fill_;  // contact graph, for the row order
   std::vector<int> contact_level_;  // orderFromTheGround: per active contact, the lower body's depth

@@ -139,12 +139,14 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   const bool jacobi = options.solver == SolverKind::Jacobi;
   motion_.resize(body_count);
   pseudo_.resize(body_count);
+  out_of_solve_.resize(body_count);
   if (jacobi) delta_.resize(body_count);
   // Each body's solver velocities from its state alone: in pieces on the workers.
   forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       motion_[i].v = bodies[i].linear_velocity;
       motion_[i].w = bodies[i].angular_velocity;
+      out_of_solve_[i] = bodies[i].is_static ? 1 : 0;
       pseudo_[i] = Motion{};
       if (jacobi) delta_[i] = Motion{};
     }
@@ -872,7 +874,7 @@ void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
     const auto stillHeld = [&](const CachedManifold& m) {
       const std::uint32_t ia = m.index_a, ib = m.index_b;
       return ia < bodies.size() && ib < bodies.size() && ((*held_)[ia] != 0 || (*held_)[ib] != 0) &&
-             bodies[ia].is_static && bodies[ib].is_static &&
+             out_of_solve_[ia] != 0 && out_of_solve_[ib] != 0 &&
              (*held_ids_)[ia] == static_cast<EntityId>(m.pair >> 32) &&
              (*held_ids_)[ib] == static_cast<EntityId>(m.pair & 0xffffffffu);
     };
