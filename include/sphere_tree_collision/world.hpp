@@ -315,8 +315,11 @@ class World {
   // setUpPairTests: each broad-phase pair's ids and dense indices as last
   // looked up, by its place in the pair list (a pair mostly keeps its place
   // from tick to tick); emptied when a removal moves dense indices.
-  std::vector<BroadPair> pair_ids_seen_;
-  std::vector<std::array<std::uint32_t, 2>> pair_indices_seen_;
+  struct SeenPair {
+    BroadPair ids{0, 0};  // {0, 0} is no pair: a miss
+    std::array<std::uint32_t, 2> indices{};
+  };
+  std::vector<SeenPair> pairs_seen_;
   std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
   std::vector<std::uint32_t> pair_reused_;  // each pair's carried-over contacts (PairContactCache), or kNone
   std::vector<Contact> contacts_;

@@ -150,14 +150,13 @@ struct SweepAndPrune::Impl {
   std::vector<std::uint8_t> moved;
   std::vector<std::uint32_t> moved_slots;
   bool many_moved = false;
-  // The last full quantise's maps of each axis (for the filter ranges), and
-  // the updates since it.
-  Quantiser filter_q[3];
-  bool quantised = false;
-  int updates_since_full = 0;
   // A full update at least this often: fresh quantisers and Bloom masks keep
   // the filters sharp.
   static constexpr int kFullEvery = 64;
+  // The last full quantise's maps of each axis (for the filter ranges), and
+  // the updates since it (the first update is a full one).
+  Quantiser filter_q[3];
+  int updates_since_full = kFullEvery;
 
   // Pair set: pairs (owned by SweepAndPrune) and pair_keys are parallel dense
   // arrays; pair_index maps a key to its index there.
@@ -342,15 +341,21 @@ struct SweepAndPrune::Impl {
       q[a].top = 255.0;
       filter_q[a] = q[a];
       lists[a].max_extent = max_extent;
-      lists[a].lo.resize(slots);
-      lists[a].hi.resize(slots);
-      lists[a].new_lo.resize(slots);
-      lists[a].new_hi.resize(slots);
     }
+    sizeBandRanges();
     for (std::size_t s = 0; s < slots; ++s) {
       if (inUse(s)) quantiseBox(static_cast<std::uint32_t>(s));
     }
-    quantised = true;
+  }
+
+  // The per-slot band ranges of every list, one entry a slot.
+  void sizeBandRanges() {
+    for (AxisLists& list : lists) {
+      list.lo.resize(state.size());
+      list.hi.resize(state.size());
+      list.new_lo.resize(state.size());
+      list.new_hi.resize(state.size());
+    }
   }
 
   // One box's filter ranges (the saved quantisers) and the bands it must be in.
@@ -369,13 +374,7 @@ struct SweepAndPrune::Impl {
   // holding a moved one are marked for sorting. max_extent stays an upper
   // bound (it only grows here), which is all the sweeps need.
   void quantiseMoved() {
-    for (AxisLists& list : lists) {
-      const std::size_t slots = state.size();
-      list.lo.resize(slots);
-      list.hi.resize(slots);
-      list.new_lo.resize(slots);
-      list.new_hi.resize(slots);
-    }
+    sizeBandRanges();
     const auto one = [&](std::uint32_t s) {
       quantiseBox(s);
       for (int a = 0; a < 3; ++a) {
@@ -646,8 +645,7 @@ void SweepAndPrune::update() {
   // Incremental while few boxes changed (a world mostly at rest, asleep or
   // still): their bands alone are sorted.
   const std::size_t touched = m.moved_slots.size() + m.added.size();
-  const bool incremental = !rebanded && !m.many_moved && m.quantised &&
-                           m.updates_since_full < Impl::kFullEvery && 8 * touched <= m.slot_of_id.size();
+  const bool incremental = !rebanded && !m.many_moved && m.updates_since_full < Impl::kFullEvery && 8 * touched <= m.slot_of_id.size();
   if (incremental) {
     ++m.updates_since_full;
     m.quantiseMoved();

@@ -211,8 +211,7 @@ bool World::removeEntity(EntityId id) {
     names_[index] = std::move(names_[last]);
     index_of_->set(ids_[index], static_cast<std::uint32_t>(index));
   }
-  pair_ids_seen_.clear();  // a dense index moved
-  pair_indices_seen_.clear();
+  pairs_seen_.clear();  // a dense index moved
   ids_.pop_back();
   bodies_.pop_back();
   body_shapes_.pop_back();
@@ -241,8 +240,7 @@ void World::clear() {
   box_modes_.clear();
   names_.clear();
   *index_of_ = detail::FlatHashMap();
-  pair_ids_seen_.clear();
-  pair_indices_seen_.clear();
+  pairs_seen_.clear();
   id_by_name_.clear();
   broad_phase_ = SweepAndPrune();
   islands_.clear();
@@ -451,24 +449,21 @@ bool World::setUpPairTests() {
   if (islands_.quiet()) return false;  // all asleep: every pair is held-held or held-static
   // Each pair's dense indices and whether it is tested, in pieces on the
   // workers: each writes its own slots. The indices are last lookup's while
-  // the pair at that place is the same (no removal since: ids_seen emptied),
+  // the pair at that place is the same (no removal since: pairs_seen_ emptied),
   // else a hash look-up each, at random.
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
   pair_tested_.resize(pairs.size());
-  const std::size_t seen = pair_ids_seen_.size();
-  if (seen < pairs.size()) {
-    pair_ids_seen_.resize(pairs.size(), BroadPair{0, 0});  // {0, 0} is no pair: a miss
-    pair_indices_seen_.resize(pairs.size());
-  }
+  if (pairs_seen_.size() < pairs.size()) pairs_seen_.resize(pairs.size());
   workers_.forEach(pairs.size(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const BroadPair pair = pairs[k];
-      std::array<std::uint32_t, 2>& indices = pair_indices_seen_[k];
-      if (!(pair_ids_seen_[k] == pair)) {
-        indices = {static_cast<std::uint32_t>(index_of_->find(pair.first)),
-                   static_cast<std::uint32_t>(index_of_->find(pair.second))};
-        pair_ids_seen_[k] = pair;
+      SeenPair& seen = pairs_seen_[k];
+      if (!(seen.ids == pair)) {
+        seen.ids = pair;
+        seen.indices = {static_cast<std::uint32_t>(index_of_->find(pair.first)),
+                        static_cast<std::uint32_t>(index_of_->find(pair.second))};
       }
+      const std::array<std::uint32_t, 2>& indices = seen.indices;
       assert(indices[0] == index_of_->find(pair.first) && indices[1] == index_of_->find(pair.second));
       pair_bodies_[k] = indices;
       // Two static (or held) bodies: nothing can change.
