@@ -225,11 +225,11 @@ class ContactSolver {
   const CachedManifold* findCached(std::uint64_t pair, const CachedPoint*& points) const;
   void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
                const ResponseOptions& options, double dt, SolveStats& stats);
-  void orderFromTheGround(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
+  void orderFromTheGround();  // from active_, contact_bodies_ and immovable_
   // After orderFromTheGround: order_ regrouped block by block, manifold by
   // manifold; manifold_start_, manifolds_, a pass's and the shock levels'
   // runs of manifolds (contact_solver_blocks.cpp).
-  void blockManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts);
+  void blockManifolds(const std::vector<BodyState>& bodies);
   struct ManifoldRun {
     std::uint32_t first = 0, end = 0;
   };
@@ -329,10 +329,15 @@ class ContactSolver {
   std::vector<Motion> delta_;   // Jacobi: impulses of one iteration, applied together
   std::vector<Motion> pseudo_;  // split-impulse pseudo-velocities
   std::vector<std::uint8_t> out_of_solve_;  // per body: static (or held) in this solve, compact
+  std::vector<std::uint8_t> immovable_;     // per body: static or of infinite mass, compact
+  // Per contact: its two dense body indices, compact, for the serial loops of
+  // the set-up (the order from the ground, the groups), which would otherwise
+  // read a whole Contact for two indices.
+  std::vector<std::array<std::uint32_t, 2>> contact_bodies_;
   std::vector<int> contact_count_;
   std::vector<int> depth_, adjacency_start_, fill_;  // contact graph, for the row order
   std::vector<int> contact_level_;  // orderFromTheGround: per active contact, the lower body's depth
-  std::vector<std::uint32_t> adjacency_, queue_;
+  std::vector<std::uint32_t> adjacency_, queue_;  // adjacency_: the other body of each contact at a body
   std::vector<CachedPoint> cache_, next_cache_;
   std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // last solve's and this one's, sorted by pair
   // Manifolds of sleeping pairs, sorted by pair, their points in held_points_.

@@ -50,10 +50,12 @@ struct SweepScratch {
   bool prune_by_boxes = true;
 };
 
-// Bodies moved from start[i] to bodies[i].pose this tick. A body is fast when
-// it moved (rotation counted at its farthest leaf) more than `threshold` of
-// its smallest leaf radius (ResponseOptions::sweep_threshold). Static bodies
-// and shapes[i] == nullptr never are. Fills `fast`, returns the count.
+// A body moved from `start` to body.pose this tick is fast when it moved
+// (rotation counted at its farthest leaf) more than `threshold` of its
+// smallest leaf radius (ResponseOptions::sweep_threshold). A static body and
+// shape == nullptr never are.
+bool movesFast(const BodyState& body, const Pose& start, const ShapeBounds* shape, double threshold);
+// movesFast for each of bodies (from start[i], shapes[i]) into `fast`; returns the count.
 std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vector<Pose>& start,
                            const std::vector<const ShapeBounds*>& shapes, double threshold,
                            std::vector<std::uint8_t>& fast);

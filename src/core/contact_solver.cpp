@@ -140,6 +140,7 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   motion_.resize(body_count);
   pseudo_.resize(body_count);
   out_of_solve_.resize(body_count);
+  immovable_.resize(body_count);
   if (jacobi) delta_.resize(body_count);
   // Each body's solver velocities from its state alone: in pieces on the workers.
   forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
@@ -147,6 +148,7 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
       motion_[i].v = bodies[i].linear_velocity;
       motion_[i].w = bodies[i].angular_velocity;
       out_of_solve_[i] = bodies[i].is_static ? 1 : 0;
+      immovable_[i] = (bodies[i].is_static || bodies[i].inv_mass == 0.0) ? 1 : 0;
       pseudo_[i] = Motion{};
       if (jacobi) delta_[i] = Motion{};
     }
@@ -160,13 +162,16 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   }
   const auto inverseMass = [&](std::uint32_t i) { return bodies[i].is_static ? 0.0 : bodies[i].inv_mass; };
   active_.clear();
+  growCapacity(contact_bodies_, contacts.size());
+  contact_bodies_.resize(contacts.size());
   for (std::uint32_t ci = 0; ci < contacts.size(); ++ci) {
     const Contact& c = contacts[ci];
-    if (inverseMass(c.index_a) == 0.0 && inverseMass(c.index_b) == 0.0) continue;  // two immovable bodies
+    contact_bodies_[ci] = {c.index_a, c.index_b};
+    if (immovable_[c.index_a] != 0 && immovable_[c.index_b] != 0) continue;  // two immovable bodies
     active_.push_back(ci);
   }
-  orderFromTheGround(bodies, contacts);
-  blockManifolds(bodies, contacts);  // order_ now block by block, manifold by manifold
+  orderFromTheGround();
+  blockManifolds(bodies);  // order_ now block by block, manifold by manifold
   stats.slabs = partition_.slabs();
   stats.crossing_manifolds = partition_.crossing();
 
@@ -307,26 +312,27 @@ void ContactSolver::prepareRolling(const std::vector<BodyState>& bodies, bool ja
 // lower body from an immovable one (breadth-first from the static bodies).
 // Fills order_ with the active contacts, stably sorted by that level
 // (unreached ones last), and depth_ per body.
-void ContactSolver::orderFromTheGround(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts) {
-  const std::size_t body_count = bodies.size();
+void ContactSolver::orderFromTheGround() {
+  const std::size_t body_count = immovable_.size();
   depth_.assign(body_count, kUnreached);
-  // Adjacency as CSR: active contacts touching each body.
+  // Adjacency as CSR: for each body, the other body of each active contact on it.
   adjacency_start_.assign(body_count + 1, 0);
   for (const std::uint32_t ci : active_) {
-    ++adjacency_start_[contacts[ci].index_a + 1];
-    ++adjacency_start_[contacts[ci].index_b + 1];
+    ++adjacency_start_[contact_bodies_[ci][0] + 1];
+    ++adjacency_start_[contact_bodies_[ci][1] + 1];
   }
   for (std::size_t i = 0; i < body_count; ++i) adjacency_start_[i + 1] += adjacency_start_[i];
   adjacency_.resize(2 * active_.size());
   fill_.assign(adjacency_start_.begin(), adjacency_start_.end() - 1);
   for (const std::uint32_t ci : active_) {
-    adjacency_[static_cast<std::size_t>(fill_[contacts[ci].index_a]++)] = ci;
-    adjacency_[static_cast<std::size_t>(fill_[contacts[ci].index_b]++)] = ci;
+    const auto [a, b] = contact_bodies_[ci];
+    adjacency_[static_cast<std::size_t>(fill_[a]++)] = b;
+    adjacency_[static_cast<std::size_t>(fill_[b]++)] = a;
   }
   queue_.clear();
   for (const std::uint32_t ci : active_) {
-    for (const std::uint32_t i : {contacts[ci].index_a, contacts[ci].index_b}) {
-      if (depth_[i] == kUnreached && (bodies[i].is_static || bodies[i].inv_mass == 0.0)) {
+    for (const std::uint32_t i : contact_bodies_[ci]) {
+      if (depth_[i] == kUnreached && immovable_[i] != 0) {
         depth_[i] = 0;
         queue_.push_back(i);
       }
@@ -335,8 +341,7 @@ void ContactSolver::orderFromTheGround(const std::vector<BodyState>& bodies, con
   for (std::size_t q = 0; q < queue_.size(); ++q) {
     const std::uint32_t i = queue_[q];
     for (int k = adjacency_start_[i]; k < adjacency_start_[i + 1]; ++k) {
-      const Contact& c = contacts[adjacency_[static_cast<std::size_t>(k)]];
-      const std::uint32_t other = c.index_a == i ? c.index_b : c.index_a;
+      const std::uint32_t other = adjacency_[static_cast<std::size_t>(k)];
       if (depth_[other] == kUnreached) {
         depth_[other] = depth_[i] + 1;
         queue_.push_back(other);
@@ -344,11 +349,11 @@ void ContactSolver::orderFromTheGround(const std::vector<BodyState>& bodies, con
     }
   }
   // Stable counting sort by level. Unreached contacts go last.
-  growCapacity(contact_level_, contacts.size());
-  contact_level_.resize(contacts.size());
+  growCapacity(contact_level_, contact_bodies_.size());
+  contact_level_.resize(contact_bodies_.size());
   int top = 0;
   for (const std::uint32_t ci : active_) {
-    const int level = std::min(depth_[contacts[ci].index_a], depth_[contacts[ci].index_b]);
+    const int level = std::min(depth_[contact_bodies_[ci][0]], depth_[contact_bodies_[ci][1]]);
     contact_level_[ci] = level;
     if (level != kUnreached) top = std::max(top, level);
   }

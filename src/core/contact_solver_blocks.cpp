@@ -8,7 +8,7 @@
 
 namespace stc {
 
-void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts) {
+void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
   // Groups: the manifolds, runs of one body pair in order_ (a pair's contacts
   // are adjacent, as ContactBuilder emits them, and stay so in the order from
   // the ground, which is stable).
@@ -24,16 +24,13 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies, const s
   growCapacity(manifolds_, order_.size());
   growCapacity(levels_, order_.size());
   for (std::size_t p = 0; p < order_.size(); ++p) {
-    const Contact& c = contacts[order_[p]];
+    const std::array<std::uint32_t, 2> c = contact_bodies_[order_[p]];
     const int level = contact_level_[order_[p]];
     if (levels_.empty() || levels_.back() != level) levels_.push_back(level);
-    if (p > 0) {
-      const Contact& previous = contacts[order_[p - 1]];
-      if (c.index_a == previous.index_a && c.index_b == previous.index_b) continue;
-    }
+    if (p > 0 && c == contact_bodies_[order_[p - 1]]) continue;
     SolverGroup group;
-    group.a = bodies[c.index_a].is_static ? SolverGroup::kStatic : c.index_a;
-    group.b = bodies[c.index_b].is_static ? SolverGroup::kStatic : c.index_b;
+    group.a = out_of_solve_[c[0]] != 0 ? SolverGroup::kStatic : c[0];
+    group.b = out_of_solve_[c[1]] != 0 ? SolverGroup::kStatic : c[1];
     groups_.push_back(group);
     group_first_.push_back(static_cast<std::uint32_t>(p));
   }

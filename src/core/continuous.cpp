@@ -229,22 +229,21 @@ bool sweepable(const BodyState& body, const ShapeBounds* shape) {
 
 }  // namespace
 
+bool movesFast(const BodyState& body, const Pose& start, const ShapeBounds* shape, double threshold) {
+  if (!sweepable(body, shape)) return false;
+  const double moved = (body.pose.position - start.position).norm() +
+                       start.orientation.angularDistance(body.pose.orientation) * shape->bound_radius;
+  return moved > threshold * shape->min_leaf_radius;
+}
+
 std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vector<Pose>& start,
                            const std::vector<const ShapeBounds*>& shapes, double threshold,
                            std::vector<std::uint8_t>& fast) {
   fast.assign(bodies.size(), 0);
   std::size_t count = 0;
   for (std::size_t i = 0; i < bodies.size(); ++i) {
-    const ShapeBounds* shape = shapes[i];
-    if (!sweepable(bodies[i], shape)) continue;
-    const Pose& p0 = start[i];
-    const Pose& p1 = bodies[i].pose;
-    const double moved = (p1.position - p0.position).norm() +
-                         p0.orientation.angularDistance(p1.orientation) * shape->bound_radius;
-    if (moved > threshold * shape->min_leaf_radius) {
-      fast[i] = 1;
-      ++count;
-    }
+    fast[i] = movesFast(bodies[i], start[i], shapes[i], threshold) ? 1 : 0;
+    count += fast[i];
   }
   return count;
 }

@@ -28,23 +28,25 @@ void Physics::integrate(const StepContext& step) {
   IntegrationOptions integration;
   integration.gravity = step.gravity;
   integration.gyroscopic = options.gyroscopic;
-  // Each body alone: any split of the bodies gives the same result.
+  // Without a response nothing would turn a body put back at its hit: no sweep.
+  const bool sweeps = options.continuous && options.enabled && step.dt > 0.0;
+  std::vector<std::uint8_t>& fast = sweep_scratch_.fast;
+  fast.resize(bodies.size());
+  if (sweeps) body_bounds_.resize(bodies.size());
+  // Each body alone (moved, then marked fast or not): any split of the bodies
+  // gives the same result.
   forEachIndex(step.workers, bodies.size(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       start_[i] = bodies[i].pose;
       integratePosition(bodies[i], integration, step.dt);
       integrateVelocity(bodies[i], integration, step.dt);
+      fast[i] = 0;
+      if (!sweeps) continue;
+      body_bounds_[i] = &(*step.shape_bounds)[(*step.body_shapes)[i]];
+      fast[i] = movesFast(bodies[i], start_[i], body_bounds_[i], options.sweep_threshold) ? 1 : 0;
     }
   });
-  sweep_scratch_.fast.assign(bodies.size(), 0);
-  // Without a response nothing would turn a body put back at its hit: no sweep.
-  if (!(options.continuous && options.enabled && step.dt > 0.0)) return;
-  body_bounds_.resize(bodies.size());
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    body_bounds_[i] = &(*step.shape_bounds)[(*step.body_shapes)[i]];
-  }
-  report_.sweep.fast_bodies =
-      markFastBodies(bodies, start_, body_bounds_, options.sweep_threshold, sweep_scratch_.fast);
+  if (sweeps) report_.sweep.fast_bodies = static_cast<std::size_t>(std::count(fast.begin(), fast.end(), 1));
 }
 
 void Physics::sweep(const StepContext& step) {
