@@ -8,7 +8,9 @@
 // threads, TBB's workers included), and the phases' wall times from the
 // TickReport; the speed-up per phase; the serial fraction s of the tick from
 // Amdahl's law fitted to the two runs, t_N = t_1 (s + (1 - s) / N), and what
-// that s predicts for 8 and 16 cores. The load average is printed with the
+// that s predicts for 8 and 16 cores; and the serial part measured: the
+// N-thread tick's time outside the team's parallel loops (World::timeTeamLoops),
+// with the calling thread's wait inside them. The load average is printed with the
 // figures: on a busy machine the parallel run waits for cores.
 //
 // Before each turn of the two runs, two threads pass one cache line back and
@@ -64,6 +66,8 @@ struct Options : stc_bench::SceneTiming {
 // Per-tick samples of one run, seconds.
 struct Run {
   std::vector<double> wall, cpu, integrate, broad, sweep, narrow, response, other;
+  std::vector<double> team_loop, team_wait;  // World::timeTeamLoops (the N-thread run)
+  double team_loops = 0.0;                   // summed over the ticks
   double contacts = 0.0, manifolds = 0.0, crossing = 0.0, slabs = 0.0;  // sums over the ticks
 };
 
@@ -87,6 +91,9 @@ void timedTicks(World& world, double dt, int ticks, Run& run) {
     run.narrow.push_back(r.narrow_s);
     run.response.push_back(r.response_s);
     run.other.push_back(r.total_s - r.integrate_s - r.broad_s - r.sweep_s - r.narrow_s - r.response_s);
+    run.team_loop.push_back(r.team_loop_s);
+    run.team_wait.push_back(r.team_wait_s);
+    run.team_loops += static_cast<double>(r.team_loops);
     run.contacts += static_cast<double>(r.contacts);
     run.slabs += world.physicsReport().solve.slabs;
     run.crossing += static_cast<double>(world.physicsReport().solve.crossing_manifolds);
@@ -135,6 +142,7 @@ double runCase(const Case& c, const Options& opt) {
   SceneWorld scene_many = makeWorld(c, opt.threads);
   World& one = scene_one.world;
   World& many = scene_many.world;
+  many.timeTeamLoops(true);  // the serial part measured, not only fitted
   const SceneSpec& spec = scene_one.spec;
   const int settle = static_cast<int>(std::lround(opt.settle / spec.dt));
   for (int t = 0; t < settle; ++t) {
@@ -191,6 +199,18 @@ double runCase(const Case& c, const Options& opt) {
   const double s = serialFraction(meanOf(r1.wall), meanOf(rn.wall), opt.threads);
   std::printf("\nserial fraction (Amdahl fit, 1 vs %d threads): %.3f; model: 8 cores %.2fx, 16 cores %.2fx\n",
               opt.threads, s, amdahl(std::max(s, 0.0), 8), amdahl(std::max(s, 0.0), 16));
+  // Measured: what the calling thread ran alone (the tick outside the team's
+  // loops) is the serial part; the loops hold the rest, and their own
+  // speed-up is what the 1-thread run spent outside that serial part over
+  // their wall time (the serial part taken to cost the same on one thread).
+  const double alone = meanOf(rn.wall) - meanOf(rn.team_loop);
+  const double s_measured = ratio(alone, meanOf(r1.wall));
+  std::printf("serial part, measured (%d threads): %.3f ms a tick ran on the calling thread alone, %.3f ms in %.0f team "
+              "loops a tick, of which it waited %.3f ms for the others; serial fraction %.3f (of the 1-thread tick), "
+              "the loops' speed-up %.2f; model: 8 cores %.2fx, 16 cores %.2fx\n",
+              opt.threads, ms(alone), ms(meanOf(rn.team_loop)), rn.team_loops / ticks, ms(meanOf(rn.team_wait)),
+              s_measured, ratio(meanOf(r1.wall) - alone, meanOf(rn.team_loop)), amdahl(std::max(s_measured, 0.0), 8),
+              amdahl(std::max(s_measured, 0.0), 16));
   std::printf("core-to-core round trip before each turn: p50 %.0f ns (%.0f-%.0f)\n",
               1e9 * percentile(round_trips, 0.5), 1e9 * percentile(round_trips, 0.0), 1e9 * percentile(round_trips, 1.0));
   for (int far = 0; far < 2; ++far) {

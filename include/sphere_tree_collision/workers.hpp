@@ -38,6 +38,16 @@ class RangeFn {
   void (*call_)(void*, std::size_t, std::size_t);
 };
 
+// The calling thread's view of the team's parallel loops (Workers::timeLoops):
+// how many there were, the wall time inside them, and of that the time it
+// waited for the other members after its own blocks. The rest of a tick is
+// the calling thread alone: the serial part, measured rather than fitted.
+struct LoopTimes {
+  std::uint64_t loops = 0;
+  double loop_s = 0.0;
+  double wait_s = 0.0;
+};
+
 // The threads of one Workers::withTeam call: the calling thread (member 0)
 // and the arena's other threads, which stay awake between the stages it
 // posts, so a stage starts within microseconds instead of after a worker's
@@ -81,6 +91,11 @@ class Workers {
   Workers& operator=(Workers&&) noexcept;
 
   int threads() const { return threads_; }
+  // While on, each team loop reads the steady clock three times (about 20 ns
+  // a read here) and adds to loopTimes(); off by default. With one thread
+  // there are no team loops: loopTimes() stays zero.
+  void timeLoops(bool on);
+  LoopTimes loopTimes() const;  // summed since construction
   // fn over [0, n) in pieces of at least `grain` indices, on the arena's
   // threads (the caller among them); returns when all are done.
   void forEach(std::size_t n, std::size_t grain, RangeFn fn) const;

@@ -87,6 +87,11 @@ struct TickReport {
   double integrate_s = 0.0, broad_s = 0.0, narrow_s = 0.0, response_s = 0.0, total_s = 0.0;
   double sweep_s = 0.0;  // continuous collision of fast bodies, between broad and narrow phase
   double contacts_s = 0.0;  // of response_s: building the contacts (the rest is the solve)
+  // With threads > 1 and World::timeTeamLoops on (else 0): the team's parallel
+  // loops this tick, the calling thread's wall time inside them and, of that,
+  // its wait for the other threads. total_s - team_loop_s ran on one thread.
+  std::uint64_t team_loops = 0;
+  double team_loop_s = 0.0, team_wait_s = 0.0;
   // What each phase got of the budget. Integrate and the broad phase cannot be
   // interrupted: they get what they use. The narrow phase gets Budget::seconds
   // or what the tick budget leaves after them and the reserve, whichever is
@@ -234,6 +239,9 @@ class World {
   std::size_t narrowChunks() const { return narrow_chunks_used_; }
   // Threads the tick runs on (WorldConfig::threads resolved: 0 -> the cores).
   int threads() const { return workers_.threads(); }
+  // Times the team's loops into TickReport::team_* (Workers::timeLoops: three
+  // clock reads a loop, about 200 loops a tick of 500 bodies); off by default.
+  void timeTeamLoops(bool on) { workers_.timeLoops(on); }
   const std::vector<Contact>& contacts() const { return contacts_; }
   // The broad phase: its pairs and boxes as of the last step (checks and tests).
   const SweepAndPrune& broadPhase() const { return broad_phase_; }

@@ -80,6 +80,8 @@ struct Team::State {
   std::atomic<bool> open{false};      // a withTeam call is running
   std::atomic<bool> shutdown{false};  // the Workers are going
   std::array<std::atomic<bool>, kMaxThreads> present{};  // a task serves as member m
+  bool timed = false;  // read and written by the calling thread only, as `times`
+  LoopTimes times;
 };
 
 namespace {
@@ -188,7 +190,9 @@ void Team::forBlocks(std::size_t count, RangeFn fn, Claim claim) {
     for (std::size_t k = 0; k < count; ++k) fn(k, k + 1);
     return;
   }
+  const auto now = [] { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); };
   for (std::size_t base = 0; base < count; base += kMaxBlocks) {
+    const double start = state_->timed ? now() : 0.0;
     const std::size_t round = std::min(kMaxBlocks, count - base);
     const auto shifted = [&](std::size_t k, std::size_t) { fn(base + k, base + k + 1); };
     const RangeFn round_fn(shifted);
@@ -201,8 +205,15 @@ void Team::forBlocks(std::size_t count, RangeFn fn, Claim claim) {
     state_->done.store(0, std::memory_order_relaxed);
     state_->sequence.store(odd + 1, std::memory_order_release);
     take(0, odd + 1, &round_fn, round, claim);
+    const double own_done = state_->timed ? now() : 0.0;
     Spin spin;
     while (state_->done.load(std::memory_order_acquire) < round) spin.wait();
+    if (state_->timed) {
+      const double end = now();
+      ++state_->times.loops;
+      state_->times.loop_s += end - start;
+      state_->times.wait_s += end - own_done;
+    }
   }
 }
 
@@ -245,6 +256,12 @@ Workers::Arena::~Arena() {
   state.shutdown.store(true, std::memory_order_release);
   arena.execute([&] { members.wait(); });
 }
+
+void Workers::timeLoops(bool on) {
+  if (arena_) arena_->state.timed = on;
+}
+
+LoopTimes Workers::loopTimes() const { return arena_ ? arena_->state.times : LoopTimes{}; }
 
 void Workers::runTeam(void (*call)(void*, Team&), void* body) const {
   if (!arena_) {

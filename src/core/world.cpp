@@ -315,6 +315,7 @@ TickReport World::step(double dt, const Budget& budget) {
   double t0i = 0.0, t1 = 0.0, t2 = 0.0, t2s = 0.0, t3 = 0.0, t4 = 0.0, t5 = 0.0, scheduled = 0.0;
   // One team for the phases: the workers stay awake from loop to loop
   // (waking one costs more than many a loop here: docs/architecture.md).
+  const LoopTimes loops_before = workers_.loopTimes();
   workers_.withTeam([&](Team&) {
     t0i = breakPending(t0, tick_end, report);  // splits the last tick had no time for
     integrate(dt, report);
@@ -330,6 +331,10 @@ TickReport World::step(double dt, const Budget& budget) {
     t4 = clock_();
     t5 = fracture(t4, tick_end, report);
   });
+  const LoopTimes loops_after = workers_.loopTimes();
+  report.team_loops = loops_after.loops - loops_before.loops;
+  report.team_loop_s = loops_after.loop_s - loops_before.loop_s;
+  report.team_wait_s = loops_after.wait_s - loops_before.wait_s;
   report.integrate_s = t1 - t0i;
   report.broad_s = t2 - t1;
   report.sweep_s = t2s - t2;

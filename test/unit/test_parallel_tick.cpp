@@ -90,6 +90,38 @@ TEST(ParallelTick, UnlimitedBudgetGivesTheSameBitsWhateverTheThreadCount) {
   }
 }
 
+// World::timeTeamLoops only reads clocks: the same bits as a world that does
+// not time. Its figures are consistent with each other and with the tick
+// (no threshold on any duration): loops ran, the calling thread's wait lies
+// within its time in the loops, and that within the tick as timed around
+// step(); off, or with one thread, they stay zero.
+TEST(ParallelTick, TimedTeamLoopsAddUpWithinTheTickAndChangeNoBits) {
+  World plain = sceneWorld(SceneKind::CornerDrift, 2);
+  World timed = sceneWorld(SceneKind::CornerDrift, 2);
+  World alone = sceneWorld(SceneKind::CornerDrift, 1);
+  timed.timeTeamLoops(true);
+  alone.timeTeamLoops(true);
+  std::uint64_t loops = 0;
+  for (int t = 0; t < 120; ++t) {
+    const TickReport off = plain.step(1.0 / 60.0, Budget::unlimited());
+    const auto start = std::chrono::steady_clock::now();
+    const TickReport on = timed.step(1.0 / 60.0, Budget::unlimited());
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const TickReport one = alone.step(1.0 / 60.0, Budget::unlimited());
+    ASSERT_TRUE(sameState(plain, timed)) << "tick " << t;
+    EXPECT_EQ(off.team_loops, 0u);
+    EXPECT_EQ(off.team_loop_s, 0.0);
+    EXPECT_EQ(one.team_loops, 0u);
+    EXPECT_EQ(one.team_loop_s, 0.0);
+    EXPECT_GE(on.team_wait_s, 0.0) << "tick " << t;
+    EXPECT_LE(on.team_wait_s, on.team_loop_s) << "tick " << t;
+    EXPECT_LE(on.team_loop_s, wall) << "tick " << t;
+    EXPECT_EQ(on.team_loops == 0, on.team_loop_s == 0.0) << "tick " << t;
+    loops += on.team_loops;
+  }
+  EXPECT_GT(loops, 120u);  // more than one a tick (the narrow phase alone runs chunks on the team)
+}
+
 TEST(ParallelTick, SphereTestBudgetGivesTheSameBitsRunAfterRun) {
   for (const SceneKind kind : kScenes) {
     for (const int threads : {2, 4}) {
