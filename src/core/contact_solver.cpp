@@ -329,6 +329,11 @@ void ContactSolver::orderFromTheGround() {
     adjacency_[static_cast<std::size_t>(fill_[a]++)] = b;
     adjacency_[static_cast<std::size_t>(fill_[b]++)] = a;
   }
+  // Each body enters the queue once at most, and a level is at most the body
+  // count: sized by the bodies, so the first immovable body in contact (a
+  // sleeper held as static) allocates nothing.
+  growCapacity(queue_, body_count);
+  growCapacity(level_start_, body_count + 3);
   queue_.clear();
   for (const std::uint32_t ci : active_) {
     for (const std::uint32_t i : contact_bodies_[ci]) {

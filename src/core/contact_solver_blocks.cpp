@@ -21,6 +21,11 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
     growCapacity(*v, order_.size() + 1);
   }
   growCapacity(groups_, order_.size());
+  // Shock propagation's runs: at most one a manifold, and at most kStages
+  // stage starts a level from the ground (a level is at most the body count),
+  // sized here and not in the tick whose contacts first reach the ground.
+  growCapacity(level_runs_, order_.size());
+  growCapacity(level_stage_start_, ContactPartition::kStages * (bodies.size() + 1) + 1);
   growCapacity(manifolds_, order_.size());
   growCapacity(levels_, order_.size());
   for (std::size_t p = 0; p < order_.size(); ++p) {
