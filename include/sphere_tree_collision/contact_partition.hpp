@@ -46,6 +46,10 @@ class ContactPartition {
 
   // Blocks the groups of `bodies` (dense indices); no allocation once warm.
   void assign(const std::vector<SolverGroup>& groups, const std::vector<BodyState>& bodies);
+  // Capacity for up to `groups` groups of `bodies` bodies, grown geometrically:
+  // the solver sizes it by its rows, in the tick they grow, so a later tick with
+  // more groups (or the first with enough to cut) allocates nothing.
+  void reserve(std::size_t groups, std::size_t bodies);
   std::uint32_t slabs() const { return slabs_; }
   // Block of each group: stage * slabs() + slab (stage 3: 3 * slabs()).
   const std::vector<std::uint32_t>& blocks() const { return block_; }

@@ -8,6 +8,13 @@
 
 namespace stc {
 
+void ContactPartition::reserve(std::size_t groups, std::size_t bodies) {
+  growCapacity(block_, groups);
+  growCapacity(bin_, bodies);
+  growCapacity(bin_weight_, kBins);
+  growCapacity(slab_of_bin_, kBins);
+}
+
 void ContactPartition::assign(const std::vector<SolverGroup>& groups, const std::vector<BodyState>& bodies) {
   growCapacity(block_, groups.size());  // assign alone would reallocate to the exact count
   block_.assign(groups.size(), 0);

@@ -272,6 +272,9 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
 // rock's, where it touches). Box2D v3 takes the larger coefficient too.
 void ContactSolver::prepareRolling(const std::vector<BodyState>& bodies, bool jacobi) {
   const std::size_t manifolds = manifold_start_.size() - 1;
+  // Sized by the rows (a manifold has at least one), as they grow: a later
+  // tick with more manifolds and no more rows allocates nothing.
+  growCapacity(rolling_, rows_.size());
   if (rolling_.size() < manifolds) rolling_.resize(manifolds);
   std::atomic<bool> any{false};
   const auto prepareManifold = [&](std::size_t m) {

@@ -21,6 +21,7 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
     growCapacity(*v, order_.size() + 1);
   }
   growCapacity(groups_, order_.size());
+  partition_.reserve(order_.size(), bodies.size());
   // Shock propagation's runs: at most one a manifold, and at most kStages
   // stage starts a level from the ground (a level is at most the body count),
   // sized here and not in the tick whose contacts first reach the ground.
