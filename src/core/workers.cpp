@@ -1,6 +1,7 @@
 // Workers on a oneTBB task arena (workers.hpp).
 #include "sphere_tree_collision/workers.hpp"
 
+#include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/types.hpp"
 
 #include <tbb/blocked_range.h>
@@ -190,9 +191,8 @@ void Team::forBlocks(std::size_t count, RangeFn fn, Claim claim) {
     for (std::size_t k = 0; k < count; ++k) fn(k, k + 1);
     return;
   }
-  const auto now = [] { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); };
   for (std::size_t base = 0; base < count; base += kMaxBlocks) {
-    const double start = state_->timed ? now() : 0.0;
+    const double start = state_->timed ? steadySeconds() : 0.0;
     const std::size_t round = std::min(kMaxBlocks, count - base);
     const auto shifted = [&](std::size_t k, std::size_t) { fn(base + k, base + k + 1); };
     const RangeFn round_fn(shifted);
@@ -205,11 +205,11 @@ void Team::forBlocks(std::size_t count, RangeFn fn, Claim claim) {
     state_->done.store(0, std::memory_order_relaxed);
     state_->sequence.store(odd + 1, std::memory_order_release);
     take(0, odd + 1, &round_fn, round, claim);
-    const double own_done = state_->timed ? now() : 0.0;
+    const double own_done = state_->timed ? steadySeconds() : 0.0;
     Spin spin;
     while (state_->done.load(std::memory_order_acquire) < round) spin.wait();
     if (state_->timed) {
-      const double end = now();
+      const double end = steadySeconds();
       ++state_->times.loops;
       state_->times.loop_s += end - start;
       state_->times.wait_s += end - own_done;
