@@ -242,6 +242,17 @@ class ContactSolver {
     return level_stage_start_.empty() ? 0 : (level_stage_start_.size() - 1) / ContactPartition::kStages;
   }
   void forEachStageOfLevel(std::size_t level, RangeFn manifolds);
+  // A team's plan of one pass (unit 0) or one level (unit 1 + level): each
+  // member's slabs (a contiguous range) take in one block, in stage order,
+  // the blocks of stages 0-2 that touch no other member's slabs; the rest
+  // (the cuts between members' slabs, the blocks after them on the same
+  // slabs, stage 3) runs stage by stage after. So a pass waits for the team
+  // once or twice, not three times. No two members' blocks share a movable
+  // body, and each body meets its groups in the order of the four stages:
+  // the result is that of forEachStage's stages, bit for bit.
+  void planStages();
+  void runPlan(std::size_t unit, RangeFn manifolds) const;
+  bool planned() const { return team_ != nullptr && plan_members_ >= 2 && plan_members_ == team_->members(); }
   // The blocks runs[0, count) of one stage: on the team when there are two
   // or more and they hold `least` (task_manifolds_ when 0) or more, else in turn here.
   void runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds, std::size_t least = 0) const;
@@ -362,6 +373,12 @@ class ContactSolver {
   // per block, and each (level, stage)'s first run.
   std::vector<ManifoldRun> pass_runs_, level_runs_;
   std::vector<std::uint32_t> pass_stage_start_, level_stage_start_, cursor_;
+  std::vector<std::uint32_t> pass_run_block_, level_run_block_;  // each run's block
+  // planStages: a unit's offsets into plan_runs_ (plan_members_ + 4 a unit):
+  // the members' fused blocks, then the 3 stages left.
+  std::vector<ManifoldRun> plan_runs_;
+  std::vector<std::uint32_t> plan_start_;
+  int plan_members_ = 0;
   std::vector<int> levels_;
 };
 

@@ -26,6 +26,8 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
   // stage starts a level from the ground (a level is at most the body count),
   // sized here and not in the tick whose contacts first reach the ground.
   growCapacity(level_runs_, order_.size());
+  growCapacity(level_run_block_, order_.size());
+  growCapacity(pass_run_block_, ContactPartition::kStages * ContactPartition::kMaxSlabs);
   growCapacity(level_stage_start_, ContactPartition::kStages * (bodies.size() + 1) + 1);
   growCapacity(manifolds_, order_.size());
   growCapacity(levels_, order_.size());
@@ -67,11 +69,13 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
   // A pass's runs: the non-empty blocks, stage by stage.
   const std::uint32_t slabs = partition_.slabs();
   pass_runs_.clear();
+  pass_run_block_.clear();
   pass_stage_start_.clear();
   for (std::uint32_t b = 0; b < block_count; ++b) {
     if (b % slabs == 0) pass_stage_start_.push_back(static_cast<std::uint32_t>(pass_runs_.size()));
     if (block_manifold_start_[b + 1] > block_manifold_start_[b]) {
       pass_runs_.push_back(ManifoldRun{block_manifold_start_[b], block_manifold_start_[b + 1]});
+      pass_run_block_.push_back(b);
     }
   }
   pass_stage_start_.push_back(static_cast<std::uint32_t>(pass_runs_.size()));
@@ -82,6 +86,7 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
   // movable body.
   constexpr int kUnreached = std::numeric_limits<int>::max();
   level_runs_.clear();
+  level_run_block_.clear();
   level_stage_start_.clear();
   cursor_.assign(block_manifold_start_.begin(), block_manifold_start_.end() - 1);
   for (const int level : levels_) {
@@ -90,11 +95,82 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
       if (b % slabs == 0) level_stage_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
       std::uint32_t end = cursor_[b];
       while (end < block_manifold_start_[b + 1] && contact_level_[order_[manifold_start_[end]]] == level) ++end;
-      if (end > cursor_[b]) level_runs_.push_back(ManifoldRun{cursor_[b], end});
+      if (end > cursor_[b]) {
+        level_runs_.push_back(ManifoldRun{cursor_[b], end});
+        level_run_block_.push_back(b);
+      }
       cursor_[b] = end;
     }
   }
   if (!level_stage_start_.empty()) level_stage_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
+  planStages();
+}
+
+void ContactSolver::planStages() {
+  const std::uint32_t slabs = partition_.slabs();
+  const int members = workers_ != nullptr ? workers_->threads() : 1;
+  plan_members_ = (members >= 2 && slabs >= 2) ? members : 0;
+  plan_runs_.clear();
+  plan_start_.clear();
+  if (plan_members_ == 0) return;
+  const std::size_t m_count = static_cast<std::size_t>(members);
+  const auto owner = [&](std::uint32_t slab) { return static_cast<std::size_t>(slab) * m_count / slabs; };
+  // -1: the block runs after the members' blocks, in its stage.
+  const auto fusedMember = [&](std::uint32_t block) -> long {
+    const std::uint32_t stage = block / slabs, s = block % slabs;
+    if (stage == 0) return static_cast<long>(owner(s));
+    if (stage == 1) return owner(s) == owner(s + 1) ? static_cast<long>(owner(s)) : -1;
+    if (stage == 2) {  // after stage 1's cuts on its slabs, which must be fused too
+      const std::size_t o = owner(s);
+      const bool alone = owner(s - 1) == o && owner(s + 1) == o && owner(std::min(s + 2, slabs - 1)) == o;
+      return alone ? static_cast<long>(o) : -1;
+    }
+    return -1;
+  };
+  const auto plan = [&](const ManifoldRun* runs, const std::uint32_t* blocks, std::size_t count) {
+    const std::size_t unit = plan_start_.size();
+    plan_start_.resize(unit + m_count + 4);
+    for (std::size_t m = 0; m < m_count; ++m) {
+      plan_start_[unit + m] = static_cast<std::uint32_t>(plan_runs_.size());
+      for (std::size_t k = 0; k < count; ++k) {  // in stage order
+        if (fusedMember(blocks[k]) == static_cast<long>(m)) plan_runs_.push_back(runs[k]);
+      }
+    }
+    for (std::uint32_t stage = 1; stage < ContactPartition::kStages; ++stage) {
+      plan_start_[unit + m_count + stage - 1] = static_cast<std::uint32_t>(plan_runs_.size());
+      for (std::size_t k = 0; k < count; ++k) {
+        if (blocks[k] / slabs == stage && fusedMember(blocks[k]) < 0) plan_runs_.push_back(runs[k]);
+      }
+    }
+    plan_start_[unit + m_count + 3] = static_cast<std::uint32_t>(plan_runs_.size());
+  };
+  // Sized as the runs and the level starts are (blockManifolds).
+  growCapacity(plan_runs_, ContactPartition::kStages * ContactPartition::kMaxSlabs + order_.size());
+  growCapacity(plan_start_, (m_count + 4) * (motion_.size() + 2));
+  plan(pass_runs_.data(), pass_run_block_.data(), pass_runs_.size());
+  for (std::size_t level = 0; level < shockLevels(); ++level) {
+    const std::uint32_t first = level_stage_start_[level * ContactPartition::kStages];
+    const std::uint32_t end = level_stage_start_[(level + 1) * ContactPartition::kStages];
+    plan(level_runs_.data() + first, level_run_block_.data() + first, end - first);
+  }
+}
+
+void ContactSolver::runPlan(std::size_t unit, RangeFn manifolds) const {
+  const std::size_t m_count = static_cast<std::size_t>(plan_members_);
+  const std::uint32_t* start = plan_start_.data() + unit * (m_count + 4);
+  std::size_t total = 0;
+  for (std::uint32_t k = start[0]; k < start[m_count]; ++k) total += plan_runs_[k].end - plan_runs_[k].first;
+  const auto member = [&](std::size_t m, std::size_t) {
+    for (std::uint32_t k = start[m]; k < start[m + 1]; ++k) manifolds(plan_runs_[k].first, plan_runs_[k].end);
+  };
+  if (total >= task_manifolds_) {
+    team_->forBlocks(m_count, member);
+  } else {
+    for (std::size_t m = 0; m < m_count; ++m) member(m, m + 1);
+  }
+  for (std::size_t stage = 0; stage + 1 < ContactPartition::kStages; ++stage) {
+    runStage(plan_runs_.data() + start[m_count + stage], start[m_count + stage + 1] - start[m_count + stage], manifolds);
+  }
 }
 
 void ContactSolver::runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds, std::size_t least) const {
@@ -108,12 +184,20 @@ void ContactSolver::runStage(const ManifoldRun* runs, std::size_t count, RangeFn
 }
 
 void ContactSolver::forEachStage(RangeFn manifolds) {
+  if (planned()) {
+    runPlan(0, manifolds);
+    return;
+  }
   for (std::size_t s = 0; s + 1 < pass_stage_start_.size(); ++s) {
     runStage(pass_runs_.data() + pass_stage_start_[s], pass_stage_start_[s + 1] - pass_stage_start_[s], manifolds);
   }
 }
 
 void ContactSolver::forEachStageOfLevel(std::size_t level, RangeFn manifolds) {
+  if (planned()) {
+    runPlan(1 + level, manifolds);
+    return;
+  }
   const std::size_t first = level * ContactPartition::kStages;
   for (std::size_t s = first; s < first + ContactPartition::kStages; ++s) {
     runStage(level_runs_.data() + level_stage_start_[s], level_stage_start_[s + 1] - level_stage_start_[s], manifolds);
