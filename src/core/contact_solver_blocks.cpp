@@ -4,6 +4,7 @@
 
 #include "grow_capacity.hpp"
 
+#include <cassert>
 #include <limits>
 
 namespace stc {
@@ -129,6 +130,7 @@ void ContactSolver::planStages() {
   };
   const auto plan = [&](const ManifoldRun* runs, const std::uint32_t* blocks, std::size_t count) {
     const std::size_t unit = plan_start_.size();
+    [[maybe_unused]] const std::size_t first_run = plan_runs_.size();
     plan_start_.resize(unit + m_count + 4);
     for (std::size_t m = 0; m < m_count; ++m) {
       plan_start_[unit + m] = static_cast<std::uint32_t>(plan_runs_.size());
@@ -143,6 +145,22 @@ void ContactSolver::planStages() {
       }
     }
     plan_start_[unit + m_count + 3] = static_cast<std::uint32_t>(plan_runs_.size());
+#ifndef NDEBUG
+    // Every run placed once, and no movable body in two members' blocks.
+    assert(plan_runs_.size() - first_run == count);
+    std::vector<long> member_of(motion_.size(), -1);
+    for (std::size_t m = 0; m < m_count; ++m) {
+      for (std::uint32_t k = plan_start_[unit + m]; k < plan_start_[unit + m + 1]; ++k) {
+        for (std::uint32_t g = plan_runs_[k].first; g < plan_runs_[k].end; ++g) {
+          for (const std::uint32_t body : {manifolds_[g].a, manifolds_[g].b}) {
+            if (body == SolverGroup::kStatic) continue;
+            assert(member_of[body] < 0 || member_of[body] == static_cast<long>(m));
+            member_of[body] = static_cast<long>(m);
+          }
+        }
+      }
+    }
+#endif
   };
   // Sized as the runs and the level starts are (blockManifolds).
   growCapacity(plan_runs_, ContactPartition::kStages * ContactPartition::kMaxSlabs + order_.size());
