@@ -148,7 +148,8 @@ void ContactSolver::planStages() {
 #ifndef NDEBUG
     // Every run placed once, and no movable body in two members' blocks.
     assert(plan_runs_.size() - first_run == count);
-    std::vector<long> member_of(motion_.size(), -1);
+    static thread_local std::vector<long> member_of;  // debug scratch, kept: no allocation once grown
+    member_of.assign(motion_.size(), -1);
     for (std::size_t m = 0; m < m_count; ++m) {
       for (std::uint32_t k = plan_start_[unit + m]; k < plan_start_[unit + m + 1]; ++k) {
         for (std::uint32_t g = plan_runs_[k].first; g < plan_runs_[k].end; ++g) {
