@@ -131,20 +131,27 @@ void ContactSolver::planStages() {
   const auto plan = [&](const ManifoldRun* runs, const std::uint32_t* blocks, std::size_t count) {
     const std::size_t unit = plan_start_.size();
     [[maybe_unused]] const std::size_t first_run = plan_runs_.size();
-    plan_start_.resize(unit + m_count + 4);
+    plan_start_.resize(unit + m_count + 5);
+    plan_fused_.clear();
+    std::uint32_t fused_manifolds = 0;
+    for (std::size_t k = 0; k < count; ++k) {
+      plan_fused_.push_back(fusedMember(blocks[k]));
+      if (plan_fused_[k] >= 0) fused_manifolds += runs[k].end - runs[k].first;
+    }
     for (std::size_t m = 0; m < m_count; ++m) {
       plan_start_[unit + m] = static_cast<std::uint32_t>(plan_runs_.size());
       for (std::size_t k = 0; k < count; ++k) {  // in stage order
-        if (fusedMember(blocks[k]) == static_cast<long>(m)) plan_runs_.push_back(runs[k]);
+        if (plan_fused_[k] == static_cast<long>(m)) plan_runs_.push_back(runs[k]);
       }
     }
     for (std::uint32_t stage = 1; stage < ContactPartition::kStages; ++stage) {
       plan_start_[unit + m_count + stage - 1] = static_cast<std::uint32_t>(plan_runs_.size());
       for (std::size_t k = 0; k < count; ++k) {
-        if (blocks[k] / slabs == stage && fusedMember(blocks[k]) < 0) plan_runs_.push_back(runs[k]);
+        if (blocks[k] / slabs == stage && plan_fused_[k] < 0) plan_runs_.push_back(runs[k]);
       }
     }
     plan_start_[unit + m_count + 3] = static_cast<std::uint32_t>(plan_runs_.size());
+    plan_start_[unit + m_count + 4] = fused_manifolds;
 #ifndef NDEBUG
     // Every run placed once, and no movable body in two members' blocks.
     assert(plan_runs_.size() - first_run == count);
@@ -165,7 +172,8 @@ void ContactSolver::planStages() {
   };
   // Sized as the runs and the level starts are (blockManifolds).
   growCapacity(plan_runs_, ContactPartition::kStages * ContactPartition::kMaxSlabs + order_.size());
-  growCapacity(plan_start_, (m_count + 4) * (motion_.size() + 2));
+  growCapacity(plan_fused_, ContactPartition::kStages * ContactPartition::kMaxSlabs + order_.size());
+  growCapacity(plan_start_, (m_count + 5) * (motion_.size() + 2));
   plan(pass_runs_.data(), pass_run_block_.data(), pass_runs_.size());
   for (std::size_t level = 0; level < shockLevels(); ++level) {
     const std::uint32_t first = level_stage_start_[level * ContactPartition::kStages];
@@ -176,9 +184,8 @@ void ContactSolver::planStages() {
 
 void ContactSolver::runPlan(std::size_t unit, RangeFn manifolds) const {
   const std::size_t m_count = static_cast<std::size_t>(plan_members_);
-  const std::uint32_t* start = plan_start_.data() + unit * (m_count + 4);
-  std::size_t total = 0;
-  for (std::uint32_t k = start[0]; k < start[m_count]; ++k) total += plan_runs_[k].end - plan_runs_[k].first;
+  const std::uint32_t* start = plan_start_.data() + unit * (m_count + 5);
+  const std::size_t total = start[m_count + 4];  // the members' manifolds
   const auto member = [&](std::size_t m, std::size_t) {
     for (std::uint32_t k = start[m]; k < start[m + 1]; ++k) manifolds(plan_runs_[k].first, plan_runs_[k].end);
   };
