@@ -8,6 +8,8 @@
 # leak, timeout, out-of-memory) is saved as build_fuzz/findings/<target>-*.
 # Exit status 0: no finding; 1: at least one. Last line, for the test count:
 #   fuzz: 4 targets, 1234567 executions, 0 findings
+# With --build-only it builds the targets and stops (scripts/test.sh builds them
+# while the other tests run; the run after it finds them up to date).
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 build="${STC_FUZZ_BUILD:-$STC_ROOT/build_fuzz}"
@@ -20,6 +22,7 @@ CC=clang CXX=clang++ cmake -S "$STC_ROOT" -B "$build" -DPYTHON_EXECUTABLE=/usr/b
 targets=()
 for src in "$STC_ROOT"/fuzz/fuzz_*.cpp; do targets+=("$(basename "$src" .cpp)"); done
 cmake --build "$build" --target "${targets[@]}" -- -j"$jobs" >/dev/null
+[ "${1:-}" = "--build-only" ] && exit 0
 
 export ASAN_OPTIONS="detect_leaks=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
