@@ -374,11 +374,12 @@ class ContactSolver {
   std::vector<ManifoldRun> pass_runs_, level_runs_;
   std::vector<std::uint32_t> pass_stage_start_, level_stage_start_, cursor_;
   std::vector<std::uint32_t> pass_run_block_, level_run_block_;  // each run's block
-  // planStages: a unit's offsets into plan_runs_ (plan_members_ + 5 a unit):
-  // the members' fused blocks, then the 3 stages left, the end, and last the
+  // planStages: a unit's offsets into plan_runs_ (planStride() a unit): the
+  // members' fused blocks, then the 3 stages left, and the end; per unit, the
   // fused blocks' manifold count. plan_fused_: each run's member (-1: left).
+  std::size_t planStride() const { return static_cast<std::size_t>(plan_members_) + ContactPartition::kStages; }
   std::vector<ManifoldRun> plan_runs_;
-  std::vector<std::uint32_t> plan_start_;
+  std::vector<std::uint32_t> plan_start_, plan_fused_manifolds_;
   std::vector<long> plan_fused_;
   int plan_members_ = 0;
   std::vector<int> levels_;

@@ -113,6 +113,7 @@ void ContactSolver::planStages() {
   plan_members_ = (members >= 2 && slabs >= 2) ? members : 0;
   plan_runs_.clear();
   plan_start_.clear();
+  plan_fused_manifolds_.clear();
   if (plan_members_ == 0) return;
   const std::size_t m_count = static_cast<std::size_t>(members);
   const auto owner = [&](std::uint32_t slab) { return static_cast<std::size_t>(slab) * m_count / slabs; };
@@ -131,7 +132,7 @@ void ContactSolver::planStages() {
   const auto plan = [&](const ManifoldRun* runs, const std::uint32_t* blocks, std::size_t count) {
     const std::size_t unit = plan_start_.size();
     [[maybe_unused]] const std::size_t first_run = plan_runs_.size();
-    plan_start_.resize(unit + m_count + 5);
+    plan_start_.resize(unit + planStride());
     plan_fused_.clear();
     std::uint32_t fused_manifolds = 0;
     for (std::size_t k = 0; k < count; ++k) {
@@ -150,8 +151,8 @@ void ContactSolver::planStages() {
         if (blocks[k] / slabs == stage && plan_fused_[k] < 0) plan_runs_.push_back(runs[k]);
       }
     }
-    plan_start_[unit + m_count + 3] = static_cast<std::uint32_t>(plan_runs_.size());
-    plan_start_[unit + m_count + 4] = fused_manifolds;
+    plan_start_[unit + planStride() - 1] = static_cast<std::uint32_t>(plan_runs_.size());  // the end
+    plan_fused_manifolds_.push_back(fused_manifolds);
 #ifndef NDEBUG
     // Every run placed once, and no movable body in two members' blocks.
     assert(plan_runs_.size() - first_run == count);
@@ -173,7 +174,8 @@ void ContactSolver::planStages() {
   // Sized as the runs and the level starts are (blockManifolds).
   growCapacity(plan_runs_, ContactPartition::kStages * ContactPartition::kMaxSlabs + order_.size());
   growCapacity(plan_fused_, ContactPartition::kStages * ContactPartition::kMaxSlabs + order_.size());
-  growCapacity(plan_start_, (m_count + 5) * (motion_.size() + 2));
+  growCapacity(plan_start_, planStride() * (motion_.size() + 2));
+  growCapacity(plan_fused_manifolds_, motion_.size() + 2);
   plan(pass_runs_.data(), pass_run_block_.data(), pass_runs_.size());
   for (std::size_t level = 0; level < shockLevels(); ++level) {
     const std::uint32_t first = level_stage_start_[level * ContactPartition::kStages];
@@ -184,8 +186,8 @@ void ContactSolver::planStages() {
 
 void ContactSolver::runPlan(std::size_t unit, RangeFn manifolds) const {
   const std::size_t m_count = static_cast<std::size_t>(plan_members_);
-  const std::uint32_t* start = plan_start_.data() + unit * (m_count + 5);
-  const std::size_t total = start[m_count + 4];  // the members' manifolds
+  const std::uint32_t* start = plan_start_.data() + unit * planStride();
+  const std::size_t total = plan_fused_manifolds_[unit];  // the members' manifolds
   const auto member = [&](std::size_t m, std::size_t) {
     for (std::uint32_t k = start[m]; k < start[m + 1]; ++k) manifolds(plan_runs_[k].first, plan_runs_[k].end);
   };
