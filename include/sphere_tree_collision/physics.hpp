@@ -110,7 +110,6 @@ class Physics {
   struct alignas(64) ChunkContacts {  // a line of its own: its end moves with each contact
     std::vector<Contact> contacts;
     PairContactCache::Pending reuse;  // the chunk's pairs' cache entries for the next tick
-    std::size_t first = 0;            // where its contacts start in the joined list
   };
   std::vector<ChunkContacts> chunk_contacts_;
   std::size_t builder_turn_ = 0;

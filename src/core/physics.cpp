@@ -134,6 +134,12 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
 void Physics::buildContacts(const StepContext& step) {
   const std::size_t count = step.pair_count;
   std::vector<Contact>& contacts = *step.contacts;
+  // Room for last tick's count and an eighth more, made while the vector is
+  // empty: a pile's contacts grow a little most ticks, and growing as they
+  // are appended copied the tick's contacts so far each time.
+  const std::size_t last_count = contacts.size();
+  contacts.clear();
+  growCapacity(contacts, last_count + last_count / 8);
   growCapacity(sweep_hit_of_pair_, count);  // assign alone would reallocate to the exact count
   sweep_hit_of_pair_.assign(count, -1);
   for (const std::uint32_t body : sweep_scratch_.clamped) {
@@ -149,12 +155,6 @@ void Physics::buildContacts(const StepContext& step) {
   if (builders_.size() < chunks) builders_.resize(chunks);
   if (chunk_contacts_.size() < chunks) chunk_contacts_.resize(chunks);
   if (chunks == 1) {
-    // Room for last tick's count and an eighth more, made while the vector is
-    // empty: a pile's contacts grow a little most ticks, and growing as they
-    // are appended copied the tick's contacts so far each time.
-    const std::size_t last_count = contacts.size();
-    contacts.clear();
-    growCapacity(contacts, last_count + last_count / 8);
     appendContacts(step, 0, count, builders_[0], contacts, chunk_contacts_[0].reuse);
   } else {
     // The builders take turns at the chunks, so each one's scratch grows to
@@ -166,22 +166,10 @@ void Physics::buildContacts(const StepContext& step) {
       const auto [first, last] = chunkRange(count, k, chunks);
       appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk, chunk_contacts_[k].reuse);
     }, Team::Claim::Balanced);
-    // Joined in pair order, each chunk copied by a member in parallel (mostly
-    // the one that built it, whose cache holds it): copied by the calling
-    // thread alone, the other core's contacts came over line by line, about
-    // 3 % of a 2-thread packed_box tick. Resized from last tick's list, so
-    // only the new end is constructed before the copy overwrites it.
-    std::size_t total = 0;
     for (std::size_t k = 0; k < chunks; ++k) {
-      chunk_contacts_[k].first = total;
-      total += chunk_contacts_[k].contacts.size();
+      const std::vector<Contact>& chunk = chunk_contacts_[k].contacts;
+      contacts.insert(contacts.end(), chunk.begin(), chunk.end());
     }
-    resizeRewritten(contacts, total);
-    step.workers->forChunks(chunks, [&](std::size_t k, std::size_t) {
-      const ChunkContacts& chunk = chunk_contacts_[k];
-      std::copy(chunk.contacts.begin(), chunk.contacts.end(),
-                contacts.begin() + static_cast<std::ptrdiff_t>(chunk.first));
-    });
   }
   // The next tick's cache: this tick's entries, in pair order.
   if (step.reused != nullptr) {
