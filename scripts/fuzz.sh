@@ -16,9 +16,15 @@ build="${STC_FUZZ_BUILD:-$STC_ROOT/build_fuzz}"
 seconds="${STC_FUZZ_SECONDS:-15}"
 jobs="${STC_JOBS:-$(nproc)}"
 flags="-fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=all -fno-omit-frame-pointer -g"
+# RelWithDebInfo without its -DNDEBUG: the core's debug assertions run under the
+# fuzzers (every other build of the project leaves them out), and one that fails
+# is a finding like a crash. Eigen's own checks of every coefficient access stay
+# out (EIGEN_NO_DEBUG): with them the fuzzers ran about 1.6 times fewer inputs.
+# With the project's assertions alone, about as many as with -DNDEBUG (49,000 against 47,000 in 60 s).
 CC=clang CXX=clang++ cmake -S "$STC_ROOT" -B "$build" -DPYTHON_EXECUTABLE=/usr/bin/python3 \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCATKIN_ENABLE_TESTING=OFF -DSTC_FUZZ=ON \
-  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g -DEIGEN_NO_DEBUG" \
+  -DCATKIN_ENABLE_TESTING=OFF \
+  -DSTC_FUZZ=ON -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
 targets=()
 for src in "$STC_ROOT"/fuzz/fuzz_*.cpp; do targets+=("$(basename "$src" .cpp)"); done
 cmake --build "$build" --target "${targets[@]}" -- -j"$jobs" >/dev/null
