@@ -30,12 +30,10 @@ for src in "$STC_ROOT"/fuzz/fuzz_*.cpp; do targets+=("$(basename "$src" .cpp)");
 cmake --build "$build" --target "${targets[@]}" -- -j"$jobs" >/dev/null
 [ "${1:-}" = "--build-only" ] && exit 0
 
-# The targets find their libraries by their run path, but a ROS environment
-# (test.sh sources devel/setup.bash) puts the main build's devel/lib on
-# LD_LIBRARY_PATH, which comes first: the fuzzers then ran the release core,
-# without the sanitizers, the coverage or the assertions (238 edges instead of
-# 2,355 on fuzz_gaze). This build's libraries go first.
-export LD_LIBRARY_PATH="$build/devel/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+# test.sh sources devel/setup.bash first: without this the fuzzers ran the
+# release core, no sanitizers, coverage or assertions (238 edges instead of
+# 2,355 on fuzz_gaze).
+preferBuildLibraries "$build"
 export ASAN_OPTIONS="detect_leaks=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 mkdir -p "$build/findings"

@@ -16,9 +16,7 @@ tests=()
 for src in "$STC_ROOT"/test/unit/*.cpp; do tests+=("$(basename "$src" .cpp)"); done
 cmake --build "$build" --target "${tests[@]}" -- -j"$jobs"
 
-# This build's libraries before any on LD_LIBRARY_PATH (a sourced ROS
-# environment puts the main build's release core there; see fuzz.sh).
-export LD_LIBRARY_PATH="$build/devel/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+preferBuildLibraries "$build"
 export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 failed=0
