@@ -11,13 +11,20 @@ set +u
 # shellcheck disable=SC1091
 source "$STC_BUILD/devel/setup.bash"
 set -u
-# The fuzzers' sanitizer build (about 4 minutes of compiling on 2 cores) goes on
-# while the tests run, most of which wait on ROS masters and nodes; no test
-# depends on timing. Its log is kept for the fuzz check below, which builds again
-# (up to date then, or failing the same way) and runs them.
+# The fuzzers' sanitizer build (about 4 minutes of compiling on 2 cores), then
+# the assertions' build (about 3), go on while the tests run, most of which wait
+# on ROS masters and nodes; no test depends on timing. Their logs are kept for
+# the checks below, which build again (up to date then, or failing the same
+# way) and run them.
 fuzz_build_log="$STC_BUILD/fuzz_build.log"
-bash "$STC_ROOT/scripts/fuzz.sh" --build-only >"$fuzz_build_log" 2>&1 &
-fuzz_build=$!
+asserts_build_log="$STC_BUILD/asserts_build.log"
+{
+  bash "$STC_ROOT/scripts/fuzz.sh" --build-only >"$fuzz_build_log" 2>&1 ||
+    { echo "fuzz build failed, log: $fuzz_build_log"; tail -n 20 "$fuzz_build_log"; }
+  bash "$STC_ROOT/scripts/asserts.sh" --build-only >"$asserts_build_log" 2>&1 ||
+    { echo "asserts build failed, log: $asserts_build_log"; tail -n 20 "$asserts_build_log"; }
+} &
+side_builds=$!
 # run_tests exits 0 even when a test fails: the result files decide.
 make -C "$STC_BUILD" run_tests -j1 2>&1 | tee "$STC_BUILD/run_tests.log" | grep -E "^\[ *(RUN|  OK|  FAILED|  PASSED) |^\[ROSTEST\]|FAILURE|Error|error:" || true
 # Checks that are scripts, recorded as test cases beside the gtests and rostests.
@@ -25,6 +32,8 @@ check() { /usr/bin/python3 "$STC_ROOT/scripts/run_check.py" "$STC_BUILD/test_res
 check catkin_lint -- /usr/bin/catkin_lint --strict --skip-path build "$STC_ROOT"
 check installed_demo -- bash "$STC_ROOT/scripts/check_install.sh"
 # libFuzzer under ASan + UBSan on the message-to-core path, about 60 s (docs/fuzzing.md).
-wait "$fuzz_build" || { echo "fuzz build failed, log: $fuzz_build_log"; tail -n 20 "$fuzz_build_log"; }
+wait "$side_builds" || true
 check fuzz -- bash "$STC_ROOT/scripts/fuzz.sh"
+# The core's debug assertions, at 2 and 4 threads among others (scripts/asserts.sh).
+check asserts -- bash "$STC_ROOT/scripts/asserts.sh"
 /usr/bin/python3 "$STC_ROOT/scripts/count_results.py" "$STC_BUILD/test_results"

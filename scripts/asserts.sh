@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The core's debug assertions, which every other build leaves out (-DNDEBUG):
+# the core and the gtests that reach them built at -O2 with assert() on in
+# build_asserts (or $STC_ASSERTS_BUILD), then run. test_parallel_tick takes
+# planStages' checks at 2 and 4 threads (no movable body in two members'
+# blocks), test_sleeping the held manifolds' order, test_static_cover its masks.
+# A failed assertion (abort) or a failed test fails it. With --build-only it
+# builds and stops (scripts/test.sh builds while the other tests run).
+# Last line: "asserts: N gtests, M failed".
+set -euo pipefail
+source "$(dirname "$0")/common.sh"
+build="${STC_ASSERTS_BUILD:-$STC_ROOT/build_asserts}"
+jobs="${STC_JOBS:-$(nproc)}"
+tests=(test_parallel_tick test_sleeping test_static_cover)
+# Release's flags without -DNDEBUG; Eigen's own index checks stay out, as in
+# the fuzzers' build. STC_ASSERTS_REQUIRED makes test_parallel_tick refuse to
+# compile if NDEBUG came back.
+cmake -S "$STC_ROOT" -B "$build" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DEIGEN_NO_DEBUG" -DCMAKE_CXX_FLAGS="-DSTC_ASSERTS_REQUIRED" >/dev/null
+cmake --build "$build" --target "${tests[@]}" -- -j"$jobs" >/dev/null
+[ "${1:-}" = "--build-only" ] && exit 0
+
+# The core that the tests load must call assert's failure handler somewhere.
+core="$build/devel/lib/libstc_core.so"
+if ! nm -D --undefined-only "$core" | grep -q __assert_fail; then
+  echo "asserts: $core has no assertions compiled in"
+  echo "asserts: ${#tests[@]} gtests, ${#tests[@]} failed"
+  exit 1
+fi
+preferBuildLibraries "$build"
+failed=0
+for t in "${tests[@]}"; do
+  start=$(date +%s)
+  # From the source root, as catkin_add_gtest's WORKING_DIRECTORY.
+  if (cd "$STC_ROOT" && "$build/devel/lib/sphere_tree_collision/$t" --gtest_brief=1 >"$build/$t.log" 2>&1); then
+    echo "asserts: $t ok ($(( $(date +%s) - start )) s)"
+  else
+    failed=$((failed + 1))
+    echo "asserts: $t FAILED ($(( $(date +%s) - start )) s), log: $build/$t.log"
+    tail -n 40 "$build/$t.log"
+  fi
+done
+echo "asserts: ${#tests[@]} gtests, $failed failed"
+[ "$failed" -eq 0 ]
