@@ -28,17 +28,4 @@ if ! nm -D --undefined-only "$core" | grep -q __assert_fail; then
   exit 1
 fi
 preferBuildLibraries "$build"
-failed=0
-for t in "${tests[@]}"; do
-  start=$(date +%s)
-  # From the source root, as catkin_add_gtest's WORKING_DIRECTORY.
-  if (cd "$STC_ROOT" && "$build/devel/lib/sphere_tree_collision/$t" --gtest_brief=1 >"$build/$t.log" 2>&1); then
-    echo "asserts: $t ok ($(( $(date +%s) - start )) s)"
-  else
-    failed=$((failed + 1))
-    echo "asserts: $t FAILED ($(( $(date +%s) - start )) s), log: $build/$t.log"
-    tail -n 40 "$build/$t.log"
-  fi
-done
-echo "asserts: ${#tests[@]} gtests, $failed failed"
-[ "$failed" -eq 0 ]
+runGtests "$build" asserts "${tests[@]}"

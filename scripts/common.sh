@@ -11,3 +11,23 @@ export ROS_PYTHON_VERSION=3
 preferBuildLibraries() {
   export LD_LIBRARY_PATH="$1/devel/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 }
+# runGtests BUILD LABEL TEST...: each gtest of BUILD's devel space, run from the
+# source root (as catkin_add_gtest's WORKING_DIRECTORY) with its output in
+# BUILD/TEST.log; a line "LABEL: TEST ok (N s)" or "... FAILED" with the log's
+# tail, then "LABEL: N gtests, M failed". Returns non-zero when any failed.
+runGtests() {
+  local build="$1" label="$2" failed=0 t start
+  shift 2
+  for t in "$@"; do
+    start=$(date +%s)
+    if (cd "$STC_ROOT" && "$build/devel/lib/sphere_tree_collision/$t" --gtest_brief=1 >"$build/$t.log" 2>&1); then
+      echo "$label: $t ok ($(($(date +%s) - start)) s)"
+    else
+      failed=$((failed + 1))
+      echo "$label: $t FAILED ($(($(date +%s) - start)) s), log: $build/$t.log"
+      tail -n 40 "$build/$t.log"
+    fi
+  done
+  echo "$label: $# gtests, $failed failed"
+  [ "$failed" -eq 0 ]
+}

@@ -19,18 +19,4 @@ cmake --build "$build" --target "${tests[@]}" -- -j"$jobs"
 preferBuildLibraries "$build"
 export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-failed=0
-for t in "${tests[@]}"; do
-  bin="$build/devel/lib/sphere_tree_collision/$t"
-  start=$(date +%s)
-  # Tests run from the source root, as catkin_add_gtest's WORKING_DIRECTORY does.
-  if (cd "$STC_ROOT" && "$bin" --gtest_brief=1 >"$build/$t.log" 2>&1); then
-    echo "sanitize: $t ok ($(( $(date +%s) - start )) s)"
-  else
-    failed=$((failed + 1))
-    echo "sanitize: $t FAILED ($(( $(date +%s) - start )) s), log: $build/$t.log"
-    tail -n 40 "$build/$t.log"
-  fi
-done
-echo "sanitize: ${#tests[@]} gtests, $failed failed"
-[ "$failed" -eq 0 ]
+runGtests "$build" sanitize "${tests[@]}"
