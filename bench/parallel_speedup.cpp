@@ -13,6 +13,14 @@
 // with the calling thread's wait inside them. The load average is printed with the
 // figures: on a busy machine the parallel run waits for cores.
 //
+// What the machine itself allows: in each turn, after the two runs, N worlds
+// of one thread each tick side by side on N threads (no team, nothing shared
+// but the machine), the first timed over the same ticks as the 1-thread run.
+// N times its time alone over its time side by side is the most any N-thread
+// tick could gain here: on this VM two such worlds slow each other by 5-25 %
+// (caches and memory; a loop in registers is not slowed), so the ceiling is
+// below N. The share of it that the N-thread tick reaches is printed with it.
+//
 // Before each turn of the two runs, two threads pass one cache line back and
 // forth: the round trip between two cores. On this VM it is 100-200 ns in
 // some minutes and 450-550 ns in others (the host seems to place the two
@@ -24,7 +32,8 @@
 //   --seconds: simulated time timed per scene (cube_box: --cube-seconds);
 //   --settle: simulated time run first, untimed, at one thread (so the
 //   scene is moving and colliding when timing starts).
-// Last lines: SPEEDUP scene=<name> threads=<N> x=<wall ratio>.
+// Last lines: SPEEDUP scene=<name> threads=<N> x=<wall ratio>, then
+// CEILING scene=<name> threads=<N> x=<N worlds side by side: throughput over one alone>.
 #include "bench_args.hpp"
 #include "scene_cases.hpp"
 #include "sphere_tree_collision/scenes.hpp"
@@ -137,22 +146,56 @@ double serialFraction(double t1, double tn, int n) {
 }
 double amdahl(double s, int n) { return 1.0 / (s + (1.0 - s) / n); }
 
-double runCase(const Case& c, const Options& opt) {
-  SceneWorld scene_one = makeWorld(c, 1);
-  SceneWorld scene_many = makeWorld(c, opt.threads);
-  World& one = scene_one.world;
-  World& many = scene_many.world;
+// `ticks` ticks of worlds[0] timed on the calling thread while each other
+// world steps as many on a thread of its own, all started together.
+void sideBySideTicks(std::vector<SceneWorld>& worlds, double dt, int ticks, Run& run) {
+  // Past the N-thread world's linger (its members spin 2 ms after a team).
+  std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  std::atomic<int> ready{0};
+  const int count = static_cast<int>(worlds.size());
+  std::vector<std::thread> others;
+  for (int k = 1; k < count; ++k) {
+    others.emplace_back([&, k] {
+      ready.fetch_add(1);
+      while (ready.load() < count) {
+      }
+      for (int t = 0; t < ticks; ++t) worlds[static_cast<std::size_t>(k)].world.step(dt, Budget::unlimited());
+    });
+  }
+  ready.fetch_add(1);
+  while (ready.load() < count) {
+  }
+  timedTicks(worlds[0].world, dt, ticks, run);
+  for (std::thread& t : others) t.join();
+}
+
+struct SceneWorlds {
+  SceneWorld one, many;
+  std::vector<SceneWorld> side_by_side;  // opt.threads worlds of one thread each
+};
+
+SceneWorlds makeWorlds(const Case& c, const Options& opt) {
+  SceneWorlds w{makeWorld(c, 1), makeWorld(c, opt.threads), {}};
+  for (int k = 0; k < opt.threads; ++k) w.side_by_side.push_back(makeWorld(c, 1));
+  return w;
+}
+
+double runCase(const Case& c, const Options& opt, double& ceiling) {
+  SceneWorlds worlds = makeWorlds(c, opt);
+  World& one = worlds.one.world;
+  World& many = worlds.many.world;
   many.timeTeamLoops(true);  // the serial part measured, not only fitted
-  const SceneSpec& spec = scene_one.spec;
+  const SceneSpec& spec = worlds.one.spec;
   const int settle = static_cast<int>(std::lround(opt.settle / spec.dt));
   for (int t = 0; t < settle; ++t) {
     one.step(spec.dt, Budget::unlimited());
     many.step(spec.dt, Budget::unlimited());
+    for (SceneWorld& w : worlds.side_by_side) w.world.step(spec.dt, Budget::unlimited());
   }
   const double seconds = opt.secondsOf(c);
   const int ticks = std::max(1, static_cast<int>(std::lround(seconds / spec.dt)));
   const int block = 30;  // ticks per turn: the two runs take turns
-  Run r1, rn;
+  Run r1, rn, r_side;  // r_side: side_by_side[0], the same ticks as r1
   // Wall time of the turns by the round trip measured before them: near
   // (under kFarRoundTrip) and far.
   constexpr double kFarRoundTrip = 300e-9;
@@ -168,6 +211,7 @@ double runCase(const Case& c, const Options& opt) {
     const std::size_t from = r1.wall.size();
     timedTicks(one, spec.dt, n, r1);
     timedTicks(many, spec.dt, n, rn);
+    sideBySideTicks(worlds.side_by_side, spec.dt, n, r_side);
     for (std::size_t t = from; t < r1.wall.size(); ++t) {
       wall_one[far] += r1.wall[t];
       wall_many[far] += rn.wall[t];
@@ -211,6 +255,10 @@ double runCase(const Case& c, const Options& opt) {
               opt.threads, ms(alone), ms(meanOf(rn.team_loop)), rn.team_loops / ticks, ms(meanOf(rn.team_wait)),
               s_measured, ratio(meanOf(r1.wall) - alone, meanOf(rn.team_loop)), amdahl(std::max(s_measured, 0.0), 8),
               amdahl(std::max(s_measured, 0.0), 16));
+  ceiling = opt.threads * ratio(meanOf(r1.wall), meanOf(r_side.wall));
+  std::printf("the machine's ceiling: %d worlds of one thread side by side, %.3f ms a tick against %.3f alone "
+              "(the same ticks): %.2fx the throughput of one; the %d-thread tick reaches %.0f %% of it\n",
+              opt.threads, ms(meanOf(r_side.wall)), ms(meanOf(r1.wall)), ceiling, opt.threads, 100.0 * x / ceiling);
   std::printf("core-to-core round trip before each turn: p50 %.0f ns (%.0f-%.0f)\n",
               1e9 * percentile(round_trips, 0.5), 1e9 * percentile(round_trips, 0.0), 1e9 * percentile(round_trips, 1.0));
   for (int far = 0; far < 2; ++far) {
@@ -244,14 +292,18 @@ int main(int argc, char** argv) {
   Options opt;
   if (!stc_bench::parseFlags("bench_parallel_speedup", parseOptions, argc, argv, opt)) return 2;
   std::printf("# Parallel tick: 1 vs %d threads, unlimited budget (load average %.2f)\n", opt.threads, loadAverage());
-  std::vector<std::string> lines;
+  std::vector<std::string> lines, ceilings;
   for (const Case& c : opt.cases) {
-    const double x = runCase(c, opt);
+    double ceiling = NAN;
+    const double x = runCase(c, opt, ceiling);
     char buf[128];
     std::snprintf(buf, sizeof buf, "SPEEDUP scene=%s threads=%d x=%.2f", caseName(c).c_str(), opt.threads, x);
     lines.emplace_back(buf);
+    std::snprintf(buf, sizeof buf, "CEILING scene=%s threads=%d x=%.2f", caseName(c).c_str(), opt.threads, ceiling);
+    ceilings.emplace_back(buf);
   }
   std::printf("\n");
   for (const std::string& line : lines) std::printf("%s\n", line.c_str());
+  for (const std::string& line : ceilings) std::printf("%s\n", line.c_str());
   return 0;
 }
