@@ -17,9 +17,9 @@
 // of one thread each tick side by side on N threads (no team, nothing shared
 // but the machine), the first timed over the same ticks as the 1-thread run.
 // N times its time alone over its time side by side is the most any N-thread
-// tick could gain here: on this VM two such worlds slow each other by 5-25 %
-// (caches and memory; a loop in registers is not slowed), so the ceiling is
-// below N. The share of it that the N-thread tick reaches is printed with it.
+// tick could gain here: on this VM two such worlds slowed each other by up
+// to a fifth (caches and memory; a loop in registers is not slowed), so the
+// ceiling may be below N. The share of it the N-thread tick reaches is printed.
 //
 // Before each turn of the two runs, two threads pass one cache line back and
 // forth: the round trip between two cores. On this VM it is 100-200 ns in
