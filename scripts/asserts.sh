@@ -21,11 +21,6 @@ cmake --build "$build" --target "${tests[@]}" -- -j"$jobs" >/dev/null
 [ "${1:-}" = "--build-only" ] && exit 0
 
 # The core that the tests load must call assert's failure handler somewhere.
-core="$build/devel/lib/libstc_core.so"
-if ! nm -D --undefined-only "$core" | grep -q __assert_fail; then
-  echo "asserts: $core has no assertions compiled in"
-  echo "asserts: ${#tests[@]} gtests, ${#tests[@]} failed"
-  exit 1
-fi
+requireAssertions "$build" asserts "${#tests[@]}"
 preferBuildLibraries "$build"
 runGtests "$build" asserts "${tests[@]}"

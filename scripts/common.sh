@@ -11,6 +11,17 @@ export ROS_PYTHON_VERSION=3
 preferBuildLibraries() {
   export LD_LIBRARY_PATH="$1/devel/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 }
+# requireAssertions BUILD LABEL COUNT: fails, with the closing line of COUNT
+# gtests all failed, when BUILD's core was compiled without assert() (it
+# then imports no __assert_fail: built with -DNDEBUG).
+requireAssertions() {
+  local core="$1/devel/lib/libstc_core.so"
+  if ! nm -D --undefined-only "$core" | grep -q __assert_fail; then
+    echo "$2: $core has no assertions compiled in"
+    echo "$2: $3 gtests, $3 failed"
+    return 1
+  fi
+}
 # runGtests BUILD LABEL TEST...: each gtest of BUILD's devel space, run from the
 # source root (as catkin_add_gtest's WORKING_DIRECTORY) with its output in
 # BUILD/TEST.log; a line "LABEL: TEST ok (N s)" or "... FAILED" with the log's

@@ -19,7 +19,12 @@ struct SweepStats {
   std::size_t clamped = 0;  // moved back to their first contact
   std::size_t pairs = 0;    // pairs swept (relative motion fast)
   std::size_t leaf_tests = 0;  // leaf box pairs tested
+  std::size_t rounds = 0;      // sweeps of the pairs run: the first, and one after each that held a body back
 };
+
+// Rounds of the sweep at most in one tick (sweepFastBodies): a hold-back
+// passes one body up a column a round, and a tick's fall closes few gaps.
+constexpr std::size_t kMaxSweepRounds = 16;
 
 // A fast body's earliest hit of the tick.
 struct SweepHit {
@@ -43,6 +48,8 @@ struct SweepScratch {
   std::vector<std::uint8_t> fast;        // per body: moved far enough to be swept
   std::vector<SweepHit> hits;            // per body: the earliest over all lanes
   std::vector<std::uint32_t> clamped;    // bodies put back this tick
+  std::vector<SweepHit> round;           // per body: the earliest of the round being merged
+  std::vector<std::uint8_t> moved;       // per body: put back in the last round
   std::vector<SweepLane> lanes;          // runs of the pairs, in pair order
   // Node pairs whose leaves' boxes cannot reach a hit are not opened (the
   // same hits, far fewer leaf tests). false: every node pair the spheres let
@@ -76,6 +83,12 @@ std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vect
 // narrow phase gave that pair none). scratch.hits and scratch.clamped say
 // where. Pairs already overlapping at the start are resting contacts, left to
 // the solver.
+// A body held back changes its pairs' relative motion: cubes falling side by
+// side or in a column are not fast against each other, until the lowest is
+// stopped and the next falls the rest of the tick into it. So the pairs of
+// the bodies put back are swept again, each body from its start to where it
+// now is, and a hit holds it back further along that path; rounds until none
+// holds a body back, at most kMaxSweepRounds (what is left is the solver's).
 // With `workers` the pairs are cut into runs swept in parallel, each into its
 // own hits; a body takes the earliest hit, on a tie the one of the lowest pair
 // index, as the one run in pair order does: the result is the same bit for bit

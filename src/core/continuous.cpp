@@ -259,6 +259,7 @@ struct SweepInput {
   const std::vector<std::uint8_t>& fast;
   double threshold;
   bool prune_by_boxes;
+  const std::uint8_t* moved = nullptr;  // after the first round: only pairs with a body put back in the last
 };
 
 // Sweeps pairs [begin, end) in order into the lane's hits.
@@ -267,6 +268,7 @@ void sweepPairs(const SweepInput& in, std::size_t begin, std::size_t end, SweepL
   for (std::size_t k = begin; k < end; ++k) {
     const std::uint32_t a = in.pairs[k][0];
     const std::uint32_t b = in.pairs[k][1];
+    if (in.moved != nullptr && in.moved[a] == 0 && in.moved[b] == 0) continue;
     if (!fast[a] && !fast[b]) continue;
     const ShapeBounds* sa = in.shapes[a];
     const ShapeBounds* sb = in.shapes[b];
@@ -330,50 +332,72 @@ SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pos
   if (scratch.fast.size() != bodies.size()) return stats;  // markFastBodies not run on these bodies
   for (const std::uint8_t f : scratch.fast) stats.fast_bodies += f;
   if (stats.fast_bodies == 0) return stats;
-  // Each pair is swept once, in the relative motion of its two bodies, and
-  // the hit holds back whichever of them is fast. Every pair sees the poses
-  // of this integration (bodies are put back after all pairs): the result
-  // does not depend on the pair order.
+  // Each pair is swept once a round, in the relative motion of its two
+  // bodies, and the hit holds back whichever of them is fast. Every pair of a
+  // round sees the poses the round started with (bodies are put back after
+  // all its pairs): the result does not depend on the pair order.
   const std::size_t lanes = laneCount(workers, pair_count);
   if (scratch.lanes.size() < lanes) scratch.lanes.resize(lanes);
   for (std::size_t l = 0; l < lanes; ++l) {
     SweepLane& lane = scratch.lanes[l];
     if (lane.hits.size() != bodies.size()) lane.hits.assign(bodies.size(), SweepHit{});
-    lane.touched.clear();
     lane.touched.reserve(bodies.size());
-    lane.stats = SweepStats{};
   }
-  const SweepInput in{bodies, start, shapes, pairs, scratch.fast, threshold, scratch.prune_by_boxes};
+  scratch.round.assign(bodies.size(), SweepHit{});
+  scratch.moved.assign(bodies.size(), 0);
+  SweepInput in{bodies, start, shapes, pairs, scratch.fast, threshold, scratch.prune_by_boxes};
   const auto run = [&](std::size_t l, std::size_t) {
     const auto [begin, end] = chunkRange(pair_count, l, lanes);
     sweepPairs(in, begin, end, scratch.lanes[l]);
   };
-  if (lanes == 1) {
-    run(0, 1);
-  } else {
-    workers->forChunks(lanes, run);
-  }
-  // Lanes in pair order, a later one taking a body only when strictly earlier.
-  for (std::size_t l = 0; l < lanes; ++l) {
-    SweepLane& lane = scratch.lanes[l];
-    stats.pairs += lane.stats.pairs;
-    stats.leaf_tests += lane.stats.leaf_tests;
-    for (const std::uint32_t i : lane.touched) {
-      if (lane.hits[i].t < scratch.hits[i].t) scratch.hits[i] = lane.hits[i];
-      lane.hits[i] = SweepHit{};
+  while (stats.rounds < kMaxSweepRounds) {
+    ++stats.rounds;
+    for (std::size_t l = 0; l < lanes; ++l) {
+      scratch.lanes[l].touched.clear();
+      scratch.lanes[l].stats = SweepStats{};
     }
-  }
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    const double t = scratch.hits[i].t;
-    if (!(t < 1.0)) continue;
-    BodyState& body = bodies[i];
-    const Pose& p0 = start[i];
-    const Pose p1 = body.pose;
-    body.pose.position = p0.position + t * (p1.position - p0.position);
-    body.pose.orientation = p0.orientation.slerp(t, p1.orientation).normalized();
-    refreshWorldInertia(body);
-    scratch.clamped.push_back(static_cast<std::uint32_t>(i));
-    ++stats.clamped;
+    if (lanes == 1) {
+      run(0, 1);
+    } else {
+      workers->forChunks(lanes, run);
+    }
+    // Lanes in pair order, a later one taking a body only when strictly earlier.
+    for (std::size_t l = 0; l < lanes; ++l) {
+      SweepLane& lane = scratch.lanes[l];
+      stats.pairs += lane.stats.pairs;
+      stats.leaf_tests += lane.stats.leaf_tests;
+      for (const std::uint32_t i : lane.touched) {
+        if (lane.hits[i].t < scratch.round[i].t) scratch.round[i] = lane.hits[i];
+        lane.hits[i] = SweepHit{};
+      }
+    }
+    // Each body hit this round back to its hit on the path it swept (start to
+    // where it was), so over the rounds hits[i].t is the fraction of the tick.
+    bool held = false;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      scratch.moved[i] = 0;
+      SweepHit& hit = scratch.round[i];
+      const double t = hit.t;
+      if (!(t < 1.0)) continue;
+      BodyState& body = bodies[i];
+      const Pose& p0 = start[i];
+      const Pose p1 = body.pose;
+      body.pose.position = p0.position + t * (p1.position - p0.position);
+      body.pose.orientation = p0.orientation.slerp(t, p1.orientation).normalized();
+      refreshWorldInertia(body);
+      SweepHit& kept = scratch.hits[i];
+      if (!(kept.t < 1.0)) {
+        scratch.clamped.push_back(static_cast<std::uint32_t>(i));
+        ++stats.clamped;
+      }
+      hit.t *= kept.t;
+      kept = hit;
+      hit = SweepHit{};
+      scratch.moved[i] = 1;
+      held = true;
+    }
+    if (!held) break;
+    in.moved = scratch.moved.data();
   }
   return stats;
 }

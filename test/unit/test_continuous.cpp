@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace stc {
@@ -204,6 +205,72 @@ TEST(Continuous, CubeGrazingAFrictionlessWallKeepsFalling) {
   EXPECT_GT(b.pose.position.x(), 0.2 - 0.25 * kVoxel);  // and not through it (a quarter voxel, as the fast sphere of test_stability)
   const double fallen = -20.0 * steps * kDt - kG * kDt * kDt * steps * (steps - 1) / 2.0;
   EXPECT_NEAR(b.pose.position.z() - 1.0, fallen, 1e-9);
+}
+
+// How deep two cubes of half side h overlap (true shapes, by the separating
+// axes of two boxes): the least overlap over the 15 axes; < 0 when apart.
+double cubeOverlap(const Pose& a, const Pose& b, double h) {
+  const Mat3 ra = a.orientation.toRotationMatrix(), rb = b.orientation.toRotationMatrix();
+  const Vec3 d = b.position - a.position;
+  double least = std::numeric_limits<double>::infinity();
+  const auto along = [&](const Vec3& axis) {
+    const double length = axis.norm();
+    if (length < 1e-9) return;
+    const Vec3 u = axis / length;
+    const double reach = h * ((ra.transpose() * u).cwiseAbs().sum() + (rb.transpose() * u).cwiseAbs().sum());
+    least = std::min(least, reach - std::abs(d.dot(u)));
+  };
+  for (int i = 0; i < 3; ++i) {
+    along(ra.col(i));
+    along(rb.col(i));
+    for (int j = 0; j < 3; ++j) along(ra.col(i).cross(rb.col(j)));
+  }
+  return least;
+}
+
+// A column of cubes falling together onto a floor (as cube_box's lattice
+// lands): the lowest is held back at the floor; the ones above fall no
+// faster than it did relative to them, so their pair is not fast, yet it
+// closes by the rest of the tick's fall once the one below is stopped. A
+// cube is a shell of leaf spheres one voxel thick: a cube sinking a voxel
+// into the one below it is inside it, and stays there. Each cube above is
+// held back by the one below: no pair overlaps by more than half a voxel,
+// and the column comes to rest stacked. Several speeds and gaps: the hits fall
+// at different instants of a tick.
+TEST(Continuous, ACubeColumnLandingTogetherStaysStacked) {
+  for (const double speed : {3.0, 5.0, 8.0}) {
+    for (const double gap : {0.005, 0.02}) {
+      SCOPED_TRACE(testing::Message() << "speed " << speed << " gap " << gap);
+      WorldConfig config;
+      config.gravity = Vec3(0.0, 0.0, -kG);
+      World w(config);
+      const Material m{0.2, 0.5};
+      addSlab(w, Vec3(0.0, 0.0, -0.1), Quat::Identity(), m);  // top face at z = 0
+      const ShapeId cube = preset(w, "cube");
+      std::vector<std::size_t> column;
+      for (int k = 0; k < 4; ++k) {
+        EntitySpec spec;
+        spec.shape = cube;
+        spec.material = m;
+        spec.pose.position = Vec3(0.0, 0.0, 0.2 + 0.03 + k * (0.4 + gap));
+        spec.linear_velocity = Vec3(0.0, 0.0, -speed);
+        column.push_back(*w.indexOf(w.addEntity(spec)));
+      }
+      double deepest = -1.0;
+      for (int s = 0; s < static_cast<int>(2.0 / kDt); ++s) {
+        w.step(kDt, Budget::unlimited());
+        for (std::size_t k = 0; k + 1 < column.size(); ++k) {
+          deepest = std::max(deepest, cubeOverlap(w.bodies()[column[k]].pose, w.bodies()[column[k + 1]].pose, 0.2));
+        }
+      }
+      EXPECT_LT(deepest, 0.5 * kVoxel);
+      for (std::size_t k = 0; k < column.size(); ++k) {
+        const BodyState& b = w.bodies()[column[k]];
+        EXPECT_NEAR(b.pose.position.z(), 0.2 + 0.4 * static_cast<double>(k), 0.5 * kVoxel) << "cube " << k;
+        EXPECT_LT(b.linear_velocity.norm(), 0.05) << "cube " << k;
+      }
+    }
+  }
 }
 
 // With no detection budget and unresolved pairs rejected, the narrow phase
