@@ -86,9 +86,11 @@ std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vect
 // A body held back changes its pairs' relative motion: cubes falling side by
 // side or in a column are not fast against each other, until the lowest is
 // stopped and the next falls the rest of the tick into it. So the pairs of
-// the bodies put back are swept again, each body from its start to where it
-// now is, and a hit holds it back further along that path; rounds until none
-// holds a body back, at most kMaxSweepRounds (what is left is the solver's).
+// the bodies put back are swept again: the other body, when fast, from its
+// start to where it now is, against the one put back standing where it was
+// put (it stopped there first), and a hit holds back the moving one alone,
+// further along that path. Rounds until none holds a body back, at most
+// kMaxSweepRounds (what is left is the solver's).
 // With `workers` the pairs are cut into runs swept in parallel, each into its
 // own hits; a body takes the earliest hit, on a tie the one of the lowest pair
 // index, as the one run in pair order does: the result is the same bit for bit

@@ -223,9 +223,9 @@ struct Sweeper {
   }
 };
 
-bool sweepable(const BodyState& body, const ShapeBounds* shape) {
-  return shape != nullptr && shape->tree != nullptr && !body.is_static;
-}
+bool sweepable(const ShapeBounds* shape) { return shape != nullptr && shape->tree != nullptr; }
+
+bool sweepable(const BodyState& body, const ShapeBounds* shape) { return sweepable(shape) && !body.is_static; }
 
 }  // namespace
 
@@ -262,52 +262,99 @@ struct SweepInput {
   const std::uint8_t* moved = nullptr;  // after the first round: only pairs with a body put back in the last
 };
 
-// Sweeps pairs [begin, end) in order into the lane's hits.
+// A hit of pair k at fraction t of `body`'s path holds it back, when it is
+// the earliest of the lane's for that body so far.
+void recordHit(SweepLane& lane, std::uint32_t body, std::size_t k, double t, const Vec3& point, const Vec3& normal) {
+  SweepHit& hit = lane.hits[body];
+  if (!(t < hit.t)) return;
+  if (!(hit.t < 1.0)) lane.touched.push_back(body);
+  hit.t = t;
+  hit.pair = static_cast<std::uint32_t>(k);
+  hit.point = point;
+  hit.normal = normal;
+}
+
+// The first round: pair k in the relative motion of its two bodies; a hit
+// holds back whichever of them is fast, both at the same instant.
+void sweepBoth(const SweepInput& in, std::size_t k, SweepLane& lane) {
+  const std::vector<std::uint8_t>& fast = in.fast;
+  const std::uint32_t a = in.pairs[k][0];
+  const std::uint32_t b = in.pairs[k][1];
+  const ShapeBounds* sa = in.shapes[a];
+  const ShapeBounds* sb = in.shapes[b];
+  if (!sweepable(sa) || !sweepable(sb)) return;
+  const Pose& p0 = in.start[a];
+  const Pose& p1 = in.bodies[a].pose;
+  const Pose& q0 = in.start[b];
+  const Pose& q1 = in.bodies[b].pose;
+  // Bodies falling side by side are fast but not towards each other: the
+  // pair is swept only when its relative motion is fast.
+  const double turn_a = p0.orientation.angularDistance(p1.orientation);
+  const double turn_b = q0.orientation.angularDistance(q1.orientation);
+  const double relative = ((p1.position - p0.position) - (q1.position - q0.position)).norm() +
+                          turn_a * sa->bound_radius + turn_b * sb->bound_radius;
+  const double finest = std::min(fast[a] ? sa->min_leaf_radius : sb->min_leaf_radius,
+                                 fast[b] ? sb->min_leaf_radius : sa->min_leaf_radius);
+  if (!(relative > in.threshold * finest)) return;
+  // Only a hit earlier than a fast body's earliest so far matters.
+  const double latest = std::max(fast[a] ? lane.hits[a].t : 0.0, fast[b] ? lane.hits[b].t : 0.0);
+  Sweeper s{*sa, *sb, p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(),
+            q0.orientation.toRotationMatrix(), q1.orientation.toRotationMatrix(),
+            p0.position, p1.position, q0.position, q1.position, latest, lane.stack};
+  s.anchor_first = fast[a] != 0;
+  s.turn_first = turn_a;
+  s.turn_second = turn_b;
+  s.prune_by_boxes = in.prune_by_boxes;
+  ++lane.stats.pairs;
+  const bool found = s.run();
+  lane.stats.leaf_tests += s.leaf_tests;
+  if (!found) return;
+  for (const std::uint32_t i : {a, b}) {
+    if (fast[i]) recordHit(lane, i, k, s.best, s.point, s.normal);  // normal from a (the sweeper's first body) towards b
+  }
+}
+
+// Later rounds: `mover`, fast, from its start to where it now is, against
+// `held`, put back in the last round and standing where it was put (it
+// stopped there first: a body falling onto it holds back the one falling,
+// never the one below). A hit holds back the mover alone.
+void sweepAgainstHeld(const SweepInput& in, std::size_t k, std::uint32_t mover, std::uint32_t held,
+                      SweepLane& lane) {
+  const ShapeBounds* sm = in.shapes[mover];
+  const ShapeBounds* sh = in.shapes[held];
+  if (!sweepable(sm) || !sweepable(sh)) return;
+  const Pose& p0 = in.start[mover];
+  const Pose& p1 = in.bodies[mover].pose;
+  const Pose& q = in.bodies[held].pose;
+  const double turn = p0.orientation.angularDistance(p1.orientation);
+  const double moved = (p1.position - p0.position).norm() + turn * sm->bound_radius;
+  if (!(moved > in.threshold * sm->min_leaf_radius)) return;
+  const Mat3 rq = q.orientation.toRotationMatrix();
+  Sweeper s{*sm, *sh, p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(), rq, rq,
+            p0.position, p1.position, q.position, q.position, lane.hits[mover].t, lane.stack};
+  s.turn_first = turn;
+  s.prune_by_boxes = in.prune_by_boxes;
+  ++lane.stats.pairs;
+  const bool found = s.run();
+  lane.stats.leaf_tests += s.leaf_tests;
+  if (!found) return;
+  recordHit(lane, mover, k, s.best, s.point, mover == in.pairs[k][0] ? s.normal : Vec3(-s.normal));
+}
+
+// Sweeps pairs [begin, end) in order into the lane's hits: in the first
+// round every pair with a fast body, later only the pairs of a body put back
+// in the last round, the other body (when fast) against it.
 void sweepPairs(const SweepInput& in, std::size_t begin, std::size_t end, SweepLane& lane) {
   const std::vector<std::uint8_t>& fast = in.fast;
   for (std::size_t k = begin; k < end; ++k) {
     const std::uint32_t a = in.pairs[k][0];
     const std::uint32_t b = in.pairs[k][1];
-    if (in.moved != nullptr && in.moved[a] == 0 && in.moved[b] == 0) continue;
-    if (!fast[a] && !fast[b]) continue;
-    const ShapeBounds* sa = in.shapes[a];
-    const ShapeBounds* sb = in.shapes[b];
-    if (sa == nullptr || sa->tree == nullptr || sb == nullptr || sb->tree == nullptr) continue;
-    const Pose& p0 = in.start[a];
-    const Pose& p1 = in.bodies[a].pose;
-    const Pose& q0 = in.start[b];
-    const Pose& q1 = in.bodies[b].pose;
-    // Bodies falling side by side are fast but not towards each other: the
-    // pair is swept only when its relative motion is fast.
-    const double turn_a = p0.orientation.angularDistance(p1.orientation);
-    const double turn_b = q0.orientation.angularDistance(q1.orientation);
-    const double relative = ((p1.position - p0.position) - (q1.position - q0.position)).norm() +
-                            turn_a * sa->bound_radius + turn_b * sb->bound_radius;
-    const double finest = std::min(fast[a] ? sa->min_leaf_radius : sb->min_leaf_radius,
-                                   fast[b] ? sb->min_leaf_radius : sa->min_leaf_radius);
-    if (!(relative > in.threshold * finest)) continue;
-    // Only a hit earlier than a fast body's earliest so far matters.
-    const double latest = std::max(fast[a] ? lane.hits[a].t : 0.0, fast[b] ? lane.hits[b].t : 0.0);
-    Sweeper s{*sa, *sb, p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(),
-              q0.orientation.toRotationMatrix(), q1.orientation.toRotationMatrix(),
-              p0.position, p1.position, q0.position, q1.position, latest, lane.stack};
-    s.anchor_first = fast[a] != 0;
-    s.turn_first = turn_a;
-    s.turn_second = turn_b;
-    s.prune_by_boxes = in.prune_by_boxes;
-    ++lane.stats.pairs;
-    const bool found = s.run();
-    lane.stats.leaf_tests += s.leaf_tests;
-    if (!found) continue;
-    for (const std::uint32_t i : {a, b}) {
-      SweepHit& hit = lane.hits[i];
-      if (!fast[i] || !(s.best < hit.t)) continue;
-      if (!(hit.t < 1.0)) lane.touched.push_back(i);
-      hit.t = s.best;
-      hit.pair = static_cast<std::uint32_t>(k);
-      hit.point = s.point;
-      hit.normal = s.normal;  // from a (the sweeper's first body) towards b
+    if (in.moved == nullptr) {
+      if (fast[a] || fast[b]) sweepBoth(in, k, lane);
+      continue;
     }
+    if (in.moved[b] != 0 && fast[a] != 0) sweepAgainstHeld(in, k, a, b, lane);
+    if (in.moved[a] != 0 && fast[b] != 0) sweepAgainstHeld(in, k, b, a, lane);
   }
 }
 
