@@ -379,8 +379,7 @@ SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pos
   if (scratch.fast.size() != bodies.size()) return stats;  // markFastBodies not run on these bodies
   for (const std::uint8_t f : scratch.fast) stats.fast_bodies += f;
   if (stats.fast_bodies == 0) return stats;
-  // Each pair is swept once a round, in the relative motion of its two
-  // bodies, and the hit holds back whichever of them is fast. Every pair of a
+  // Rounds of sweeps (sweepPairs says which pairs, and how). Every pair of a
   // round sees the poses the round started with (bodies are put back after
   // all its pairs): the result does not depend on the pair order.
   const std::size_t lanes = laneCount(workers, pair_count);
