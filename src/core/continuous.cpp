@@ -274,6 +274,15 @@ void recordHit(SweepLane& lane, std::uint32_t body, std::size_t k, double t, con
   hit.normal = normal;
 }
 
+// One pair's sweep, counted in the lane's stats; whether it hit.
+bool sweepOnce(Sweeper& s, const SweepInput& in, SweepLane& lane) {
+  s.prune_by_boxes = in.prune_by_boxes;
+  ++lane.stats.pairs;
+  const bool found = s.run();
+  lane.stats.leaf_tests += s.leaf_tests;
+  return found;
+}
+
 // The first round: pair k in the relative motion of its two bodies; a hit
 // holds back whichever of them is fast, both at the same instant.
 void sweepBoth(const SweepInput& in, std::size_t k, SweepLane& lane) {
@@ -304,11 +313,7 @@ void sweepBoth(const SweepInput& in, std::size_t k, SweepLane& lane) {
   s.anchor_first = fast[a] != 0;
   s.turn_first = turn_a;
   s.turn_second = turn_b;
-  s.prune_by_boxes = in.prune_by_boxes;
-  ++lane.stats.pairs;
-  const bool found = s.run();
-  lane.stats.leaf_tests += s.leaf_tests;
-  if (!found) return;
+  if (!sweepOnce(s, in, lane)) return;
   for (const std::uint32_t i : {a, b}) {
     if (fast[i]) recordHit(lane, i, k, s.best, s.point, s.normal);  // normal from a (the sweeper's first body) towards b
   }
@@ -333,11 +338,7 @@ void sweepAgainstHeld(const SweepInput& in, std::size_t k, std::uint32_t mover, 
   Sweeper s{*sm, *sh, p0.orientation.toRotationMatrix(), p1.orientation.toRotationMatrix(), rq, rq,
             p0.position, p1.position, q.position, q.position, lane.hits[mover].t, lane.stack};
   s.turn_first = turn;
-  s.prune_by_boxes = in.prune_by_boxes;
-  ++lane.stats.pairs;
-  const bool found = s.run();
-  lane.stats.leaf_tests += s.leaf_tests;
-  if (!found) return;
+  if (!sweepOnce(s, in, lane)) return;
   recordHit(lane, mover, k, s.best, s.point, mover == in.pairs[k][0] ? s.normal : Vec3(-s.normal));
 }
 
