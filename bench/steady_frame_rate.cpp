@@ -9,7 +9,10 @@
 // (TickReport); solver passes. At the end: bodies with a non-finite state and
 // bodies outside the scene's bounds (each named on stderr; --trace-escape
 // names them at every tick they are outside, from the first, with what that
-// tick did). Target: p99 whole tick <= 1.1 x budget.
+// tick did). Target: p99 whole tick <= 1.1 x budget. And whether the scene
+// came to rest as it does without a budget: movers asleep and moving at the
+// end, their mean height, and how many contacts a tick came from unresolved
+// pairs and from their root spheres.
 //
 // The budget runs on the thread's CPU clock by default (World::setClock), so
 // the other processes of a shared machine do not eat it; --wall-clock runs it
@@ -17,7 +20,8 @@
 //
 // Usage: bench_steady_frame_rate [--scene corner_drift|rockfall|all] [--entities N]
 //          [--tick-budget-ms 16.7] [--seconds 60] [--budget-off] [--wall-clock]
-//          [--trace-escape] [--markdown FILE]
+//          [--trace-escape] [--sphere-tests N] [--solver-iterations N]
+//          [--position-correction F] [--markdown FILE]
 #include "bench_args.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -26,9 +30,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -52,17 +58,29 @@ struct Run {
   std::vector<double> velocity_passes, position_passes, unresolved_share;
   int interrupted = 0;
   std::size_t non_finite = 0, outside = 0;
+  // Whether the scene came to rest, as a viewer would judge it at the end:
+  // movers asleep, movers that went more than kMovedMetres in the last
+  // second, and the movers' mean height (a pile that flows flattens).
+  std::size_t asleep = 0, moving = 0;
+  double mean_height = NAN;
+  // Contacts a tick over the run (mean), of them those of accepted
+  // unresolved pairs, and of those the ones built from the root spheres
+  // (level 0). Per tick they swing with what the narrow phase got.
+  double contacts = 0.0, unresolved_contacts = 0.0, root_contacts = 0.0;
 };
+
+constexpr double kMovedMetres = 0.02;
 
 bool finiteBody(const BodyState& b) {
   return allFinite(b.pose.position) && b.pose.orientation.coeffs().allFinite() &&
          allFinite(b.linear_velocity) && allFinite(b.angular_velocity);
 }
 
-Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget, bool wall_clock,
-             bool trace_escape) {
+Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget, double position_correction,
+             bool wall_clock, bool trace_escape) {
   WorldConfig config;
   config.scheduler.kind = SchedulerKind::PriorityQueues;
+  if (std::isfinite(position_correction)) config.response.position_correction = position_correction;
   SceneParams params;
   params.entities = entities;
   SceneWorld scene = makeSceneWorld(kind, params, config);
@@ -77,7 +95,12 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
   run.scene = toString(kind);
   run.bodies = static_cast<int>(spec.movers.size());
   const int ticks = static_cast<int>(std::lround(seconds / spec.dt));
+  const int last_second = std::max(0, ticks - static_cast<int>(std::lround(1.0 / spec.dt)));
+  std::vector<Vec3> second_before_end;  // the movers' positions a second before the end
   for (int i = 0; i < ticks; ++i) {
+    if (i == last_second) {
+      for (EntityId id : spec.movers) second_before_end.push_back(world.bodies()[*world.indexOf(id)].pose.position);
+    }
     world.perception().setFixation(gaze.fixationAt(i * spec.dt, world));
     const double c0 = threadCpuSeconds();
     const auto w0 = std::chrono::steady_clock::now();
@@ -97,6 +120,12 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
     run.position_passes.push_back(r.position_passes);
     run.unresolved_share.push_back(r.broad_pairs ? double(r.unresolved) / double(r.broad_pairs) : 0.0);
     run.interrupted += r.interrupted ? 1 : 0;
+    for (const Contact& c : world.contacts()) {  // outside the timed part
+      run.contacts += 1.0;
+      if (c.resolved) continue;
+      run.unresolved_contacts += 1.0;
+      run.root_contacts += c.level == 0 ? 1.0 : 0.0;
+    }
     if (i % 600 == 599) std::fprintf(stderr, "  %s: %d / %d ticks\n", run.scene.c_str(), i + 1, ticks);
     if (trace_escape) {  // every tick a mover is outside: where, how fast, what the tick did
       for (EntityId id : spec.movers) {
@@ -110,6 +139,19 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
       }
     }
   }
+  if (ticks > 0) {
+    run.contacts /= ticks;
+    run.unresolved_contacts /= ticks;
+    run.root_contacts /= ticks;
+  }
+  double height_sum = 0.0;
+  for (std::size_t k = 0; k < spec.movers.size(); ++k) {
+    const BodyState& b = world.bodies()[*world.indexOf(spec.movers[k])];
+    run.asleep += world.isSleeping(spec.movers[k]) ? 1 : 0;
+    if (k < second_before_end.size() && !((b.pose.position - second_before_end[k]).norm() <= kMovedMetres)) ++run.moving;
+    height_sum += b.pose.position.z();
+  }
+  if (!spec.movers.empty()) run.mean_height = height_sum / static_cast<double>(spec.movers.size());
   for (EntityId id : spec.movers) {
     const BodyState& b = world.bodies()[*world.indexOf(id)];
     if (!finiteBody(b)) {
@@ -142,6 +184,9 @@ int main(int argc, char** argv) {
   double budget_ms = 16.7;
   double seconds = 60.0;
   bool budget_off = false, wall_clock = false, trace_escape = false;
+  std::int64_t sphere_tests = std::numeric_limits<std::int64_t>::max();
+  int solver_iterations = std::numeric_limits<int>::max();
+  double position_correction = NAN;  // the World's default
   std::string markdown;
   for (stc_bench::Args args(argc, argv); args.more();) {
     const std::string& a = args.flag();
@@ -150,6 +195,9 @@ int main(int argc, char** argv) {
     else if (a == "--tick-budget-ms") budget_ms = std::stod(args.value());
     else if (a == "--seconds") seconds = std::stod(args.value());
     else if (a == "--budget-off") budget_off = true;
+    else if (a == "--sphere-tests") sphere_tests = std::stoll(args.value());
+    else if (a == "--solver-iterations") solver_iterations = std::stoi(args.value());
+    else if (a == "--position-correction") position_correction = std::stod(args.value());
     else if (a == "--wall-clock") wall_clock = true;
     else if (a == "--trace-escape") trace_escape = true;
     else if (a == "--markdown") markdown = args.value();
@@ -163,12 +211,16 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "unknown scene %s\n", scene.c_str());
     return 2;
   }
-  const Budget budget = budget_off ? Budget::unlimited() : Budget::ofTickSeconds(budget_ms * 1e-3);
+  Budget budget = budget_off ? Budget::unlimited() : Budget::ofTickSeconds(budget_ms * 1e-3);
+  // The budget's two deterministic forms, alone or beside the tick's: what a
+  // pile does with pairs left unresolved, or with few solver passes.
+  budget.sphere_tests = sphere_tests;
+  budget.solver_iterations = solver_iterations;
 
   std::vector<Run> runs;
   for (const Case& c : cases) {
     std::fprintf(stderr, "%s %d: %.0f s simulated ...\n", toString(c.kind), c.entities, seconds);
-    runs.push_back(simulate(c.kind, c.entities, seconds, budget, wall_clock, trace_escape));
+    runs.push_back(simulate(c.kind, c.entities, seconds, budget, position_correction, wall_clock, trace_escape));
   }
 
   std::string md;
@@ -177,19 +229,31 @@ int main(int argc, char** argv) {
   if (!budget_off) std::snprintf(budget_text, sizeof budget_text, "%.1f ms", budget_ms);
   std::snprintf(buf, sizeof buf,
                 "%.0f s at 60 Hz per scene; tick budget %s (%s clock); priority queues, saccadic gaze, "
-                "policy accept. ms as p50 / p99 / max.\n\n",
+                "policy accept. ms as p50 / p99 / max.",
                 seconds, budget_text, wall_clock ? "steady" : "thread-CPU");
   md += buf;
+  if (sphere_tests < std::numeric_limits<std::int64_t>::max()) {
+    md += " Sphere tests a tick: " + std::to_string(sphere_tests) + ".";
+  }
+  if (solver_iterations < std::numeric_limits<int>::max()) {
+    md += " Solver iterations: " + std::to_string(solver_iterations) + ".";
+  }
+  if (std::isfinite(position_correction)) {
+    std::snprintf(buf, sizeof buf, " Position correction: %.2f.", position_correction);
+    md += buf;
+  }
+  md += "\n\n";
   md += "| scene | bodies | whole tick CPU | whole tick wall | p99 CPU / budget | ticks > 1.1 budget "
         "| CPU less integrate | integrate | broad | narrow "
         "| narrow got | response | reserve | velocity passes p50 / min | position passes p50 / min "
-        "| interrupted | unresolved p50 | NaN | outside |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "| interrupted | unresolved p50 | NaN | outside | asleep at end | moved > 2 cm in the last s "
+        "| mean height at end, m | contacts a tick (mean): all / unresolved / at the roots |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Run& r : runs) {
     const auto min_of = [](const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); };
     std::snprintf(buf, sizeof buf,
                   "| %s | %d | %s | %s | %.2f | %.1f%% | %s | %s | %s | %s | %s | %s | %s | %.0f / %.0f | %.0f / %.0f "
-                  "| %.1f%% | %.1f%% | %zu | %zu |\n",
+                  "| %.1f%% | %.1f%% | %zu | %zu | %zu | %zu | %.2f | %.0f / %.0f / %.0f |\n",
                   r.scene.c_str(), r.bodies, pct(r.cpu).c_str(), pct(r.wall).c_str(),
                   budget_off ? NAN : percentile(r.cpu, 0.99) / (budget_ms * 1e-3),
                   100.0 * static_cast<double>(std::count_if(r.cpu.begin(), r.cpu.end(),
@@ -201,7 +265,8 @@ int main(int argc, char** argv) {
                   percentile(r.velocity_passes, 0.5), min_of(r.velocity_passes),
                   percentile(r.position_passes, 0.5), min_of(r.position_passes),
                   100.0 * r.interrupted / static_cast<double>(r.cpu.size()),
-                  100.0 * percentile(r.unresolved_share, 0.5), r.non_finite, r.outside);
+                  100.0 * percentile(r.unresolved_share, 0.5), r.non_finite, r.outside, r.asleep, r.moving,
+                  r.mean_height, r.contacts, r.unresolved_contacts, r.root_contacts);
     md += buf;
   }
   std::printf("%s", md.c_str());
