@@ -21,7 +21,8 @@ struct Contact {
   double priority = 0.0;        // perceptual priority f(e, g) (0 without gaze)
   // Signed gap between the two shapes' surfaces along the normal (< 0:
   // penetration), each surface taken where its sphere's voxel box ends
-  // (ShapeBounds::support in response.hpp): what the solver acts on.
+  // (ShapeBounds::support in response.hpp): what the solver acts on. At
+  // least 0 for an accepted unresolved pair, whose overlap is not proven.
   double separation = 0.0;
   std::int32_t node_a = 0;      // sphere pair the contact was built from (tree node indices)
   std::int32_t node_b = 0;

@@ -170,7 +170,9 @@ void clusterSeparations(const std::vector<ContactCandidate>& candidates, const s
 // normal is the mean over its deepest members (sphere overlap within 10% of
 // its deepest: the pairs straight across the contact). separation is
 // measured along that normal between the nodes' surfaces
-// (ShapeBounds::support; the sphere itself without bounds). Coincident
+// (ShapeBounds::support; the sphere itself without bounds), and at least 0
+// for an Unresolved test: its overlap is the frontier's, not proven of the
+// surfaces, so its contacts stop approach and push nothing apart. Coincident
 // centres: the direction between the body centres, then +Z; never NaN.
 // A cache line of its own: the parallel contact building gives each thread
 // a builder, and its scratch vectors' ends move with every candidate.

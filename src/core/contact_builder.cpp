@@ -456,7 +456,12 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
     contact.point = rep.point;
     contact.normal = normals_[r];
     contact.depth = std::max(0.0, rep.overlap);
-    contact.separation = separations_[r];
+    // An unresolved pair's overlap is its frontier's, not proven of its
+    // surfaces (they may be up to its gap bound apart): its contact keeps the
+    // bodies from closing in but pushes nothing apart. Pushed out of their
+    // root spheres' and node boxes' overlaps, the rocks of a pile under a tick
+    // budget flowed and flattened it (docs/error_vs_runtime.md).
+    contact.separation = status == PairStatus::Colliding ? separations_[r] : std::max(0.0, separations_[r]);
     // The pair's bound (its deepest sphere pair's h_a + h_b), the same for
     // every point: the solver's slop is a fraction of it, and a slop that
     // differs point by point let position correction lift a rolling link
