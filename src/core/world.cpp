@@ -16,11 +16,13 @@ namespace {
 // The reserve for what follows the narrow phase forgets a cost spike by this
 // factor a tick: it follows rises at once and halves in about 14 ticks.
 constexpr double kReserveDecay = 0.95;
-// ... and is kept with this margin: that cost varies by about a tenth from
-// tick to tick (how far the narrow phase got changes the contacts to build).
-// On corner_drift 500 at 16.7 ms the margin took the ticks over 1.1 x budget
-// from 2% to 0.5% for 2% less narrow-phase time.
-constexpr double kReserveMargin = 1.1;
+// ... and is kept with this margin: that cost varies from tick to tick (how
+// far the narrow phase got changes the contacts to build). On corner_drift
+// 500 at 16.7 ms a margin of 1.1 took the ticks over 1.1 x budget from 2% to
+// 0.5% for 2% less narrow-phase time; on the rockfall 1,000, whose mandatory
+// part swings more (p50 9, p99 12-13 ms), 1.1 left 1.8-2.4% of its ticks over
+// and a p99 of 1.14-1.17 x, 1.25 0.4-0.6% and 1.02-1.06 x (2026-12-04).
+constexpr double kReserveMargin = 1.25;
 
 // Auto box mode: a shape whose occupied extent is this much longer along its
 // longest axis than along its shortest gets a dynamic box (paper 3.2: long,
