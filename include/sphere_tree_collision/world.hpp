@@ -101,7 +101,8 @@ struct TickReport {
   double response_budget_s = std::numeric_limits<double>::infinity();
   // Kept back from the narrow phase (with a tick budget) for what cannot be
   // cut after it: its own accounting and the response's mandatory part (the
-  // largest such cost of recent ticks, with a 10% margin).
+  // largest such cost of recent ticks, with a 25% margin: kReserveMargin in
+  // world.cpp).
   double reserve_s = 0.0;
   double response_refinement_s = 0.0;  // of response_s: iterations the deadline could have cut
   int velocity_passes = 0;             // solver iterations run (>= 1 with contacts)

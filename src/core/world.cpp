@@ -21,7 +21,7 @@ constexpr double kReserveDecay = 0.95;
 // 500 at 16.7 ms a margin of 1.1 took the ticks over 1.1 x budget from 2% to
 // 0.5% for 2% less narrow-phase time; on the rockfall 1,000, whose mandatory
 // part swings more (p50 9, p99 12-13 ms), 1.1 left 1.8-2.4% of its ticks over
-// and a p99 of 1.14-1.17 x, 1.25 0.4-0.6% and 1.02-1.06 x (2026-12-04).
+// and a p99 of 1.14-1.17 x, 1.25 0.2-0.6% and 0.96-1.06 x (2026-12-04).
 constexpr double kReserveMargin = 1.25;
 
 // Auto box mode: a shape whose occupied extent is this much longer along its
