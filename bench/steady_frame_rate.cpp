@@ -144,16 +144,15 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
     run.unresolved_contacts /= ticks;
     run.root_contacts /= ticks;
   }
+  // One pass over the movers at the end: their state, where they are, and
+  // whether they went anywhere in the last second (a NaN pose counts as moved).
   double height_sum = 0.0;
   for (std::size_t k = 0; k < spec.movers.size(); ++k) {
-    const BodyState& b = world.bodies()[*world.indexOf(spec.movers[k])];
-    run.asleep += world.isSleeping(spec.movers[k]) ? 1 : 0;
+    const EntityId id = spec.movers[k];
+    const BodyState& b = world.bodies()[*world.indexOf(id)];
+    run.asleep += world.isSleeping(id) ? 1 : 0;
     if (k < second_before_end.size() && !((b.pose.position - second_before_end[k]).norm() <= kMovedMetres)) ++run.moving;
     height_sum += b.pose.position.z();
-  }
-  if (!spec.movers.empty()) run.mean_height = height_sum / static_cast<double>(spec.movers.size());
-  for (EntityId id : spec.movers) {
-    const BodyState& b = world.bodies()[*world.indexOf(id)];
     if (!finiteBody(b)) {
       ++run.non_finite;
     } else if (!spec.bounds.contains(b.pose.position)) {
@@ -163,6 +162,7 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
                    b.pose.position.z(), b.linear_velocity.norm());
     }
   }
+  if (!spec.movers.empty()) run.mean_height = height_sum / static_cast<double>(spec.movers.size());
   return run;
 }
 
