@@ -197,8 +197,10 @@ class World {
   // state edited through bodies() is checked the same way before the tick.
   TickReport step(double dt, const Budget& budget);
   // Time source of step(): phase times and deadlines (default steadySeconds).
-  // A fake clock makes time budgets deterministic in tests.
-  void setClock(SecondsClock clock) { clock_ = std::move(clock); }
+  // A fake clock makes time budgets deterministic in tests. Reads the clock
+  // a few dozen times, to space the narrow phase's reads by what one costs
+  // (checkEveryFor, budget.hpp).
+  void setClock(SecondsClock clock);
   // The entities the last step removed, with the reason.
   const std::vector<QuarantinedEntity>& quarantined() const { return quarantined_; }
   // The bodies the last step (and breakEntity since) broke, with their pieces.
@@ -335,6 +337,7 @@ class World {
   Physics physics_;  // integration and response (response.hpp), warm-start state
   Islands islands_;  // which bodies sleep, indexed like bodies_
   SecondsClock clock_ = steadySeconds;
+  std::int64_t clock_check_every_ = BudgetTracker::kDefaultCheckEvery;  // of clock_ (setClock)
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step
   std::vector<std::uint8_t> held_through_tick_;  // step: Islands::held() before endTick (pooled)

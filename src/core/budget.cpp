@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 
 namespace stc {
 
@@ -16,5 +17,31 @@ BudgetTracker::BudgetTracker(const Budget& budget, std::int64_t check_every)
                                           ? steadySeconds() + std::max(budget.seconds, 0.0)
                                           : budget.seconds),
                     check_every) {}
+
+namespace {
+
+// Least steady-clock seconds that kReads reads of `read` took, over kBatches batches.
+template <typename Read>
+double leastBatchSeconds(const Read& read) {
+  constexpr int kBatches = 4, kReads = 16;
+  double least = std::numeric_limits<double>::infinity();
+  volatile double sink = 0.0;  // keeps the reads
+  for (int b = 0; b < kBatches; ++b) {
+    const double start = steadySeconds();
+    for (int r = 0; r < kReads; ++r) sink = sink + read();
+    least = std::min(least, steadySeconds() - start);
+  }
+  return least;
+}
+
+}  // namespace
+
+std::int64_t checkEveryFor(const SecondsClock& clock) {
+  const double steady = leastBatchSeconds(steadySeconds);
+  const double own = leastBatchSeconds(clock);
+  if (!(steady > 0.0) || !(own > steady)) return BudgetTracker::kDefaultCheckEvery;
+  const double scaled = static_cast<double>(BudgetTracker::kDefaultCheckEvery) * own / steady;
+  return static_cast<std::int64_t>(std::min(scaled, static_cast<double>(kMostCheckEvery)));
+}
 
 }  // namespace stc

@@ -298,6 +298,11 @@ void World::invalidateLastTick() {
 // ---------------------------------------------------------------------------------
 // The tick
 
+void World::setClock(SecondsClock clock) {
+  clock_check_every_ = checkEveryFor(clock);
+  clock_ = std::move(clock);
+}
+
 TickReport World::step(double dt, const Budget& budget) {
   if (!(std::isfinite(dt) && dt >= 0.0)) throw InputError("dt", "must be finite and >= 0");
   TickReport report;
@@ -539,7 +544,7 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
         pair_tests_[i].resumeColliding(a, b, &chunk.arena, e.leaf, e.level);
       }
     }
-    BudgetTracker tracker(chunkShare(budget.sphere_tests, k, chunks), Deadline(&clock_, end));
+    BudgetTracker tracker(chunkShare(budget.sphere_tests, k, chunks), Deadline(&clock_, end), clock_check_every_);
     chunk.stats = chunk.scheduler->run(pair_tests_.data() + first, last - first,
                                        PairBodies{pair_bodies_.data() + first, bodies_.size()},
                                        gaze ? &perception_ : nullptr, tracker);

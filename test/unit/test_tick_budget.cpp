@@ -212,6 +212,42 @@ TEST(TickBudget, NarrowPhaseGetsWhatTheFixedPhasesAndTheReserveLeave) {
   EXPECT_NEAR(w.step(kDt, both).narrow_budget_s, 1e-4, 1e-15);
 }
 
+// A clock whose read costs real time (a thread CPU clock is a system call,
+// about 20 times the steady clock) is read once per many sphere tests, and
+// the narrow phase still ends at its deadline. The clock's values are fake
+// (every read 1e-4 s later), so what is asserted does not depend on the
+// machine; only its cost is real: each read spins 2 us on the steady clock.
+TEST(TickBudget, ACostlyClockIsReadOncePerManySphereTests) {
+  constexpr double kStep = 1e-4;
+  auto reads = std::make_shared<std::int64_t>(0);
+  const SecondsClock costly = [reads] {
+    const double until = steadySeconds() + 2e-6;
+    while (steadySeconds() < until) {
+    }
+    return kStep * static_cast<double>((*reads)++);
+  };
+  EXPECT_GE(checkEveryFor(costly), 10 * BudgetTracker::kDefaultCheckEvery);
+  EXPECT_LE(checkEveryFor(costly), kMostCheckEvery);
+  EXPECT_EQ(checkEveryFor(steppingClock(kStep)), BudgetTracker::kDefaultCheckEvery) << "a cheap clock: as before";
+
+  World w = pile(60);
+  w.setClock(costly);
+  bool interrupted = false;
+  for (int i = 0; i < 10; ++i) {
+    const TickReport r = w.step(kDt, Budget::ofTickSeconds(0.003));
+    // Every read is kStep of fake time: the narrow phase's reads, less its
+    // stamps and the read that saw the deadline, came one per 320 sphere
+    // tests or fewer (with a cheap clock, one per 32).
+    const auto narrow_reads = static_cast<std::int64_t>(std::lround(r.narrow_s / kStep));
+    EXPECT_GE(r.sphere_tests, 10 * BudgetTracker::kDefaultCheckEvery * (narrow_reads - 3)) << "tick " << i;
+    // Ended by the first read past the deadline; two stamps follow it
+    // (scheduling done, and the phase's end).
+    EXPECT_LE(r.narrow_s, r.narrow_budget_s + 3 * kStep + 1e-12) << "tick " << i;
+    interrupted = interrupted || r.interrupted;
+  }
+  EXPECT_TRUE(interrupted) << "the deadline, not the pairs running out, ended the narrow phase";
+}
+
 // The response's time is its contacts' building and the solve: the report
 // names the first (contacts_s), on the World's clock like every phase.
 TEST(TickBudget, ResponseTimeIsBuildingTheContactsAndTheSolve) {
