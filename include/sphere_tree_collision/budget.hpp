@@ -92,7 +92,8 @@ class BudgetTracker {
 // The check interval for `clock`: BudgetTracker::kDefaultCheckEvery scaled by
 // what a read of it costs against a read of the steady clock (each the least
 // of a few timed batches, so a preempted batch does not count), between
-// kDefaultCheckEvery and kMostCheckEvery. Reading it then costs the narrow
+// kDefaultCheckEvery and kMostCheckEvery (a clock within twice the steady
+// clock's cost keeps the default). Reading it then costs the narrow
 // phase the share the steady clock costs at the default: a thread CPU clock
 // is a system call, about 20 times the steady clock's read, and read every 32
 // tests it took 13 % of a budgeted rockfall's tick. Reads `clock` 64 times.
