@@ -38,6 +38,7 @@ class PairContactCache {
     double depth = 0.0, separation = 0.0, gap_bound = 0.0;
     std::int32_t node_a = 0, node_b = 0;
     int level = 0;
+    bool resolved = true;  // found at the leaves (an unresolved pair's frontier: false)
   };
   // A pair's contacts as built, and the pose of B in A's frame then.
   // Carried over unchanged while it is reused.
@@ -87,14 +88,15 @@ class PairContactCache {
 
   // The entry's contacts at the bodies' poses now, appended to `out`: each
   // point on A and on B where it was on its body, the normal turned with
-  // A, the separation measured again between the two points along it.
+  // A, the separation measured again between the two points along it (at
+  // least 0 for a point of an unresolved pair, as when it was built).
   // `base` gives the ids, dense indices and priority.
   void place(std::uint32_t index, const Contact& base, const Pose& pose_a, const Pose& pose_b,
              std::vector<Contact>& out) const;
 
   // Into `pending`: the entry of a pair whose contacts [first, end) of
-  // `contacts` were just built from its test (Colliding), with its
-  // tolerance in metres.
+  // `contacts` were just built from its test (Colliding, or Unresolved for
+  // the steady frontier: Physics), with its tolerance in metres.
   static void record(const PairTest& test, const ReuseBody& a, const ReuseBody& b, double tolerance,
                      const Contact* first, const Contact* end, Pending& pending);
   // ... or a reused entry, carried over as it is.
@@ -103,6 +105,9 @@ class PairContactCache {
   // order. The entries found this tick are no longer valid after it.
   void commit(const Pending* const* pending, std::size_t count);
   void clear();
+  // Room for a tick of `entries` entries and `points` points (both caches of
+  // commit's swap, and the index), so such a tick allocates nothing.
+  void reserve(std::size_t entries, std::size_t points);
   std::size_t size() const { return entries_.size(); }
 
  private:

@@ -43,6 +43,10 @@ struct StepContext {
   // (buildContacts; nullptr: every pair's contacts are built).
   const std::vector<std::uint32_t>* reused = nullptr;
   bool accept_unresolved = true;  // policy accept: unresolved pairs give contacts too
+  // The narrow phase was limited this tick: an accepted unresolved pair keeps
+  // the contacts of the deepest frontier it reached while its bodies stay put
+  // (buildContacts; Physics::kFrontierTolerance).
+  bool steady_frontier = false;
   SolveBudget budget;             // what the solver may spend (solve)
   std::vector<Contact>* contacts = nullptr;  // buildContacts' output, solve's input
   const Workers* workers = nullptr;  // threads of the parallel loops (nullptr: the caller's alone)
@@ -96,12 +100,26 @@ class Physics {
   const PairContactCache& pairCache() const { return pair_cache_; }
   // Drops the carried contacts: the next tick builds every pair's (a static
   // body came or went, so covered faces may have changed; or the options did).
-  void forgetReuse() { pair_cache_.clear(); }
+  void forgetReuse() {
+    pair_cache_.clear();
+    frontier_cache_.clear();
+  }
+
+  // A limited narrow phase reaches a pair's leaves in one tick and its root in
+  // the next, as the time it gets and the gaze move: the frontier contacts
+  // changed from tick to tick, and a pile under a varying budget flowed
+  // (docs/error_vs_runtime.md). An accepted unresolved pair whose frontier
+  // now is shallower than the one it had keeps that one's contacts, placed
+  // anew, while no point of either body moved by more than this fraction of
+  // the smaller leaf radius since they were built.
+  static constexpr double kFrontierTolerance = 0.5;
 
  private:
   // Also records the pairs' cache entries into `reuse` when step.reused is set.
+  // And the pairs' frontier entries into `frontier` when step.steady_frontier is set.
   void appendContacts(const StepContext& step, std::size_t first, std::size_t last, ContactBuilder& builder,
-                      std::vector<Contact>& out, PairContactCache::Pending& reuse) const;
+                      std::vector<Contact>& out, PairContactCache::Pending& reuse,
+                      PairContactCache::Pending& frontier) const;
   ReuseBody reuseBody(const StepContext& step, std::uint32_t index) const;
 
   // A builder (its scratch) and the contacts of each chunk of the pairs
@@ -110,11 +128,13 @@ class Physics {
   struct alignas(64) ChunkContacts {  // a line of its own: its end moves with each contact
     std::vector<Contact> contacts;
     PairContactCache::Pending reuse;  // the chunk's pairs' cache entries for the next tick
+    PairContactCache::Pending frontier;  // ... and their frontier entries (steady_frontier)
   };
   std::vector<ChunkContacts> chunk_contacts_;
   std::size_t builder_turn_ = 0;
   ContactSolver solver_;
   PairContactCache pair_cache_;  // contacts carried over between ticks
+  PairContactCache frontier_cache_;  // each pair's deepest contacts while it stays put (steady_frontier)
   std::vector<const PairContactCache::Pending*> reuse_pending_;  // the chunks' entries, for commit
   double gravity_speed_ = 0.0;  // |g| dt of the last integrate
   std::vector<Pose> start_;

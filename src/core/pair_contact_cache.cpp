@@ -2,6 +2,7 @@
 #include "sphere_tree_collision/pair_contact_cache.hpp"
 
 #include "flat_hash_map.hpp"
+#include "grow_capacity.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -68,7 +69,8 @@ void PairContactCache::place(std::uint32_t index, const Contact& base, const Pos
     c.depth = std::max(p.depth - (c.separation - p.separation), 0.0);
     c.gap_bound = p.gap_bound;
     c.level = p.level;
-    c.resolved = true;
+    c.resolved = p.resolved;
+    if (!p.resolved) c.separation = std::max(c.separation, 0.0);
     c.node_a = p.node_a;
     c.node_b = p.node_b;
     out.push_back(c);
@@ -77,7 +79,7 @@ void PairContactCache::place(std::uint32_t index, const Contact& base, const Pos
 
 void PairContactCache::record(const PairTest& test, const ReuseBody& a, const ReuseBody& b, double tolerance,
                               const Contact* first, const Contact* end, Pending& pending) {
-  assert(test.status() == PairStatus::Colliding && test.hasLastPair());
+  assert(test.status() == PairStatus::Unresolved || (test.status() == PairStatus::Colliding && test.hasLastPair()));
   const Pose& pa = *a.pose;
   const Pose& pb = *b.pose;
   Entry e;
@@ -85,7 +87,7 @@ void PairContactCache::record(const PairTest& test, const ReuseBody& a, const Re
   e.b_in_a = originIn(pa, pb);
   e.a_to_b = pa.orientation.conjugate() * pb.orientation;
   e.tolerance = tolerance;
-  e.leaf = test.lastPair();
+  if (test.hasLastPair()) e.leaf = test.lastPair();
   e.level = test.deepestLevel();
   e.first = static_cast<std::uint32_t>(pending.points.size());
   e.count = static_cast<std::uint32_t>(end - first);
@@ -104,6 +106,7 @@ void PairContactCache::record(const PairTest& test, const ReuseBody& a, const Re
     p.node_a = c->node_a;
     p.node_b = c->node_b;
     p.level = c->level;
+    p.resolved = c->resolved;
     pending.points.push_back(p);
   }
   pending.entries.push_back(e);
@@ -133,6 +136,13 @@ void PairContactCache::commit(const Pending* const* pending, std::size_t count) 
   entries_.swap(next_entries_);
   points_.swap(next_points_);
   index_.swap(next_index_);
+}
+
+void PairContactCache::reserve(std::size_t entries, std::size_t points) {
+  for (std::vector<Entry>* v : {&entries_, &next_entries_}) growCapacity(*v, entries);
+  for (std::vector<Point>* v : {&points_, &next_points_}) growCapacity(*v, points);
+  index_->reserve(entries);
+  next_index_->reserve(entries);
 }
 
 void PairContactCache::clear() {

@@ -70,10 +70,25 @@ std::uint32_t Physics::reusableEntry(const StepContext& step, std::uint32_t ia, 
   return pair_cache_.find(reuseBody(step, ia), reuseBody(step, ib), step.dt);
 }
 
+namespace {
+
+// What a cache's placed contacts of the pair of `test` take from the pair now.
+Contact placedBase(const PairTest& test, std::uint32_t ia, std::uint32_t ib, double priority) {
+  Contact base;
+  base.a = test.bodyA().id;
+  base.b = test.bodyB().id;
+  base.index_a = ia;
+  base.index_b = ib;
+  base.priority = priority;
+  return base;
+}
+
+}  // namespace
+
 // The contacts of pairs [first, last) appended to `out` in pair order.
 void Physics::appendContacts(const StepContext& step, std::size_t first, std::size_t last,
                              ContactBuilder& builder, std::vector<Contact>& out,
-                             PairContactCache::Pending& reuse) const {
+                             PairContactCache::Pending& reuse, PairContactCache::Pending& frontier) const {
   const ResponseOptions& options = *step.options;
   const std::vector<PairTest>& tests = *step.tests;
   const std::vector<std::array<std::uint32_t, 2>>& pair_bodies = *step.pair_bodies;
@@ -85,21 +100,27 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
   build.accept_unresolved = step.accept_unresolved;
   build.face_normals = options.face_normals;
   reuse.clear();
+  frontier.clear();
   for (std::size_t i = first; i < last; ++i) {
     const std::uint32_t ia = pair_bodies[i][0];
     const std::uint32_t ib = pair_bodies[i][1];
     const std::size_t before = out.size();
     const std::uint32_t entry = step.reused != nullptr ? (*step.reused)[i] : PairContactCache::kNone;
     if (entry != PairContactCache::kNone) {  // its test resumed Colliding: last tick's contacts, placed anew
-      Contact base;
-      base.a = tests[i].bodyA().id;
-      base.b = tests[i].bodyB().id;
-      base.index_a = ia;
-      base.index_b = ib;
-      base.priority = priorities[i];
-      pair_cache_.place(entry, base, *tests[i].bodyA().pose, *tests[i].bodyB().pose, out);
+      pair_cache_.place(entry, placedBase(tests[i], ia, ib, priorities[i]), *tests[i].bodyA().pose,
+                        *tests[i].bodyB().pose, out);
       pair_cache_.carry(entry, reuse);
       continue;
+    }
+    const PairStatus status = tests[i].status();
+    if (step.steady_frontier && status == PairStatus::Unresolved && step.accept_unresolved) {
+      const std::uint32_t kept = frontier_cache_.find(reuseBody(step, ia), reuseBody(step, ib), step.dt);
+      if (kept != PairContactCache::kNone && frontier_cache_.entry(kept).level > tests[i].deepestLevel()) {
+        frontier_cache_.place(kept, placedBase(tests[i], ia, ib, priorities[i]), *tests[i].bodyA().pose,
+                              *tests[i].bodyB().pose, out);
+        frontier_cache_.carry(kept, frontier);
+        continue;
+      }
     }
     const StaticCover* cover = step.static_cover;
     const ShapeBounds& bounds_a = shape_bounds[body_shapes[ia]];
@@ -107,10 +128,14 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
     builder.append(tests[i], ia, ib, priorities[i],
                    BodySurface{&bounds_a, cover != nullptr ? cover->of(ia) : nullptr},
                    BodySurface{&bounds_b, cover != nullptr ? cover->of(ib) : nullptr}, build, out);
-    if (step.reused != nullptr && tests[i].status() == PairStatus::Colliding && out.size() > before) {
-      const double tolerance = options.reuse_tolerance * std::min(bounds_a.min_leaf_radius, bounds_b.min_leaf_radius);
-      PairContactCache::record(tests[i], reuseBody(step, ia), reuseBody(step, ib), tolerance, out.data() + before,
-                               out.data() + out.size(), reuse);
+    const double leaf_radius = std::min(bounds_a.min_leaf_radius, bounds_b.min_leaf_radius);
+    if (step.reused != nullptr && status == PairStatus::Colliding && out.size() > before) {
+      PairContactCache::record(tests[i], reuseBody(step, ia), reuseBody(step, ib),
+                               options.reuse_tolerance * leaf_radius, out.data() + before, out.data() + out.size(), reuse);
+    }
+    if (step.steady_frontier && status != PairStatus::Separate && out.size() > before) {
+      PairContactCache::record(tests[i], reuseBody(step, ia), reuseBody(step, ib), kFrontierTolerance * leaf_radius,
+                               out.data() + before, out.data() + out.size(), frontier);
     }
     if (out.size() == before && sweep_hit_of_pair_[i] >= 0) {
       // The sweep held a body back at this pair's first touch but the test
@@ -154,8 +179,17 @@ void Physics::buildContacts(const StepContext& step) {
   const std::size_t chunks = threads > 1 && count >= kPairsPerTask ? kChunksPerThread * threads : 1;
   if (builders_.size() < chunks) builders_.resize(chunks);
   if (chunk_contacts_.size() < chunks) chunk_contacts_.resize(chunks);
+  if (step.steady_frontier) {  // sized by the pairs: a tick with more entries than any before allocates nothing
+    const std::size_t points_per_pair = static_cast<std::size_t>(std::max(1, step.options->max_contacts_per_pair));
+    for (std::size_t k = 0; k < chunks; ++k) {
+      const auto [first, last] = chunkRange(count, k, chunks);
+      growCapacity(chunk_contacts_[k].frontier.entries, last - first);
+      growCapacity(chunk_contacts_[k].frontier.points, (last - first) * points_per_pair);
+    }
+    frontier_cache_.reserve(count, count * points_per_pair);
+  }
   if (chunks == 1) {
-    appendContacts(step, 0, count, builders_[0], contacts, chunk_contacts_[0].reuse);
+    appendContacts(step, 0, count, builders_[0], contacts, chunk_contacts_[0].reuse, chunk_contacts_[0].frontier);
   } else {
     // The builders take turns at the chunks, so each one's scratch grows to
     // what any part of the pair list needs and then allocates no more.
@@ -164,7 +198,8 @@ void Physics::buildContacts(const StepContext& step) {
       std::vector<Contact>& chunk = chunk_contacts_[k].contacts;
       chunk.clear();
       const auto [first, last] = chunkRange(count, k, chunks);
-      appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk, chunk_contacts_[k].reuse);
+      appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk, chunk_contacts_[k].reuse,
+                     chunk_contacts_[k].frontier);
     }, Team::Claim::Balanced);
     for (std::size_t k = 0; k < chunks; ++k) {
       const std::vector<Contact>& chunk = chunk_contacts_[k].contacts;
@@ -178,6 +213,13 @@ void Physics::buildContacts(const StepContext& step) {
     pair_cache_.commit(reuse_pending_.data(), chunks);
   } else {
     pair_cache_.clear();
+  }
+  // Unlimited ticks keep the frontier entries as they are: they stay valid
+  // while their bodies stay put, and a limited tick finds them again.
+  if (step.steady_frontier) {
+    reuse_pending_.clear();
+    for (std::size_t k = 0; k < chunks; ++k) reuse_pending_.push_back(&chunk_contacts_[k].frontier);
+    frontier_cache_.commit(reuse_pending_.data(), chunks);
   }
 }
 

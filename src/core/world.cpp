@@ -526,6 +526,7 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
   const std::size_t chunks = narrowChunkCount(static_cast<std::size_t>(workers_.threads()), limited);
   assert(chunks <= narrow_chunks_.size());
   narrow_chunks_used_ = chunks;
+  narrow_limited_ = limited;
   workers_.forChunks(chunks, [&](std::size_t k, std::size_t) {
     NarrowChunk& chunk = narrow_chunks_[k];
     const auto [first, last] = chunkRange(pair_count_, k, chunks);
@@ -593,6 +594,7 @@ void World::response(double dt, const Budget& budget, const Deadline& tick_end, 
   step.dt = dt;
   step.budget.max_iterations = budget.solver_iterations;
   step.budget.deadline = tick_end;
+  step.steady_frontier = narrow_limited_;
   physics_.buildContacts(step);
   report.contacts_s = clock_() - start;
   physics_.solve(step);

@@ -256,6 +256,51 @@ TEST(PairContactCache, ARestingCubeReusesItsContactsAndRestsWhereItWouldHave) {
   EXPECT_LT(a.pose.orientation.angularDistance(b.pose.orientation), 1e-3);
 }
 
+// Under a limited narrow phase a pair reached at its leaves in one tick and
+// at its roots in the next keeps its leaf contacts, placed anew, while its
+// bodies stay put (Physics::kFrontierTolerance; without contact reuse); moved
+// away, it takes its roots' again. A pile whose budget varies from tick to
+// tick flowed on frontier contacts that changed with it
+// (docs/error_vs_runtime.md).
+TEST(SteadyFrontier, AnUnresolvedPairKeepsItsDeepestContactsWhileItStaysPut) {
+  World w = cubeOnPlate(0.0);
+  for (int t = 0; t < 120; ++t) w.step(kDt, Budget::unlimited());  // at rest on the plate
+  const TickReport leaves = w.step(kDt, Budget::ofSphereTests(std::int64_t{1} << 40));  // limited, never reached
+  ASSERT_EQ(leaves.unresolved, 0u);
+  const std::vector<Contact> resolved = w.contacts();
+  ASSERT_FALSE(resolved.empty());
+  const int leaf_level = resolved.front().level;
+  ASSERT_GT(leaf_level, 0);
+
+  const TickReport roots = w.step(kDt, Budget::ofSphereTests(0));
+  ASSERT_EQ(roots.unresolved, 1u);
+  ASSERT_EQ(w.contacts().size(), resolved.size());
+  for (std::size_t k = 0; k < resolved.size(); ++k) {
+    const Contact& c = w.contacts()[k];
+    EXPECT_EQ(c.level, leaf_level) << "the leaves' contacts, not the roots'";
+    EXPECT_TRUE(c.resolved);
+    EXPECT_EQ(c.node_a, resolved[k].node_a);
+    EXPECT_EQ(c.node_b, resolved[k].node_b);
+    EXPECT_LT((c.point - resolved[k].point).norm(), 1e-3);
+    EXPECT_GT(c.normal.dot(resolved[k].normal), 0.9999);
+  }
+  const Vec3 rest = w.bodies()[1].pose.position;
+
+  // Moved by more than the tolerance, the pair is taken at its roots.
+  w.bodies()[1].pose.position += Vec3(0.05, 0.0, 0.0);
+  w.step(kDt, Budget::ofSphereTests(0));
+  ASSERT_FALSE(w.contacts().empty());
+  for (const Contact& c : w.contacts()) {
+    EXPECT_EQ(c.level, 0);
+    EXPECT_FALSE(c.resolved);
+  }
+  // Back where it rested it does not find the leaves' contacts again: the
+  // tick at the moved pose replaced them with its roots'.
+  w.bodies()[1].pose.position = rest;
+  w.step(kDt, Budget::ofSphereTests(0));
+  for (const Contact& c : w.contacts()) EXPECT_EQ(c.level, 0);
+}
+
 TEST(PairContactCache, AMovedBodyNewOptionsOrANewStaticBodyRebuild) {
   World w = cubeOnPlate(0.05);
   for (int t = 0; t < 150; ++t) w.step(kDt, Budget::unlimited());
