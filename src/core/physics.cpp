@@ -118,6 +118,15 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
       if (kept != PairContactCache::kNone && frontier_cache_.entry(kept).level > tests[i].deepestLevel()) {
         frontier_cache_.place(kept, placedBase(tests[i], ia, ib, priorities[i]), *tests[i].bodyA().pose,
                               *tests[i].bodyB().pose, out);
+        // Where the contacts act, their separations and bounds are the
+        // deeper frontier's (a leaf point's overlap was proven at a pose
+        // within the tolerance, and pushes apart; a frontier point's does
+        // not: place()). The level is this tick's, and the pair unresolved,
+        // so that the levels still show where the narrow phase went.
+        for (std::size_t k = before; k < out.size(); ++k) {
+          out[k].level = std::max(0, tests[i].deepestLevel());
+          out[k].resolved = false;
+        }
         frontier_cache_.carry(kept, frontier);
         continue;
       }
@@ -179,14 +188,19 @@ void Physics::buildContacts(const StepContext& step) {
   const std::size_t chunks = threads > 1 && count >= kPairsPerTask ? kChunksPerThread * threads : 1;
   if (builders_.size() < chunks) builders_.resize(chunks);
   if (chunk_contacts_.size() < chunks) chunk_contacts_.resize(chunks);
-  if (step.steady_frontier) {  // sized by the pairs: a tick with more entries than any before allocates nothing
+  // Sized by the pairs: each pair keeps its deepest contacts, so the count
+  // creeps up as the gaze passes over a pile; a tick with more entries or
+  // contacts than any before then allocates nothing.
+  if (step.steady_frontier) {
     const std::size_t points_per_pair = static_cast<std::size_t>(std::max(1, step.options->max_contacts_per_pair));
     for (std::size_t k = 0; k < chunks; ++k) {
       const auto [first, last] = chunkRange(count, k, chunks);
       growCapacity(chunk_contacts_[k].frontier.entries, last - first);
       growCapacity(chunk_contacts_[k].frontier.points, (last - first) * points_per_pair);
+      if (chunks > 1) growCapacity(chunk_contacts_[k].contacts, (last - first) * points_per_pair);
     }
     frontier_cache_.reserve(count, count * points_per_pair);
+    growCapacity(contacts, count * points_per_pair);
   }
   if (chunks == 1) {
     appendContacts(step, 0, count, builders_[0], contacts, chunk_contacts_[0].reuse, chunk_contacts_[0].frontier);
