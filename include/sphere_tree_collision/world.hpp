@@ -318,7 +318,6 @@ class World {
   // tests point at them).
   std::vector<NarrowChunk> narrow_chunks_;
   std::size_t narrow_chunks_used_ = 1;  // by the last narrow phase
-  bool narrow_limited_ = false;          // the last narrow phase had a budget (StepContext::steady_frontier)
   Perception perception_;
   std::vector<PairTest> pair_tests_;  // pooled: capacity kept between ticks
   std::size_t pair_count_ = 0;

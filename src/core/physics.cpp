@@ -17,6 +17,17 @@ constexpr double kRestingFallTicks = 4.0;
 constexpr std::size_t kPairsPerTask = 64;
 constexpr std::size_t kChunksPerThread = 4;  // contact building
 
+// What a cache's placed contacts of the pair of `test` take from the pair now.
+Contact placedBase(const PairTest& test, std::uint32_t ia, std::uint32_t ib, double priority) {
+  Contact base;
+  base.a = test.bodyA().id;
+  base.b = test.bodyB().id;
+  base.index_a = ia;
+  base.index_b = ib;
+  base.priority = priority;
+  return base;
+}
+
 }  // namespace
 
 void Physics::integrate(const StepContext& step) {
@@ -69,21 +80,6 @@ ReuseBody Physics::reuseBody(const StepContext& step, std::uint32_t index) const
 std::uint32_t Physics::reusableEntry(const StepContext& step, std::uint32_t ia, std::uint32_t ib) const {
   return pair_cache_.find(reuseBody(step, ia), reuseBody(step, ib), step.dt);
 }
-
-namespace {
-
-// What a cache's placed contacts of the pair of `test` take from the pair now.
-Contact placedBase(const PairTest& test, std::uint32_t ia, std::uint32_t ib, double priority) {
-  Contact base;
-  base.a = test.bodyA().id;
-  base.b = test.bodyB().id;
-  base.index_a = ia;
-  base.index_b = ib;
-  base.priority = priority;
-  return base;
-}
-
-}  // namespace
 
 // The contacts of pairs [first, last) appended to `out` in pair order.
 void Physics::appendContacts(const StepContext& step, std::size_t first, std::size_t last,

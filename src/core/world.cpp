@@ -24,6 +24,13 @@ constexpr double kReserveDecay = 0.95;
 // and a p99 of 1.14-1.17 x, 1.25 0.2-0.6% and 0.96-1.06 x (2026-12-04).
 constexpr double kReserveMargin = 1.25;
 
+// Whether the narrow phase has a limit this tick: its own time, the tick's
+// deadline or a sphere-test count (then pairs may be left unresolved).
+bool narrowPhaseLimited(const Budget& budget, const Deadline& tick_end) {
+  return budget.seconds < std::numeric_limits<double>::infinity() || tick_end.isSet() ||
+         budget.sphere_tests < std::numeric_limits<std::int64_t>::max();
+}
+
 // Auto box mode: a shape whose occupied extent is this much longer along its
 // longest axis than along its shortest gets a dynamic box (paper 3.2: long,
 // thin objects are bounded badly by a fixed cube). With the presets at
@@ -521,12 +528,10 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
   // test, its contacts carried over (pair_contact_cache.hpp).
   StepContext step = physicsStep();
   step.dt = dt;
-  const bool limited = end < std::numeric_limits<double>::infinity() ||
-                       budget.sphere_tests < std::numeric_limits<std::int64_t>::max();
+  const bool limited = narrowPhaseLimited(budget, tick_end);
   const std::size_t chunks = narrowChunkCount(static_cast<std::size_t>(workers_.threads()), limited);
   assert(chunks <= narrow_chunks_.size());
   narrow_chunks_used_ = chunks;
-  narrow_limited_ = limited;
   workers_.forChunks(chunks, [&](std::size_t k, std::size_t) {
     NarrowChunk& chunk = narrow_chunks_[k];
     const auto [first, last] = chunkRange(pair_count_, k, chunks);
@@ -594,7 +599,7 @@ void World::response(double dt, const Budget& budget, const Deadline& tick_end, 
   step.dt = dt;
   step.budget.max_iterations = budget.solver_iterations;
   step.budget.deadline = tick_end;
-  step.steady_frontier = narrow_limited_;
+  step.steady_frontier = narrowPhaseLimited(budget, tick_end);
   physics_.buildContacts(step);
   report.contacts_s = clock_() - start;
   physics_.solve(step);
