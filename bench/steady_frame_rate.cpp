@@ -11,8 +11,9 @@
 // names them at every tick they are outside, from the first, with what that
 // tick did). Target: p99 whole tick <= 1.1 x budget. And whether the scene
 // came to rest as it does without a budget: movers asleep and moving at the
-// end, their mean height, and how many contacts a tick came from unresolved
-// pairs and from their root spheres.
+// end, their mean height, how many contacts a tick came from unresolved
+// pairs and from their root spheres, and how many unresolved pairs a tick kept
+// a deeper frontier's contacts (TickReport::frontier_kept).
 //
 // The budget runs on the thread's CPU clock by default (World::setClock), so
 // the other processes of a shared machine do not eat it; --wall-clock runs it
@@ -67,6 +68,7 @@ struct Run {
   // unresolved pairs, and of those the ones built from the root spheres
   // (level 0). Per tick they swing with what the narrow phase got.
   double contacts = 0.0, unresolved_contacts = 0.0, root_contacts = 0.0;
+  double frontier_kept = 0.0;  // pairs a tick (mean) that kept a deeper frontier's contacts
 };
 
 constexpr double kMovedMetres = 0.02;
@@ -120,6 +122,7 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
     run.position_passes.push_back(r.position_passes);
     run.unresolved_share.push_back(r.broad_pairs ? double(r.unresolved) / double(r.broad_pairs) : 0.0);
     run.interrupted += r.interrupted ? 1 : 0;
+    run.frontier_kept += static_cast<double>(r.frontier_kept);
     for (const Contact& c : world.contacts()) {  // outside the timed part
       run.contacts += 1.0;
       if (c.resolved) continue;
@@ -143,6 +146,7 @@ Run simulate(SceneKind kind, int entities, double seconds, const Budget& budget,
     run.contacts /= ticks;
     run.unresolved_contacts /= ticks;
     run.root_contacts /= ticks;
+    run.frontier_kept /= ticks;
   }
   // One pass over the movers at the end: their state, where they are, and
   // whether they went anywhere in the last second (a NaN pose counts as moved).
@@ -247,13 +251,14 @@ int main(int argc, char** argv) {
         "| CPU less integrate | integrate | broad | narrow "
         "| narrow got | response | reserve | velocity passes p50 / min | position passes p50 / min "
         "| interrupted | unresolved p50 | NaN | outside | asleep at end | moved > 2 cm in the last s "
-        "| mean height at end, m | contacts a tick (mean): all / unresolved / at the roots |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "| mean height at end, m | contacts a tick (mean): all / unresolved / at the roots "
+        "| pairs a tick that kept a deeper frontier (mean) |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Run& r : runs) {
     const auto min_of = [](const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); };
     std::snprintf(buf, sizeof buf,
                   "| %s | %d | %s | %s | %.2f | %.1f%% | %s | %s | %s | %s | %s | %s | %s | %.0f / %.0f | %.0f / %.0f "
-                  "| %.1f%% | %.1f%% | %zu | %zu | %zu | %zu | %.2f | %.0f / %.0f / %.0f |\n",
+                  "| %.1f%% | %.1f%% | %zu | %zu | %zu | %zu | %.2f | %.0f / %.0f / %.0f | %.1f |\n",
                   r.scene.c_str(), r.bodies, pct(r.cpu).c_str(), pct(r.wall).c_str(),
                   budget_off ? NAN : percentile(r.cpu, 0.99) / (budget_ms * 1e-3),
                   100.0 * static_cast<double>(std::count_if(r.cpu.begin(), r.cpu.end(),
@@ -266,7 +271,7 @@ int main(int argc, char** argv) {
                   percentile(r.position_passes, 0.5), min_of(r.position_passes),
                   100.0 * r.interrupted / static_cast<double>(r.cpu.size()),
                   100.0 * percentile(r.unresolved_share, 0.5), r.non_finite, r.outside, r.asleep, r.moving,
-                  r.mean_height, r.contacts, r.unresolved_contacts, r.root_contacts);
+                  r.mean_height, r.contacts, r.unresolved_contacts, r.root_contacts, r.frontier_kept);
     md += buf;
   }
   std::printf("%s", md.c_str());

@@ -61,6 +61,9 @@ struct StepContext {
 struct PhysicsReport {
   SweepStats sweep;
   SolveStats solve;
+  // Accepted unresolved pairs that kept a deeper frontier's contacts this tick
+  // (steady_frontier; Physics::kFrontierTolerance).
+  std::size_t frontier_kept = 0;
 };
 
 class Physics {
@@ -115,13 +118,6 @@ class Physics {
   static constexpr double kFrontierTolerance = 0.5;
 
  private:
-  // Also records the pairs' cache entries into `reuse` when step.reused is set.
-  // And the pairs' frontier entries into `frontier` when step.steady_frontier is set.
-  void appendContacts(const StepContext& step, std::size_t first, std::size_t last, ContactBuilder& builder,
-                      std::vector<Contact>& out, PairContactCache::Pending& reuse,
-                      PairContactCache::Pending& frontier) const;
-  ReuseBody reuseBody(const StepContext& step, std::uint32_t index) const;
-
   // A builder (its scratch) and the contacts of each chunk of the pairs
   // (parallel contact building); capacity kept between ticks.
   std::vector<ContactBuilder> builders_;
@@ -129,7 +125,15 @@ class Physics {
     std::vector<Contact> contacts;
     PairContactCache::Pending reuse;  // the chunk's pairs' cache entries for the next tick
     PairContactCache::Pending frontier;  // ... and their frontier entries (steady_frontier)
+    std::size_t frontier_kept = 0;       // its pairs that kept a deeper frontier's contacts
   };
+  // Also records the pairs' cache entries into chunk.reuse when step.reused is
+  // set, and their frontier entries into chunk.frontier (counting the kept ones)
+  // when step.steady_frontier is set.
+  void appendContacts(const StepContext& step, std::size_t first, std::size_t last, ContactBuilder& builder,
+                      std::vector<Contact>& out, ChunkContacts& chunk) const;
+  ReuseBody reuseBody(const StepContext& step, std::uint32_t index) const;
+
   std::vector<ChunkContacts> chunk_contacts_;
   std::size_t builder_turn_ = 0;
   ContactSolver solver_;

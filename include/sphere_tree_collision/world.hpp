@@ -115,6 +115,7 @@ struct TickReport {
   std::size_t separate = 0;             // resolved separate
   std::size_t unresolved = 0;           // left unresolved at interruption
   std::size_t unresolved_accepted = 0;  // of those, accepted as colliding (policy accept)
+  std::size_t frontier_kept = 0;        // of those, kept a deeper frontier's contacts (Physics::kFrontierTolerance)
   std::int64_t sphere_tests = 0;
   bool interrupted = false;
   bool perception_used = false;         // false without a fixation: no projection work

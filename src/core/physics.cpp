@@ -83,8 +83,7 @@ std::uint32_t Physics::reusableEntry(const StepContext& step, std::uint32_t ia, 
 
 // The contacts of pairs [first, last) appended to `out` in pair order.
 void Physics::appendContacts(const StepContext& step, std::size_t first, std::size_t last,
-                             ContactBuilder& builder, std::vector<Contact>& out,
-                             PairContactCache::Pending& reuse, PairContactCache::Pending& frontier) const {
+                             ContactBuilder& builder, std::vector<Contact>& out, ChunkContacts& chunk) const {
   const ResponseOptions& options = *step.options;
   const std::vector<PairTest>& tests = *step.tests;
   const std::vector<std::array<std::uint32_t, 2>>& pair_bodies = *step.pair_bodies;
@@ -95,8 +94,11 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
   build.max_contacts_per_pair = options.max_contacts_per_pair;
   build.accept_unresolved = step.accept_unresolved;
   build.face_normals = options.face_normals;
+  PairContactCache::Pending& reuse = chunk.reuse;
+  PairContactCache::Pending& frontier = chunk.frontier;
   reuse.clear();
   frontier.clear();
+  chunk.frontier_kept = 0;
   for (std::size_t i = first; i < last; ++i) {
     const std::uint32_t ia = pair_bodies[i][0];
     const std::uint32_t ib = pair_bodies[i][1];
@@ -124,6 +126,7 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
           out[k].resolved = false;
         }
         frontier_cache_.carry(kept, frontier);
+        ++chunk.frontier_kept;
         continue;
       }
     }
@@ -199,7 +202,7 @@ void Physics::buildContacts(const StepContext& step) {
     growCapacity(contacts, count * points_per_pair);
   }
   if (chunks == 1) {
-    appendContacts(step, 0, count, builders_[0], contacts, chunk_contacts_[0].reuse, chunk_contacts_[0].frontier);
+    appendContacts(step, 0, count, builders_[0], contacts, chunk_contacts_[0]);
   } else {
     // The builders take turns at the chunks, so each one's scratch grows to
     // what any part of the pair list needs and then allocates no more.
@@ -208,8 +211,7 @@ void Physics::buildContacts(const StepContext& step) {
       std::vector<Contact>& chunk = chunk_contacts_[k].contacts;
       chunk.clear();
       const auto [first, last] = chunkRange(count, k, chunks);
-      appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk, chunk_contacts_[k].reuse,
-                     chunk_contacts_[k].frontier);
+      appendContacts(step, first, last, builders_[(k + builder_turn_) % chunks], chunk, chunk_contacts_[k]);
     }, Team::Claim::Balanced);
     for (std::size_t k = 0; k < chunks; ++k) {
       const std::vector<Contact>& chunk = chunk_contacts_[k].contacts;
@@ -226,9 +228,13 @@ void Physics::buildContacts(const StepContext& step) {
   }
   // Unlimited ticks keep the frontier entries as they are: they stay valid
   // while their bodies stay put, and a limited tick finds them again.
+  report_.frontier_kept = 0;
   if (step.steady_frontier) {
     reuse_pending_.clear();
-    for (std::size_t k = 0; k < chunks; ++k) reuse_pending_.push_back(&chunk_contacts_[k].frontier);
+    for (std::size_t k = 0; k < chunks; ++k) {
+      reuse_pending_.push_back(&chunk_contacts_[k].frontier);
+      report_.frontier_kept += chunk_contacts_[k].frontier_kept;
+    }
     frontier_cache_.commit(reuse_pending_.data(), chunks);
   }
 }

@@ -602,6 +602,7 @@ void World::response(double dt, const Budget& budget, const Deadline& tick_end, 
   step.steady_frontier = narrowPhaseLimited(budget, tick_end);
   physics_.buildContacts(step);
   report.contacts_s = clock_() - start;
+  report.frontier_kept = physics_.lastReport().frontier_kept;
   physics_.solve(step);
   const SolveStats& stats = physics_.lastReport().solve;
   report.velocity_passes = stats.velocity_passes;

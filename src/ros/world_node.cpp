@@ -330,6 +330,7 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.separate = static_cast<std::uint32_t>(r.separate);
   s.unresolved = static_cast<std::uint32_t>(r.unresolved);
   s.unresolved_accepted = static_cast<std::uint32_t>(r.unresolved_accepted);
+  s.frontier_kept = static_cast<std::uint32_t>(r.frontier_kept);
   s.sphere_tests = r.sphere_tests;
   s.interrupted = r.interrupted;
   s.geometric_inaccuracy = r.geometric_inaccuracy;

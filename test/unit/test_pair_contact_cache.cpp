@@ -269,12 +269,14 @@ TEST(SteadyFrontier, AnUnresolvedPairKeepsItsDeepestContactsWhileItStaysPut) {
   for (int t = 0; t < 120; ++t) w.step(kDt, Budget::unlimited());  // at rest on the plate
   const TickReport leaves = w.step(kDt, Budget::ofSphereTests(std::int64_t{1} << 40));  // limited, never reached
   ASSERT_EQ(leaves.unresolved, 0u);
+  EXPECT_EQ(leaves.frontier_kept, 0u);
   const std::vector<Contact> resolved = w.contacts();
   ASSERT_FALSE(resolved.empty());
   ASSERT_GT(resolved.front().level, 0);
 
   const TickReport roots = w.step(kDt, Budget::ofSphereTests(0));
   ASSERT_EQ(roots.unresolved, 1u);
+  EXPECT_EQ(roots.frontier_kept, 1u);
   ASSERT_EQ(w.contacts().size(), resolved.size());
   for (std::size_t k = 0; k < resolved.size(); ++k) {
     const Contact& c = w.contacts()[k];
@@ -290,7 +292,7 @@ TEST(SteadyFrontier, AnUnresolvedPairKeepsItsDeepestContactsWhileItStaysPut) {
 
   // Moved by more than the tolerance, the pair is taken at its roots.
   w.bodies()[1].pose.position += Vec3(0.05, 0.0, 0.0);
-  w.step(kDt, Budget::ofSphereTests(0));
+  EXPECT_EQ(w.step(kDt, Budget::ofSphereTests(0)).frontier_kept, 0u);
   ASSERT_FALSE(w.contacts().empty());
   for (const Contact& c : w.contacts()) {
     EXPECT_EQ(c.node_a, 0) << "the roots' contact";
