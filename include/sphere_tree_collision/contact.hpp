@@ -15,7 +15,12 @@ struct Contact {
   Vec3 point = Vec3::Zero();
   Vec3 normal = Vec3::UnitZ();  // unit, from a towards b
   double depth = 0.0;           // sphere overlap along the normal (>= 0)
-  double gap_bound = 0.0;       // h_a + h_b of the sphere pair: the true gap is at most this
+  double gap_bound = 0.0;       // h_a + h_b of the pair's frontier this tick: the true gap is at most this
+  // h_a + h_b of the frontier the contact's spheres were found at: gap_bound,
+  // but for a contact an unresolved pair kept from a deeper frontier of an
+  // earlier tick (Physics' steady frontier), that frontier's. The scale of the
+  // solver's slop and of its warm-start match.
+  double sphere_bound = 0.0;
   int level = 0;                // deepest tree level the pair reached
   bool resolved = false;        // true: found at the leaves; false: accepted unresolved
   double priority = 0.0;        // perceptual priority f(e, g) (0 without gaze)

@@ -35,7 +35,7 @@ class PairContactCache {
   // frame and the normal in A's frame, as built.
   struct Point {
     Vec3 on_a, on_b, normal_in_a;
-    double depth = 0.0, separation = 0.0, gap_bound = 0.0;
+    double depth = 0.0, separation = 0.0, sphere_bound = 0.0;
     std::int32_t node_a = 0, node_b = 0;
     int level = 0;
     bool resolved = true;  // found at the leaves (an unresolved pair's frontier: false)

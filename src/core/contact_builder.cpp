@@ -467,6 +467,7 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
     // differs point by point let position correction lift a rolling link
     // a little every tick (config/meshes.yaml's link rolled off the floor).
     contact.gap_bound = test.gapBound();
+    contact.sphere_bound = contact.gap_bound;
     contact.level = std::max(0, test.deepestLevel());
     contact.resolved = status == PairStatus::Colliding;
     contact.priority = priority;

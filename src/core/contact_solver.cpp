@@ -241,7 +241,7 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     const double s = c.separation;
     row.speculative = s > 0.0 ? s / dt : 0.0;
     const double slop = options.allowed_penetration > 0.0 ? options.allowed_penetration
-                                                          : 0.02 * c.gap_bound;
+                                                          : 0.02 * c.sphere_bound;
     if (s < -slop) {
       info.push = options.position_correction * (-s - slop) / dt;
     } else {
@@ -476,7 +476,7 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
           ++feature_hits;
         } else {
           const Vec3 local = to_a * (c.point - ba.pose.position);
-          const double tolerance = std::max(0.5 * c.gap_bound, 1e-12);
+          const double tolerance = std::max(0.5 * c.sphere_bound, 1e-12);
           double best_d = tolerance * tolerance;
           for (std::uint32_t j = 0; j < old_count; ++j) {
             if (used >> j & 1u) continue;

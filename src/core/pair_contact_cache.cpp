@@ -67,7 +67,7 @@ void PairContactCache::place(std::uint32_t index, const Contact& base, const Pos
     c.separation = (on_b - on_a).dot(c.normal);
     c.point = 0.5 * (on_a + on_b);
     c.depth = std::max(p.depth - (c.separation - p.separation), 0.0);
-    c.gap_bound = p.gap_bound;
+    c.gap_bound = c.sphere_bound = p.sphere_bound;
     c.level = p.level;
     c.resolved = p.resolved;
     if (!p.resolved) c.separation = std::max(c.separation, 0.0);
@@ -102,7 +102,7 @@ void PairContactCache::record(const PairTest& test, const ReuseBody& a, const Re
     p.normal_in_a = to_a * c->normal;
     p.depth = c->depth;
     p.separation = c->separation;
-    p.gap_bound = c->gap_bound;
+    p.sphere_bound = c->sphere_bound;
     p.node_a = c->node_a;
     p.node_b = c->node_b;
     p.level = c->level;

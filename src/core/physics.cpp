@@ -116,13 +116,15 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
       if (kept != PairContactCache::kNone && frontier_cache_.entry(kept).level > tests[i].deepestLevel()) {
         frontier_cache_.place(kept, placedBase(tests[i], ia, ib, priorities[i]), *tests[i].bodyA().pose,
                               *tests[i].bodyB().pose, out);
-        // Where the contacts act, their separations and bounds are the
-        // deeper frontier's (a leaf point's overlap was proven at a pose
+        // Where the contacts act, their separations and sphere bounds are
+        // the deeper frontier's (a leaf point's overlap was proven at a pose
         // within the tolerance, and pushes apart; a frontier point's does
-        // not: place()). The level is this tick's, and the pair unresolved,
-        // so that the levels still show where the narrow phase went.
+        // not: place()). The level, the gap bound and the status are this
+        // tick's, so that the contacts say what the tick's report sums
+        // (World::narrowPhase) and where the narrow phase went.
         for (std::size_t k = before; k < out.size(); ++k) {
           out[k].level = std::max(0, tests[i].deepestLevel());
+          out[k].gap_bound = tests[i].gapBound();
           out[k].resolved = false;
         }
         frontier_cache_.carry(kept, frontier);

@@ -25,7 +25,7 @@ inline ::testing::AssertionResult sameState(const World& x, const World& y) {
     const Contact& a = cx[k];
     const Contact& b = cy[k];
     if (a.a != b.a || a.b != b.b || a.point != b.point || a.normal != b.normal || a.separation != b.separation ||
-        a.gap_bound != b.gap_bound || a.resolved != b.resolved || a.normal_impulse != b.normal_impulse ||
+        a.gap_bound != b.gap_bound || a.sphere_bound != b.sphere_bound || a.resolved != b.resolved || a.normal_impulse != b.normal_impulse ||
         a.friction_impulse != b.friction_impulse) {
       return ::testing::AssertionFailure() << "contact " << k << " differs";
     }

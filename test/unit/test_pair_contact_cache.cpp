@@ -260,8 +260,9 @@ TEST(PairContactCache, ARestingCubeReusesItsContactsAndRestsWhereItWouldHave) {
 // at its roots in the next keeps its leaf contacts (points, normals,
 // separations), placed anew, while its bodies stay put
 // (Physics::kFrontierTolerance; without contact reuse); moved away, it takes
-// its roots' again. A kept contact reports this tick's level and the pair as
-// unresolved, so the levels still show where the narrow phase went. A pile whose budget varies from tick to
+// its roots' again. A kept contact reports this tick's level, gap bound and
+// the pair as unresolved, so the levels still show where the narrow phase
+// went and the bounds add up to the tick's (proof_live). A pile whose budget varies from tick to
 // tick flowed on frontier contacts that changed with it
 // (docs/error_vs_runtime.md).
 TEST(SteadyFrontier, AnUnresolvedPairKeepsItsDeepestContactsWhileItStaysPut) {
@@ -287,6 +288,11 @@ TEST(SteadyFrontier, AnUnresolvedPairKeepsItsDeepestContactsWhileItStaysPut) {
     EXPECT_EQ(c.level, 0);
     EXPECT_FALSE(c.resolved);
     EXPECT_NEAR(c.separation, resolved[k].separation, 1e-3);
+    // Its gap bound is this tick's roots', the one the report sums (the
+    // error_bounds markers draw it); the solver's scale stays the leaves'.
+    EXPECT_EQ(c.gap_bound, roots.geometric_bound);
+    EXPECT_EQ(c.sphere_bound, resolved[k].gap_bound);
+    EXPECT_GT(c.gap_bound, c.sphere_bound);
   }
   const Vec3 rest = w.bodies()[1].pose.position;
 
