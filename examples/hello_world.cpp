@@ -1,8 +1,9 @@
 // hello_world: the ROS-free core on one page. A static floor, a stack of three
 // cubes and four rocks dropped beside it; two seconds of 60 Hz ticks, each under
-// a budget of sphere tests; then the contacts and what the budget left unproven
-// (geometric inaccuracy ∇ and perceived inaccuracy P). Exits 1 when the stack
-// does not stand on the floor.
+// a budget of sphere tests. Prints every 20th tick's report (contacts, and what
+// the budget left unproven: geometric inaccuracy ∇ and perceived inaccuracy P)
+// and one tick's contacts. Exits 1 when a body is not finite or the stack does
+// not stand on the floor.
 #include "sphere_tree_collision/world.hpp"
 
 #include <cmath>
