@@ -81,9 +81,11 @@ WORDS = {"half": 0.5}
 
 
 def find(root, path, pattern):
-    """(value, line number, line) of the first match, or None."""
+    """(value, line number, line) of the first match, or None. A space in the
+    pattern matches any run of white space, line breaks included, so a
+    reflowed doc line still matches."""
     text = (root / path).read_text(encoding="utf-8")
-    match = re.search(pattern, text, re.MULTILINE)
+    match = re.search(pattern.replace(" ", r"\s+"), text, re.MULTILINE)
     if not match:
         return None
     raw = match.group(1)
