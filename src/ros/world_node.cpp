@@ -146,7 +146,7 @@ stc::Pose WorldNode::loadScene() {
     }
     std::vector<stc::EntityId> ids;
     try {
-      ids = addScene(world_, scene);
+      ids = addScene(world_, scene, params_.defaults);
     } catch (const stc::InputError& e) {
       throw stc::InputError("scene " + e.field(), reasonOf(e));
     }
@@ -433,10 +433,10 @@ void WorldNode::rejectUnexpected(Input input) {
 stc::EntityId WorldNode::spawnEntity(const sphere_tree_collision::SpawnEntity& msg) {
   const bool is_preset = !msg.preset.empty() || !msg.mesh_resource.empty();  // sized by resolution, not dims
   try {
-    EntityRequest request = toEntityRequest(msg, params_.default_resolution);
+    EntityRequest request = toEntityRequest(msg);
     const std::string name = request.spec.name;
     const std::optional<Rgba> color = request.color;
-    const stc::EntityId id = addRequest(world_, std::move(request));
+    const stc::EntityId id = addRequest(world_, std::move(request), params_.defaults);
     remember(id, name, color);
     ROS_DEBUG("spawned entity %u (%s)", id, frames_[id].c_str());
     return id;
@@ -529,21 +529,12 @@ void WorldNode::setFixation(double x, double y, const ros::Time& stamp, const ch
   if (y < 0.0 || y > camera.height) {
     throw stc::InputError(y_field, "off screen: " + std::to_string(y) + " outside [0, " + std::to_string(camera.height) + "]");
   }
-  // In doubles: ros::Time / ros::Duration arithmetic throws near the ends of
-  // their range (stamp.sec = 4294967295), a double difference never does.
-  const double now = clock_.now().toSec();
-  const double when = stamp.isZero() ? now : stamp.toSec();
-  const double age = now - when;
-  if (age > params_.gaze_timeout) {
-    throw stc::InputError("header.stamp", "stale: " + std::to_string(age) + " s old (~gaze_timeout " +
-                                              std::to_string(params_.gaze_timeout) + " s)");
-  }
-  if (-age > params_.gaze_timeout) {
-    throw stc::InputError("header.stamp", "in the future by " + std::to_string(-age) + " s (~gaze_timeout " +
-                                              std::to_string(params_.gaze_timeout) + " s)");
-  }
+  const ros::Time now = clock_.now();
+  const double timeout = params_.gaze_timeout;
+  const double age = checkedStampAge(stamp, now, timeout, timeout,
+                                     "~gaze_timeout " + std::to_string(timeout) + " s");
   world_.perception().setFixation(stc::Vec2(x, y));
-  gaze_expiry_s_ = when + params_.gaze_timeout;
+  gaze_expiry_s_ = now.toSec() - age + timeout;
 }
 
 void WorldNode::onGaze(const sphere_tree_collision::GazePoint& msg) {
