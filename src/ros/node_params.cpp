@@ -23,7 +23,7 @@ const std::set<std::string>& knownParams() {
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "default_density", "default_voxel_size", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
-      "min_voxel_size", "max_voxel_size", "entity_states_rate", "publish_clock", "error_report",
+      "min_voxel_size", "max_voxel_size", "entity_states_rate", "entities_rate", "publish_clock", "error_report",
       "min_piece_voxels", "small_pieces", "strength_exponent", "threads", "reuse_tolerance",
       "diagnostic_period", "camera_info_topic"};  // diagnostic_period: read by diagnostic_updater
   return kNames;
@@ -136,6 +136,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   p.rate = positiveParam(nh, "rate", p.rate);
   if (p.rate > 10000.0 || p.rate < 0.01) throw InputError("rate", "must be in [0.01, 10000] Hz");
   p.entity_states_rate = positiveParam(nh, "entity_states_rate", p.entity_states_rate);
+  p.entities_rate = positiveParam(nh, "entities_rate", p.entities_rate);
   readParam(nh, "publish_clock", p.publish_clock);
   readParam(nh, "static_tree_markers", p.static_tree_markers);
   readParam(nh, "publish_tf", p.publish_tf);

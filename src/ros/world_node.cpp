@@ -98,7 +98,7 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   clicked_sub_ = nh_.subscribe("/clicked_point", 10, &WorldNode::onClickedPoint, this);
 
   ticks_per_states_ = ticksPerMessage(params_.rate, params_.entity_states_rate);
-  entity_states_.advertise(pnh_, params_.world_frame);
+  entity_states_.advertise(pnh_, params_.world_frame, ticksPerMessage(params_.rate, params_.entities_rate));
   services_ = std::make_unique<WorldServices>(pnh_, *this);
   clock_.start(nh_, dt_, [this] { tick(); });
   ROS_INFO("collision_world_node: %zu entities from %s, %.1f Hz, scheduler %s, budget %s ms / %s sphere tests, "
@@ -196,6 +196,7 @@ void WorldNode::guarded(const char* what, F&& callback) {
 }
 
 void WorldNode::tick() {
+  ++beats_;
   if (paused_ && steps_pending_ == 0) {
     guarded("entity list", [this] { publishEntityList(); });  // inputs still change the world while paused
     return;
@@ -230,7 +231,7 @@ void WorldNode::runTick() {
   publishContacts(now);
   publishTf(now);
   markers_->onTick(tick_, report, now);
-  entity_states_.publishListIfChanged(world_, frames_, now);
+  entity_states_.publishListIfChanged(world_, frames_, now, beats_);
   if (tick_ % ticks_per_states_ == 0) entity_states_.publishStates(world_, frames_, now);
   ROS_INFO_THROTTLE(1.0,
                     "tick %llu: %zu entities, %zu broad pairs, %zu colliding, %zu unresolved (%zu accepted), "

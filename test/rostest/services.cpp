@@ -333,6 +333,27 @@ TEST_F(Services, AStampAtTheEndOfTimeIsRefusedByName) {
   EXPECT_EQ(s.response.id, 0u);
 }
 
+// Issue 47 item 4: ~entities goes out at most once every round(~rate /
+// ~entities_rate) ticks (30 / 10: 3 here), however fast the world changes. A
+// burst of ~spawn calls, each of which used to send a whole list, costs one
+// list per period. Judged by tick numbers (tick_stats), not by time.
+TEST_F(Services, TheEntityListKeepsItsRateUnderABurstOfSpawns) {
+  EXPECT_TRUE(trigger("unpause").response.success);
+  const std::uint64_t first_tick = stats_.last.tick;
+  const std::size_t lists_before = list_.count();
+  constexpr int kSpawns = 60;
+  std::uint32_t last_id = 0;
+  for (int i = 0; i < kSpawns; ++i) {
+    const Spawn s = call("spawn", cube("burst_" + std::to_string(i), 10.0 + i));
+    ASSERT_TRUE(s.response.success) << s.response.message;
+    last_id = s.response.id;
+  }
+  ASSERT_TRUE(waitForList([&](const EntityList& l) { return find(l, last_id) != nullptr; }));
+  const std::uint64_t ticks = stats_.last.tick - first_tick;
+  const std::size_t lists = list_.count() - lists_before;
+  EXPECT_LE(lists, ticks / 3 + 2) << lists << " lists over " << ticks << " ticks for " << kSpawns << " spawns";
+}
+
 TEST_F(Services, DespawnByNameAndIdAndItsFailures) {
   Spawn a = call("spawn", cube("gone_by_name", 3.0));
   Spawn b = call("spawn", cube("gone_by_id", 4.0));

@@ -35,6 +35,7 @@ struct NodeParams {
   double rate = 60.0;                // Hz, ticks
   double marker_rate = 10.0;         // Hz
   double entity_states_rate = 10.0;  // Hz, ~entity_states (only while subscribed)
+  double entities_rate = 10.0;       // Hz, ~entities at most (only when the entity set changed)
   bool publish_clock = false;        // ticks on the wall clock, stamps with physics time, which goes on /clock
   std::vector<int> marker_levels{1, 2};
   // incremental: entity geometry sent once per entity, frame-locked in its tf
