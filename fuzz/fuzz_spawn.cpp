@@ -59,7 +59,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
     const std::size_t before = world.entityCount();
     try {
-      stc_ros::addRequest(world, stc_ros::toEntityRequest(msg, 8));
+      stc_ros::addRequest(world, stc_ros::toEntityRequest(msg));
       stc_fuzz::require(world.entityCount() == before + 1, "accepted spawn did not add one entity");
     } catch (const stc::InputError&) {
       stc_fuzz::require(world.entityCount() == before, "rejected spawn changed the entity count");

@@ -16,6 +16,13 @@ struct VoxelLimits {
   double max_voxel_size = 1e3;          // metres
 };
 
+// Throws InputError("voxel_size") unless `voxel_size` is finite, > 0 and within
+// [min_voxel_size, max_voxel_size]; the message starts with `source` ("" or
+// "<file>: ") and ends with `note`. The one check of a voxel size: grids,
+// presets, meshes and requests (before any shape cache is asked) use it.
+void validateVoxelSize(double voxel_size, const VoxelLimits& limits, const std::string& source = "",
+                       const std::string& note = "");
+
 // Grid frame: voxel (i,j,k) occupies [i,i+1]x[j,j+1]x[k,k+1] * voxel_size,
 // so the grid's min corner is the origin.
 class VoxelShape {

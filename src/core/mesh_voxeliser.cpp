@@ -56,12 +56,8 @@ Grid sizeGrid(const MeshStats& stats, const VoxeliseOptions& options) {
     voxel = extent.maxCoeff() / options.resolution;
   }
   const VoxelLimits& limits = options.limits;
-  if (!std::isfinite(voxel) || voxel <= 0.0 || voxel < limits.min_voxel_size || voxel > limits.max_voxel_size) {
-    throw InputError("voxel_size", options.source + ": must be finite and within [" +
-                                       number(limits.min_voxel_size) + ", " + number(limits.max_voxel_size) +
-                                       "] m, got " + number(voxel) +
-                                       (options.voxel_size == 0.0 ? " (mesh extent / resolution)" : ""));
-  }
+  validateVoxelSize(voxel, limits, options.source + ": ",
+                    options.voxel_size == 0.0 ? " (mesh extent / resolution)" : "");
   Grid g;
   g.voxel = voxel;
   double cells = 1.0;

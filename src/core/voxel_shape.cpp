@@ -2,8 +2,21 @@
 #include "sphere_tree_collision/voxel_shape.hpp"
 
 #include <cmath>
+#include <sstream>
 
 namespace stc {
+
+void validateVoxelSize(double voxel_size, const VoxelLimits& limits, const std::string& source,
+                       const std::string& note) {
+  if (std::isfinite(voxel_size) && voxel_size > 0.0 && voxel_size >= limits.min_voxel_size &&
+      voxel_size <= limits.max_voxel_size) {
+    return;
+  }
+  std::ostringstream out;
+  out << source << "must be finite and within [" << limits.min_voxel_size << ", " << limits.max_voxel_size
+      << "] m, got " << voxel_size << note;
+  throw InputError("voxel_size", out.str());
+}
 
 VoxelShape VoxelShape::create(int nx, int ny, int nz, double voxel_size,
                               std::vector<std::uint8_t> occupancy, const VoxelLimits& limits) {
@@ -11,13 +24,7 @@ VoxelShape VoxelShape::create(int nx, int ny, int nz, double voxel_size,
     throw InputError("dims", "every grid dimension must be positive, got " + std::to_string(nx) +
                                  " x " + std::to_string(ny) + " x " + std::to_string(nz));
   }
-  if (!std::isfinite(voxel_size) || voxel_size <= 0.0 || voxel_size < limits.min_voxel_size ||
-      voxel_size > limits.max_voxel_size) {
-    throw InputError("voxel_size", "must be finite and within [" +
-                                       std::to_string(limits.min_voxel_size) + ", " +
-                                       std::to_string(limits.max_voxel_size) + "], got " +
-                                       std::to_string(voxel_size));
-  }
+  validateVoxelSize(voxel_size, limits);
   // In double: the int64 product of three ints can overflow, the double one cannot.
   const double cells = static_cast<double>(nx) * ny * nz;
   if (cells > static_cast<double>(limits.max_voxels)) {

@@ -78,8 +78,7 @@ std::string reasonOf(const stc::InputError& error) {
   return what.compare(0, prefix.size(), prefix) == 0 ? what.substr(prefix.size()) : what;
 }
 
-EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg,
-                              std::uint32_t default_resolution) {
+EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg) {
   EntityRequest r;
   r.spec.name = msg.name;
   const bool has_grid = msg.dims[0] != 0 || msg.dims[1] != 0 || msg.dims[2] != 0 || !msg.occupancy.empty();
@@ -92,17 +91,15 @@ EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg,
     r.mesh_scale = scale.isZero(0.0) ? stc::Vec3::Ones() : scale;
     r.mesh_voxel_size = msg.voxel_size;
     r.mesh_up_axis = stc::parseColladaUpAxis(msg.up_axis);
-    const std::uint32_t resolution = msg.resolution == 0 ? default_resolution : msg.resolution;
-    if (resolution > 1024) throw stc::InputError("resolution", "must be <= 1024 for a mesh");
-    r.preset_params.resolution = static_cast<int>(resolution);
+    if (msg.resolution > 1024) throw stc::InputError("resolution", "must be <= 1024 for a mesh");
+    r.preset_params.resolution = static_cast<int>(msg.resolution);  // 0: the default (addRequest)
   } else if (!msg.up_axis.empty()) {
     throw stc::InputError("up_axis", "only for a mesh_resource");
   } else if (!msg.preset.empty()) {
     if (has_grid) throw stc::InputError("preset", "give either a preset or dims + occupancy, not both");
     r.preset = msg.preset;
-    const std::uint32_t resolution = msg.resolution == 0 ? default_resolution : msg.resolution;
-    if (resolution > 4096) throw stc::InputError("resolution", "must be <= 4096");
-    r.preset_params.resolution = static_cast<int>(resolution);
+    if (msg.resolution > 4096) throw stc::InputError("resolution", "must be <= 4096");
+    r.preset_params.resolution = static_cast<int>(msg.resolution);  // 0: the default (addRequest)
     r.preset_params.voxel_size = msg.voxel_size;
     r.preset_params.seed = msg.seed;
   } else {

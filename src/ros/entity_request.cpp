@@ -60,12 +60,40 @@ stc::ShapeId gridShape(stc::World& world, ExplicitGrid grid) {
 
 }  // namespace
 
-stc::EntityId addRequest(stc::World& world, EntityRequest request) {
+stc::Quat orientationOrIdentity(const stc::Quat& q) {
+  return q.coeffs().isZero(0.0) ? stc::Quat::Identity() : q;
+}
+
+void validateText(const std::string& text, const std::string& field) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto byte = static_cast<unsigned char>(text[i]);
+    if (byte < 0x20 || byte == 0x7f) {
+      throw stc::InputError(field, "holds a control byte (" + std::to_string(byte) + ") at offset " +
+                                       std::to_string(i));
+    }
+  }
+}
+
+void applyDefaults(EntityRequest& request, const RequestDefaults& defaults) {
+  if (request.preset_params.resolution == 0) request.preset_params.resolution = defaults.resolution;
+  if (!request.preset.empty() && request.preset_params.voxel_size == 0.0) {
+    request.preset_params.voxel_size = defaults.voxel_size;
+  }
+  if (request.spec.density == 0.0) request.spec.density = defaults.density;
+  request.spec.pose.orientation = orientationOrIdentity(request.spec.pose.orientation);
+}
+
+namespace {
+
+// Every field, before any shape is looked up or built: bad input builds nothing,
+// and a cached shape answers only a valid request.
+void validateRequest(const stc::World& world, const EntityRequest& request) {
   if (!request.spec.name.empty()) validateEntityName(request.spec.name);
   if (request.spec.name.empty() == false && world.findByName(request.spec.name)) {
     throw stc::InputError("name", "'" + request.spec.name + "' is already taken");
   }
-  // Cheap state checks before any shape work: bad input builds nothing.
+  validateText(request.preset, "preset");
+  validateText(request.mesh_resource, "mesh_resource");
   const stc::EntitySpec& spec = request.spec;
   stc::validateBodyInput(spec.pose, spec.linear_velocity, spec.angular_velocity, spec.density, spec.material,
                          world.config().limits);
@@ -74,10 +102,26 @@ stc::EntityId addRequest(stc::World& world, EntityRequest request) {
       if (!(c >= 0.0f && c <= 1.0f)) throw stc::InputError("color", "components must be in [0, 1]");
     }
   }
+  const stc::VoxelLimits& voxel_limits = world.config().voxel_limits;
+  if (!request.mesh_resource.empty()) {
+    // 0: `resolution` voxels along the mesh's longest side; anything else is a size.
+    if (request.mesh_voxel_size != 0.0) stc::validateVoxelSize(request.mesh_voxel_size, voxel_limits);
+  } else if (!request.preset.empty()) {
+    stc::validateVoxelSize(request.preset_params.voxel_size, voxel_limits);
+  } else if (request.grid) {
+    stc::validateVoxelSize(request.grid->voxel_size, voxel_limits);
+  }
   if (world.entityCount() >= world.config().max_entities) {
     throw stc::InputError("max_entities", "the world already holds " +
                                               std::to_string(world.entityCount()) + " entities");
   }
+}
+
+}  // namespace
+
+stc::EntityId addRequest(stc::World& world, EntityRequest request, const RequestDefaults& defaults) {
+  applyDefaults(request, defaults);
+  validateRequest(world, request);
 
   if (!request.mesh_resource.empty()) {
     if (!request.preset.empty() || request.grid) {

@@ -17,16 +17,21 @@ const std::string& frameOf(const EntityStatePublisher::Frames& frames, stc::Enti
 
 }  // namespace
 
-void EntityStatePublisher::advertise(ros::NodeHandle& private_nh, const std::string& world_frame) {
+void EntityStatePublisher::advertise(ros::NodeHandle& private_nh, const std::string& world_frame,
+                                     std::uint64_t beats_per_list) {
   world_frame_ = world_frame;
+  beats_per_list_ = beats_per_list;
   list_pub_ = private_nh.advertise<sphere_tree_collision::EntityList>("entities", 1, true);
   states_pub_ = private_nh.advertise<sphere_tree_collision::EntityStates>("entity_states", 10);
   changed_ = true;
 }
 
-void EntityStatePublisher::publishListIfChanged(const stc::World& world, const Frames& frames, const ros::Time& stamp) {
+void EntityStatePublisher::publishListIfChanged(const stc::World& world, const Frames& frames, const ros::Time& stamp,
+                                                std::uint64_t beat) {
   if (!changed_ || !list_pub_) return;
+  if (last_list_beat_ && beat < *last_list_beat_ + beats_per_list_) return;  // sent at the next beat due
   changed_ = false;
+  last_list_beat_ = beat;
   sphere_tree_collision::EntityList list;
   list.header.stamp = stamp;
   list.header.frame_id = world_frame_;

@@ -20,10 +20,10 @@ const std::set<std::string>& knownParams() {
       "scene", "scene_entities", "scene_seed", "entity_size", "world_frame", "rate", "marker_rate", "marker_levels", "marker_mode", "marker_keyframe_period", "show_voxels", "static_tree_markers", "publish_tf",
       "max_contact_markers", "contact_marker_size", "detection_budget", "sphere_test_budget", "tick_budget", "scheduler", "queue_count", "queue_ratio",
       "unresolved_policy", "max_entities", "max_voxels", "tree_levels", "sphere_fit", "gravity",
-      "response", "solver_iterations", "gaze_timeout", "default_resolution", "camera_frame", "published_camera_frame",
+      "response", "solver_iterations", "gaze_timeout", "default_resolution", "default_density", "default_voxel_size", "camera_frame", "published_camera_frame",
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
-      "min_voxel_size", "max_voxel_size", "entity_states_rate", "publish_clock", "error_report",
+      "min_voxel_size", "max_voxel_size", "entity_states_rate", "entities_rate", "publish_clock", "error_report",
       "min_piece_voxels", "small_pieces", "strength_exponent", "threads", "reuse_tolerance",
       "diagnostic_period", "camera_info_topic"};  // diagnostic_period: read by diagnostic_updater
   return kNames;
@@ -136,6 +136,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   p.rate = positiveParam(nh, "rate", p.rate);
   if (p.rate > 10000.0 || p.rate < 0.01) throw InputError("rate", "must be in [0.01, 10000] Hz");
   p.entity_states_rate = positiveParam(nh, "entity_states_rate", p.entity_states_rate);
+  p.entities_rate = positiveParam(nh, "entities_rate", p.entities_rate);
   readParam(nh, "publish_clock", p.publish_clock);
   readParam(nh, "static_tree_markers", p.static_tree_markers);
   readParam(nh, "publish_tf", p.publish_tf);
@@ -216,8 +217,17 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   p.gravity = vec3Param(nh, "gravity");
   if (p.gravity) stc::validateGravity(*p.gravity, limits);
   readParam(nh, "error_report", p.error_report);  // opened (and so checked) by ErrorReport
-  int resolution = static_cast<int>(p.default_resolution);
-  p.default_resolution = static_cast<std::uint32_t>(intParamIn(nh, "default_resolution", resolution, 1, 4096));
+  p.defaults.resolution = intParamIn(nh, "default_resolution", p.defaults.resolution, 1, 4096);
+  p.defaults.density = positiveParam(nh, "default_density", p.defaults.density);
+  if (!(p.defaults.density >= limits.min_density && p.defaults.density <= limits.max_density)) {
+    throw InputError("default_density", "must be within [~min_density, ~max_density]");
+  }
+  p.defaults.voxel_size = positiveParam(nh, "default_voxel_size", p.defaults.voxel_size);
+  try {
+    stc::validateVoxelSize(p.defaults.voxel_size, voxels);
+  } catch (const InputError& e) {
+    throw InputError("default_voxel_size", reasonOf(e));
+  }
 
   readParam(nh, "camera_frame", p.camera.frame);
   readParam(nh, "published_camera_frame", p.camera.published_frame);

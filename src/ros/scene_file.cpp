@@ -141,7 +141,7 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
     r.preset = readString(node["preset"], p + "preset");
   }
   if (node["name"]) r.spec.name = readString(node["name"], p + "name");
-  if (node["resolution"]) r.preset_params.resolution = static_cast<int>(readInt(node["resolution"], p + "resolution", 1, 4096));
+  if (node["resolution"]) r.preset_params.resolution = static_cast<int>(readInt(node["resolution"], p + "resolution", 0, 4096));
   if (node["voxel_size"]) r.preset_params.voxel_size = readDouble(node["voxel_size"], p + "voxel_size");
   if (node["seed"]) r.preset_params.seed = static_cast<std::uint32_t>(readInt(node["seed"], p + "seed", 0, 0xffffffffll));
   if (node["position"]) r.spec.pose.position = readVec3(node["position"], p + "position");
@@ -260,6 +260,7 @@ Scene parseSceneYaml(const std::string& yaml_text) {
 }
 
 Scene loadSceneYaml(const std::string& path) {
+  validateText(path, "scene");
   std::ifstream in(path);
   if (!in) throw InputError("scene", "cannot read file '" + path + "'");
   std::stringstream text;
@@ -267,12 +268,12 @@ Scene loadSceneYaml(const std::string& path) {
   return parseSceneYaml(text.str());
 }
 
-std::vector<stc::EntityId> addScene(stc::World& world, const Scene& scene) {
+std::vector<stc::EntityId> addScene(stc::World& world, const Scene& scene, const RequestDefaults& defaults) {
   std::vector<stc::EntityId> ids;
   ids.reserve(scene.entities.size());
   for (const SceneEntry& entry : scene.entities) {
     try {
-      ids.push_back(addRequest(world, entry.request));
+      ids.push_back(addRequest(world, entry.request, defaults));
     } catch (const InputError& e) {
       throw InputError(entry.path + "." + sceneKeyOf(e.field()), reasonOf(e));
     }

@@ -1,5 +1,7 @@
 #include "sphere_tree_collision/ros/tick_clock.hpp"
 
+#include "sphere_tree_collision/types.hpp"
+
 #include <rosgraph_msgs/Clock.h>
 
 namespace stc_ros {
@@ -8,6 +10,18 @@ namespace {
 constexpr double kRealTimeWindowSeconds = 1.0;
 
 }  // namespace
+
+double checkedStampAge(const ros::Time& stamp, const ros::Time& now, double max_age, double max_ahead,
+                       const std::string& limit) {
+  const double age = stamp.isZero() ? 0.0 : now.toSec() - stamp.toSec();
+  if (age > max_age) {
+    throw stc::InputError("header.stamp", "stale: " + std::to_string(age) + " s old (" + limit + ")");
+  }
+  if (-age > max_ahead) {
+    throw stc::InputError("header.stamp", "in the future by " + std::to_string(-age) + " s (" + limit + ")");
+  }
+  return age;
+}
 
 TickClock::TickClock(ros::NodeHandle& nh, bool publish_clock)
     : publish_clock_(publish_clock), follows_clock_(!publish_clock && ros::Time::isSimTime()) {

@@ -98,7 +98,7 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   clicked_sub_ = nh_.subscribe("/clicked_point", 10, &WorldNode::onClickedPoint, this);
 
   ticks_per_states_ = ticksPerMessage(params_.rate, params_.entity_states_rate);
-  entity_states_.advertise(pnh_, params_.world_frame);
+  entity_states_.advertise(pnh_, params_.world_frame, ticksPerMessage(params_.rate, params_.entities_rate));
   services_ = std::make_unique<WorldServices>(pnh_, *this);
   clock_.start(nh_, dt_, [this] { tick(); });
   ROS_INFO("collision_world_node: %zu entities from %s, %.1f Hz, scheduler %s, budget %s ms / %s sphere tests, "
@@ -146,7 +146,7 @@ stc::Pose WorldNode::loadScene() {
     }
     std::vector<stc::EntityId> ids;
     try {
-      ids = addScene(world_, scene);
+      ids = addScene(world_, scene, params_.defaults);
     } catch (const stc::InputError& e) {
       throw stc::InputError("scene " + e.field(), reasonOf(e));
     }
@@ -196,6 +196,7 @@ void WorldNode::guarded(const char* what, F&& callback) {
 }
 
 void WorldNode::tick() {
+  ++beats_;
   if (paused_ && steps_pending_ == 0) {
     guarded("entity list", [this] { publishEntityList(); });  // inputs still change the world while paused
     return;
@@ -230,7 +231,7 @@ void WorldNode::runTick() {
   publishContacts(now);
   publishTf(now);
   markers_->onTick(tick_, report, now);
-  entity_states_.publishListIfChanged(world_, frames_, now);
+  entity_states_.publishListIfChanged(world_, frames_, now, beats_);
   if (tick_ % ticks_per_states_ == 0) entity_states_.publishStates(world_, frames_, now);
   ROS_INFO_THROTTLE(1.0,
                     "tick %llu: %zu entities, %zu broad pairs, %zu colliding, %zu unresolved (%zu accepted), "
@@ -433,10 +434,10 @@ void WorldNode::rejectUnexpected(Input input) {
 stc::EntityId WorldNode::spawnEntity(const sphere_tree_collision::SpawnEntity& msg) {
   const bool is_preset = !msg.preset.empty() || !msg.mesh_resource.empty();  // sized by resolution, not dims
   try {
-    EntityRequest request = toEntityRequest(msg, params_.default_resolution);
+    EntityRequest request = toEntityRequest(msg);
     const std::string name = request.spec.name;
     const std::optional<Rgba> color = request.color;
-    const stc::EntityId id = addRequest(world_, std::move(request));
+    const stc::EntityId id = addRequest(world_, std::move(request), params_.defaults);
     remember(id, name, color);
     ROS_DEBUG("spawned entity %u (%s)", id, frames_[id].c_str());
     return id;
@@ -529,21 +530,12 @@ void WorldNode::setFixation(double x, double y, const ros::Time& stamp, const ch
   if (y < 0.0 || y > camera.height) {
     throw stc::InputError(y_field, "off screen: " + std::to_string(y) + " outside [0, " + std::to_string(camera.height) + "]");
   }
-  // In doubles: ros::Time / ros::Duration arithmetic throws near the ends of
-  // their range (stamp.sec = 4294967295), a double difference never does.
-  const double now = clock_.now().toSec();
-  const double when = stamp.isZero() ? now : stamp.toSec();
-  const double age = now - when;
-  if (age > params_.gaze_timeout) {
-    throw stc::InputError("header.stamp", "stale: " + std::to_string(age) + " s old (~gaze_timeout " +
-                                              std::to_string(params_.gaze_timeout) + " s)");
-  }
-  if (-age > params_.gaze_timeout) {
-    throw stc::InputError("header.stamp", "in the future by " + std::to_string(-age) + " s (~gaze_timeout " +
-                                              std::to_string(params_.gaze_timeout) + " s)");
-  }
+  const ros::Time now = clock_.now();
+  const double timeout = params_.gaze_timeout;
+  const double age = checkedStampAge(stamp, now, timeout, timeout,
+                                     "~gaze_timeout " + std::to_string(timeout) + " s");
   world_.perception().setFixation(stc::Vec2(x, y));
-  gaze_expiry_s_ = when + params_.gaze_timeout;
+  gaze_expiry_s_ = now.toSec() - age + timeout;
 }
 
 void WorldNode::onGaze(const sphere_tree_collision::GazePoint& msg) {

@@ -104,6 +104,11 @@ sphere_tree_collision::SpawnEntity WorldServices::inWorldFrame(const sphere_tree
   if (!filling && !tf_buffer_->_frameExists(frame)) {
     throw stc::InputError("header.frame_id", "tf knows no frame \"" + frame + "\"");
   }
+  // A stamp tf cannot reach within the wait (or the buffer's length) is refused
+  // by name before tf's own time arithmetic overflows on it.
+  checkedStampAge(req.header.stamp, ros::Time::now(), tf_buffer_->getCacheLength().toSec(), kTfStampWaitSeconds,
+                  "tf keeps " + std::to_string(tf_buffer_->getCacheLength().toSec()) + " s; a spawn waits " +
+                      std::to_string(kTfStampWaitSeconds) + " s for a stamp ahead");
   geometry_msgs::TransformStamped t;
   try {
     t = tf_buffer_->lookupTransform(world_frame_, frame, req.header.stamp, ros::Duration(kTfStampWaitSeconds));
@@ -114,7 +119,7 @@ sphere_tree_collision::SpawnEntity WorldServices::inWorldFrame(const sphere_tree
   const stc::Vec3 translation = toEigen(t.transform.translation);
   sphere_tree_collision::SpawnEntity m = req.entity;
   // A unit rotation keeps the quaternion's norm: a bad orientation stays bad for the topic's check.
-  const stc::Quat q = toEigen(m.pose.orientation);
+  const stc::Quat q = orientationOrIdentity(toEigen(m.pose.orientation));  // left out: the frame's own
   m.pose.position = toPointMsg(rotation * toEigen(m.pose.position) + translation);
   m.pose.orientation = toQuaternionMsg(rotation * q);
   m.twist.linear = toVector3Msg(rotation * toEigen(m.twist.linear));  // the frame is taken as not moving

@@ -137,7 +137,7 @@ class TruthShapes {
  public:
   // Adds the entity of `msg` to a local World exactly as the node does.
   Truth add(const SpawnEntity& msg) {
-    const stc::EntityId local_id = stc_ros::addRequest(world_, stc_ros::toEntityRequest(msg, 8));
+    const stc::EntityId local_id = stc_ros::addRequest(world_, stc_ros::toEntityRequest(msg));
     const stc::ShapeId shape_id = world_.bodyShapes()[*world_.indexOf(local_id)];
     Truth t;
     t.shape = &world_.shape(shape_id);  // World keeps shapes in a deque: stable address

@@ -136,12 +136,13 @@ TEST_F(BadInput, EveryMalformedKindIsRejectedByFieldAndNothingChanges) {
       {"spawn", "dims", spawn([] { auto m = grid(2, 8, 1); m.dims[1] = 0; return m; }())},
       {"spawn", "resolution", spawn(spawnWith([](SpawnEntity& m) { m.resolution = 100000; }))},
       {"spawn", "pose.orientation", spawn(spawnWith([](SpawnEntity& m) { m.pose.orientation.w = 0.5; }))},
-      {"spawn", "pose.orientation", spawn(spawnWith([](SpawnEntity& m) { m.pose.orientation.w = 0.0; }))},
+      // All four zero is the identity (left out); w 0 with x 0.5 is not a rotation.
+      {"spawn", "pose.orientation", spawn(spawnWith([](SpawnEntity& m) { m.pose.orientation.w = 0.0; m.pose.orientation.x = 0.5; }))},
       {"spawn", "pose.orientation", spawn(spawnWith([](SpawnEntity& m) { m.pose.orientation.x = kNaN; }))},
       {"spawn", "preset", spawn(spawnWith([](SpawnEntity& m) { m.preset = "dodecahedron"; }))},
       {"spawn", "preset", spawn([] { auto m = grid(2, 8, 1); m.preset = "cube"; return m; }())},
       {"spawn", "preset", spawn(spawnWith([](SpawnEntity& m) { m.preset.clear(); }))},
-      {"spawn", "density", spawn(spawnWith([](SpawnEntity& m) { m.density = 0.0; }))},
+      {"spawn", "density", spawn(spawnWith([](SpawnEntity& m) { m.density = kNaN; }))},  // 0 is ~default_density
       {"spawn", "density", spawn(spawnWith([](SpawnEntity& m) { m.density = -5.0; }))},
       {"spawn", "density", spawn(spawnWith([](SpawnEntity& m) { m.density = kInf; }))},
       {"spawn", "restitution", spawn(spawnWith([](SpawnEntity& m) { m.restitution = 1.5; }))},
@@ -152,6 +153,14 @@ TEST_F(BadInput, EveryMalformedKindIsRejectedByFieldAndNothingChanges) {
       {"spawn", "name", spawn(spawnWith([](SpawnEntity& m) { m.name = "not a frame"; }))},
       {"spawn", "name", spawn(spawnWith([](SpawnEntity& m) { m.name = "entity_3"; }))},  // reserved
       {"spawn", "color", spawn(spawnWith([](SpawnEntity& m) { m.color.r = 2.0f; m.color.a = 1.0f; }))},
+      // Control bytes in strings: a path would be cut at the NUL (issue 47).
+      {"spawn", "mesh_resource", spawn([] {
+         SpawnEntity m = goodSpawn();
+         m.preset.clear();
+         m.mesh_resource = std::string("package://sphere_tree_collision/meshes/bumpy_scan.stl") + '\0' + ".obj";
+         return m;
+       }())},
+      {"spawn", "preset", spawn(spawnWith([](SpawnEntity& m) { m.preset = "cube\n"; }))},
       {"despawn", "id", [&] { sphere_tree_collision::Despawn d; d.id = 999999; despawn_.publish(d); }},
       {"despawn", "name", [&] { sphere_tree_collision::Despawn d; d.name = "nobody"; despawn_.publish(d); }},
       {"gaze", "header.stamp", [&] { gaze_.publish(gaze(100, 100, 5.0)); }},   // stale
@@ -210,6 +219,14 @@ TEST_F(BadInput, EveryMalformedKindIsRejectedByFieldAndNothingChanges) {
   // Good input still works afterwards.
   spawn_.publish(spawnWith([](SpawnEntity& m) { m.name = "late"; }));
   ASSERT_TRUE(stc_test::spinUntil([&] { return stats_.last.entities == entities + 1; }, stc_test::kLivenessSeconds));
+  // The shortest spawn: density, resolution, voxel_size and orientation left at 0 take their defaults.
+  SpawnEntity shortest;
+  shortest.name = "shortest";
+  shortest.preset = "rock";
+  shortest.pose.position.z = 2.0;
+  spawn_.publish(shortest);
+  ASSERT_TRUE(stc_test::spinUntil([&] { return stats_.last.entities == entities + 2; }, stc_test::kLivenessSeconds))
+      << "last rejection '" << stats_.last.last_rejection << "'";
   sphere_tree_collision::GazePoint good;  // stamp 0: "now" to the node, never stale however late it arrives
   good.x = 640;
   good.y = 360;

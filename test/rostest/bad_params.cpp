@@ -97,6 +97,8 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"max_speed", -1.0}}, "max_speed"},
       {world, {{"strength_exponent", -0.5}}, "strength_exponent"},
       {world, {{"min_density", 10.0}, {"max_density", 1.0}}, "min_density"},
+      {world, {{"default_density", 1e9}}, "default_density"},        // above ~max_density
+      {world, {{"default_voxel_size", 5000.0}}, "default_voxel_size"},  // above ~max_voxel_size
       {world, {{"scene", "rockfall"}, {"scene_entities", 30000}}, "scene_entities"},
       {world, {{"entity_states_rate", 0.0}}, "entity_states_rate"},
       {world, {{"entity_states_rate", "often"}}, "entity_states_rate"},
@@ -124,7 +126,7 @@ TEST(BadParams, AGoodSetKeepsRunning) {
   const Case good{"collision_world_node",
                   {{"rate", 30}, {"scheduler", "round_robin"}, {"marker_levels", list({0, 3})}, {"tick_budget", 16.7},
                    {"camera_position", list({0, -3, 1})}, {"camera_look_at", list({0, 0, 0.5})},
-                   {"reuse_tolerance", 0.05}},
+                   {"reuse_tolerance", 0.05}, {"default_density", 2500.0}, {"default_voxel_size", 0.1}},
                   ""};
   const auto [status, output] = run(good, 1000, 3.0);
   EXPECT_FALSE(status.has_value()) << "exited with " << status.value_or(-1) << ":\n" << output;

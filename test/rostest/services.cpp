@@ -61,6 +61,16 @@ class Services : public testing::Test {
     return s;
   }
 
+  // A spawn in a frame the node's tf may not know yet (stamp 0: its latest),
+  // asked again while a new listener of the node's connects.
+  Spawn spawnOnceTfKnows(Spawn s) {
+    EXPECT_TRUE(stc_test::spinUntil([&] {
+      s = call("spawn", s);
+      return s.response.success;
+    }, stc_test::kLivenessSeconds)) << s.response.message;
+    return s;
+  }
+
   // The next ~entities list for which `holds` is true.
   testing::AssertionResult waitForList(const std::function<bool(const EntityList&)>& holds) {
     if (stc_test::spinUntil([&] { return holds(list_.last); }, stc_test::kLivenessSeconds)) return testing::AssertionSuccess();
@@ -158,6 +168,18 @@ TEST_F(Services, SpawnInAnotherFrameIsResolvedByTf) {
   EXPECT_NEAR(t.transform.translation.y, 2.5, 1e-9);
   EXPECT_NEAR(t.transform.translation.z, 8.0, 1e-9);
   EXPECT_NEAR(std::abs(t.transform.rotation.z), std::sin(M_PI / 4), 1e-9);  // the shelf's turn
+  // An orientation left out (all four zero) is the identity in the request's
+  // frame: the shelf's turn, not the world's.
+  Spawn turned = cube("turned_by_shelf", -0.5);
+  turned.request.header.frame_id = "shelf";
+  turned.request.entity.pose.orientation.w = 0.0;
+  turned = call("spawn", turned);
+  ASSERT_TRUE(turned.response.success) << turned.response.message;
+  statsAfterOneStep();
+  ASSERT_TRUE(stc_test::spinUntil([&] { return tf_.canTransform("world", "turned_by_shelf", ros::Time(0)); }, stc_test::kLivenessSeconds));
+  const auto r = tf_.lookupTransform("world", "turned_by_shelf", ros::Time(0)).transform.rotation;
+  EXPECT_NEAR(std::abs(r.z), std::sin(M_PI / 4), 1e-9);
+  EXPECT_NEAR(std::abs(r.w), std::cos(M_PI / 4), 1e-9);
 
   Spawn unknown = cube("nowhere", 0.0);
   unknown.request.header.frame_id = "no_such_frame";
@@ -186,10 +208,7 @@ TEST_F(Services, SpawnWaitingForTfLeavesTheTicksRunning) {
   // while a new listener of the node's connects).
   Spawn first = cube("rider_1", 0.0);
   first.request.header.frame_id = "drifter";
-  ASSERT_TRUE(stc_test::spinUntil([&] {
-    first = call("spawn", first);
-    return first.response.success;
-  }, stc_test::kLivenessSeconds)) << first.response.message;
+  ASSERT_TRUE(spawnOnceTfKnows(first).response.success);
 
   Spawn ahead = cube("rider_2", 0.0);  // 5 m above the drifter
   ahead.request.header.frame_id = "drifter";
@@ -244,9 +263,95 @@ TEST_F(Services, SpawnFailuresNameTheFieldAndChangeNothing) {
   s = cube("bad", 0.0);
   s.request.entity.restitution = 1.5;
   expectRefused(s, "entity.restitution");
+  // 0 takes a default; negative and NaN values are still refused by field.
+  s = cube("bad", 0.0);
+  s.request.entity.voxel_size = -0.05;
+  expectRefused(s, "entity.voxel_size");
+  s = cube("bad", 0.0);
+  s.request.entity.voxel_size = std::numeric_limits<double>::quiet_NaN();
+  expectRefused(s, "entity.voxel_size");
+  s = cube("bad", 0.0);
+  s.request.entity.density = std::numeric_limits<double>::quiet_NaN();
+  expectRefused(s, "entity.density");
+  s = cube("bad", 0.0);
+  s.request.entity.friction = -0.5;
+  expectRefused(s, "entity.friction");
   EXPECT_EQ(statsAfterOneStep().entities, before);
   EXPECT_EQ(stats_.last.rejected_spawn, 0u);  // the topic's counter: services answer instead
   EXPECT_TRUE(trigger("unpause").response.success);
+}
+
+// Issue 50: the README's shortest spawn. density, resolution, voxel_size and
+// the orientation left at 0 take ~default_density (1000), ~default_resolution
+// (8), ~default_voxel_size (0.05) and the identity; restitution and friction
+// 0 are real values. The shape key says the defaults were used.
+TEST_F(Services, TheShortestSpawnTakesTheDefaults) {
+  Spawn s;
+  s.request.entity.name = "r1";
+  s.request.entity.preset = "rock";
+  s.request.entity.pose.position.z = 2.0;
+  s = call("spawn", s);
+  ASSERT_TRUE(s.response.success) << s.response.message;
+  EXPECT_EQ(s.response.frame_id, "r1");
+  ASSERT_TRUE(waitForList([&](const EntityList& l) { return find(l, s.response.id) != nullptr; }));
+  const auto* r1 = find(list_.last, s.response.id);
+  EXPECT_EQ(r1->shape, "rock/r8/v0.05/s0");
+  // The same rock, all fields given: the same shape and the same mass.
+  Spawn full = s;
+  full.request.entity.name = "r1_full";
+  full.request.entity.resolution = 8;
+  full.request.entity.voxel_size = 0.05;
+  full.request.entity.density = 1000.0;
+  full.request.entity.pose.orientation.w = 1.0;
+  full.request.entity.pose.position.x = 3.0;
+  full = call("spawn", full);
+  ASSERT_TRUE(full.response.success) << full.response.message;
+  ASSERT_TRUE(waitForList([&](const EntityList& l) { return find(l, full.response.id) != nullptr; }));
+  const auto* a = find(list_.last, s.response.id);
+  const auto* b = find(list_.last, full.response.id);
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(a->shape, b->shape);
+  EXPECT_GT(a->inertia.m, 0.0);
+  EXPECT_DOUBLE_EQ(a->inertia.m, b->inertia.m);
+}
+
+// Issue 47: a stamp at the end of ROS time, on a moving frame (the drifter,
+// sent by the node each tick), is refused naming header.stamp, not with tf's
+// "Duration is out of dual 32-bit range".
+TEST_F(Services, AStampAtTheEndOfTimeIsRefusedByName) {
+  EXPECT_TRUE(trigger("unpause").response.success);
+  Spawn known = cube("stamp_rider", 0.0);
+  known.request.header.frame_id = "drifter";
+  ASSERT_TRUE(spawnOnceTfKnows(known).response.success);
+  Spawn s = cube("stamp_end", 0.0);
+  s.request.header.frame_id = "drifter";
+  s.request.header.stamp.sec = 4294967295u;
+  s.request.header.stamp.nsec = 999999999u;
+  s = call("spawn", s);
+  EXPECT_FALSE(s.response.success);
+  EXPECT_EQ(s.response.message.rfind("header.stamp: ", 0), 0u) << s.response.message;
+  EXPECT_EQ(s.response.id, 0u);
+}
+
+// Issue 47 item 4: ~entities goes out at most once every round(~rate /
+// ~entities_rate) ticks (30 / 10: 3 here), however fast the world changes. A
+// burst of ~spawn calls, each of which used to send a whole list, costs one
+// list per period. Judged by tick numbers (tick_stats), not by time.
+TEST_F(Services, TheEntityListKeepsItsRateUnderABurstOfSpawns) {
+  EXPECT_TRUE(trigger("unpause").response.success);
+  const std::uint64_t first_tick = stats_.last.tick;
+  const std::size_t lists_before = list_.count();
+  constexpr int kSpawns = 60;
+  std::uint32_t last_id = 0;
+  for (int i = 0; i < kSpawns; ++i) {
+    const Spawn s = call("spawn", cube("burst_" + std::to_string(i), 10.0 + i));
+    ASSERT_TRUE(s.response.success) << s.response.message;
+    last_id = s.response.id;
+  }
+  ASSERT_TRUE(waitForList([&](const EntityList& l) { return find(l, last_id) != nullptr; }));
+  const std::uint64_t ticks = stats_.last.tick - first_tick;
+  const std::size_t lists = list_.count() - lists_before;
+  EXPECT_LE(lists, ticks / 3 + 2) << lists << " lists over " << ticks << " ticks for " << kSpawns << " spawns";
 }
 
 TEST_F(Services, DespawnByNameAndIdAndItsFailures) {

@@ -121,11 +121,11 @@ TEST(SpawnClosedFaces, AStaticSpawnClosesTheNamedFacesAndBadOnesAreRejectedByNam
   msg.is_static = true;
   msg.closed_faces = {"-z"};
   stc::World world;
-  EXPECT_EQ(toEntityRequest(msg, 8).spec.closed_faces, stc::faceBit(2, false));
-  ASSERT_NE(addRequest(world, toEntityRequest(msg, 8)), stc::kInvalidEntity);
+  EXPECT_EQ(toEntityRequest(msg).spec.closed_faces, stc::faceBit(2, false));
+  ASSERT_NE(addRequest(world, toEntityRequest(msg)), stc::kInvalidEntity);
   const auto field_of = [&world](const sphere_tree_collision::SpawnEntity& m) -> std::string {
     try {
-      addRequest(world, toEntityRequest(m, 8));
+      addRequest(world, toEntityRequest(m));
     } catch (const stc::InputError& e) {
       return e.field();
     }
@@ -150,14 +150,14 @@ TEST_F(MeshSpawn, SpawnMessageWithAMeshAddsItScaled) {
   msg.density = 1000.0;
   msg.pose.orientation.w = 1.0;
   stc::World world;
-  const stc::EntityId id = addRequest(world, toEntityRequest(msg, 8));
+  const stc::EntityId id = addRequest(world, toEntityRequest(msg));
   ASSERT_NE(id, stc::kInvalidEntity);
   const stc::VoxelShape& v = world.shape(world.bodyShapes()[0]).voxels;
   EXPECT_EQ(v.occupiedCount(), 4 * 4 * 4);  // 0.2 m cube at 0.05 m
 
   msg.preset = "cube";
   try {
-    toEntityRequest(msg, 8);
+    toEntityRequest(msg);
     FAIL() << "accepted a mesh and a preset";
   } catch (const stc::InputError& e) {
     EXPECT_EQ(e.field(), "mesh_resource");
@@ -175,10 +175,10 @@ TEST_F(MeshSpawn, ADaeUpAxisIsAsWrittenUnlessZUpIsAsked) {
   msg.density = 1000.0;
   msg.pose.orientation.w = 1.0;
   stc::World world;
-  addRequest(world, toEntityRequest(msg, 8));
+  addRequest(world, toEntityRequest(msg));
   msg.up_axis = "z_up";
   msg.pose.position.x = 2.0;
-  addRequest(world, toEntityRequest(msg, 8));
+  addRequest(world, toEntityRequest(msg));
   const stc::VoxelShape& as_written = world.shape(world.bodyShapes()[0]).voxels;
   const stc::VoxelShape& turned = world.shape(world.bodyShapes()[1]).voxels;
   EXPECT_EQ(as_written.nz(), 12);
@@ -204,11 +204,11 @@ TEST_F(MeshSpawn, ADaeUpAxisIsAsWrittenUnlessZUpIsAsked) {
   EXPECT_EQ(field_of([&] { parseSceneYaml("entities:\n  - {preset: cube, up_axis: z_up}\n"); }),
             "entities[0].up_axis");
   msg.up_axis = "sideways";
-  EXPECT_EQ(field_of([&] { toEntityRequest(msg, 8); }), "up_axis");
+  EXPECT_EQ(field_of([&] { toEntityRequest(msg); }), "up_axis");
   msg.mesh_resource.clear();
   msg.preset = "cube";
   msg.up_axis = "z_up";
-  EXPECT_EQ(field_of([&] { toEntityRequest(msg, 8); }), "up_axis");
+  EXPECT_EQ(field_of([&] { toEntityRequest(msg); }), "up_axis");
 }
 
 TEST_F(MeshSpawn, PackageResourcesOfUnknownPackagesAreRejected) {

@@ -42,10 +42,10 @@ std::string reasonOf(const stc::InputError& error);
 
 // A SpawnEntity message as an EntityRequest. Checks what only the message can
 // get wrong (preset and grid both or neither, dims beyond int) and throws
-// InputError named after the message field; the rest is checked by addRequest.
-// resolution 0 takes `default_resolution`; an all-zero colour means "none".
-EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg,
-                              std::uint32_t default_resolution);
+// InputError named after the message field; the rest is checked by addRequest,
+// which also gives fields left at 0 their defaults (applyDefaults). An
+// all-zero colour means "none".
+EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg);
 
 // addRequest names fields after the core (EntitySpec, VoxelShape); this gives
 // the SpawnEntity field a user wrote (e.g. "linear_velocity" -> "twist.linear").

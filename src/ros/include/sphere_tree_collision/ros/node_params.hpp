@@ -2,6 +2,7 @@
 // Every parameter is documented (name, default, meaning) in docs/ros_interface.md.
 #pragma once
 
+#include "sphere_tree_collision/ros/entity_request.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <ros/node_handle.h>
@@ -34,6 +35,7 @@ struct NodeParams {
   double rate = 60.0;                // Hz, ticks
   double marker_rate = 10.0;         // Hz
   double entity_states_rate = 10.0;  // Hz, ~entity_states (only while subscribed)
+  double entities_rate = 10.0;       // Hz, ~entities at most (only when the entity set changed)
   bool publish_clock = false;        // ticks on the wall clock, stamps with physics time, which goes on /clock
   std::vector<int> marker_levels{1, 2};
   // incremental: entity geometry sent once per entity, frame-locked in its tf
@@ -50,7 +52,9 @@ struct NodeParams {
   std::int64_t sphere_test_budget = -1;  // < 0: none
   double tick_budget_ms = 0.0;       // whole tick (integrate .. response); 0: none
   double gaze_timeout = 0.5;         // s
-  std::uint32_t default_resolution = 8;  // spawn messages with resolution 0
+  // ~default_resolution, ~default_density, ~default_voxel_size: what spawns and
+  // scene entries left at 0 (or out) get.
+  RequestDefaults defaults;
   std::optional<stc::Vec3> gravity;  // overrides the scene's
   std::string error_report;          // CSV file, a row per tick (ErrorReport); "" = none
   stc::WorldConfig world;            // scheduler, policy, tree, limits, response

@@ -6,14 +6,14 @@
 //   entities:
 //     - name: rock_1             # letters, digits, '_'; becomes the tf frame
 //       preset: rock             # cube sphere rock rod plate L ring
-//       resolution: 8            # voxels along the largest extent
-//       voxel_size: 0.05         # metres
+//       resolution: 8            # voxels along the largest extent (absent or 0: ~default_resolution)
+//       voxel_size: 0.05         # metres (absent or 0: ~default_voxel_size)
 //       seed: 1                  # rock only
 //       position: [0, 0, 1]      # of the centre of mass, world frame
 //       orientation: {rpy: [0, 0, 0]}   # or {quat: [x, y, z, w]}
 //       velocity: [0, 0, 0]
 //       angular_velocity: [0, 0, 0]
-//       density: 1000
+//       density: 1000            # kg/m^3 (absent or 0: ~default_density)
 //       restitution: 0.3
 //       friction: 0.5
 //       color: [0.8, 0.5, 0.2, 1.0]
@@ -49,8 +49,9 @@ Scene loadSceneYaml(const std::string& path);
 // The embedded default: a handful of presets spread out on a static floor.
 const std::string& defaultSceneYaml();
 
-// Adds every entity, returns their ids in scene order. Throws
+// Adds every entity (addRequest, with `defaults` for the fields left out or
+// at 0), returns their ids in scene order. Throws
 // InputError("entities[i].<field>") on the first bad one.
-std::vector<stc::EntityId> addScene(stc::World& world, const Scene& scene);
+std::vector<stc::EntityId> addScene(stc::World& world, const Scene& scene, const RequestDefaults& defaults = {});
 
 }  // namespace stc_ros

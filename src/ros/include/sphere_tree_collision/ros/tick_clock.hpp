@@ -11,8 +11,19 @@
 #include <ros/ros.h>
 
 #include <functional>
+#include <string>
 
 namespace stc_ros {
+
+// A message's header.stamp checked against `now`: its age in seconds (now -
+// stamp; a zero stamp means "now": 0). Throws InputError("header.stamp") when
+// it is older than `max_age` or ahead by more than `max_ahead` s, the message
+// ending with `limit` (e.g. "~gaze_timeout 0.5 s"). In doubles: ros::Time and
+// ros::Duration arithmetic throws near the ends of their range (stamp.sec =
+// 4294967295, "Duration is out of dual 32-bit range"); a double difference
+// never does. The one guard of the gaze topic and ~spawn's tf stamp.
+double checkedStampAge(const ros::Time& stamp, const ros::Time& now, double max_age, double max_ahead,
+                       const std::string& limit);
 
 class TickClock {
  public:

@@ -64,7 +64,7 @@ class WorldNode {
   std::uint64_t queueSteps(std::uint32_t n);
   const std::string& frameOf(stc::EntityId id) const { return frames_.at(id); }
   const std::string& worldFrame() const { return params_.world_frame; }
-  void publishEntityList() { entity_states_.publishListIfChanged(world_, frames_, clock_.now()); }
+  void publishEntityList() { entity_states_.publishListIfChanged(world_, frames_, clock_.now(), beats_); }
 
  private:
   enum class Input { Spawn, Despawn, Gaze, ClickedPoint };
@@ -110,6 +110,7 @@ class WorldNode {
   double dt_ = 0.0;
   std::uint64_t tick_ = 0;
   std::uint64_t ticks_per_states_ = 1;
+  std::uint64_t beats_ = 0;  // timer callbacks: ticks and those while paused (~entities' rate)
   bool paused_ = false;
   std::uint64_t steps_pending_ = 0;  // paused: ticks ~step still asks for
   EntityStatePublisher entity_states_;
