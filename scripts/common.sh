@@ -46,3 +46,40 @@ runGtests() {
   echo "$label: $# gtests, $failed failed"
   [ "$failed" -eq 0 ]
 }
+# demoTicks SETUP EXPECTED: with only SETUP's environment on the ROS paths and
+# a master of its own, runs `roslaunch sphere_tree_collision demo.launch
+# rviz:=false` by package name until the world node ticks with entities and
+# the gaze simulator's gaze on. Fails when rospack finds the package outside
+# EXPECTED, when roslaunch finds two files of one name, or when the node never
+# ticks. Judged by what the node logs: the wall-clock bound only guards a hang.
+demoTicks() {
+  local setup="$1" expected="$2" log port launcher ok=1
+  log="$(mktemp)"
+  port=$((20000 + RANDOM % 10000))
+  (
+    set +u
+    unset ROS_PACKAGE_PATH CMAKE_PREFIX_PATH LD_LIBRARY_PATH PYTHONPATH ROS_MASTER_URI
+    # shellcheck disable=SC1091
+    source /opt/ros/noetic/setup.bash 2>/dev/null || true
+    # shellcheck disable=SC1090
+    source "$setup"
+    set -u
+    found="$(rospack find sphere_tree_collision)"
+    echo "rospack find sphere_tree_collision: $found"
+    case "$found" in "$expected" | "$expected"/*) ;; *) echo "the package was not found in $expected"; exit 1 ;; esac
+    export ROS_MASTER_URI="http://localhost:$port"
+    exec roslaunch -p "$port" sphere_tree_collision demo.launch rviz:=false
+  ) >"$log" 2>&1 &
+  launcher=$!
+  for _ in $(seq 1 240); do  # liveness bound: 120 s
+    if grep -qE "tick [0-9]+: [1-9][0-9]* entities.*gaze on" "$log"; then ok=0; break; fi
+    kill -0 "$launcher" 2>/dev/null || break
+    sleep 0.5
+  done
+  kill -INT "$launcher" 2>/dev/null
+  wait "$launcher" 2>/dev/null
+  grep -E "rospack find|gaze on|multiple files|ERROR|FATAL" "$log" | head -3
+  [ $ok -eq 0 ] || { echo "the demo did not tick; log:"; tail -30 "$log"; }
+  rm -f "$log"
+  return $ok
+}
