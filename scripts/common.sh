@@ -26,25 +26,35 @@ requireAssertions() {
     return 1
   fi
 }
-# runGtests BUILD LABEL TEST...: each gtest of BUILD's devel space, run from the
-# source root (as catkin_add_gtest's WORKING_DIRECTORY) with its output in
-# BUILD/TEST.log; a line "LABEL: TEST ok (N s)" or "... FAILED" with the log's
-# tail, then "LABEL: N gtests, M failed". Returns non-zero when any failed.
-runGtests() {
-  local build="$1" label="$2" failed=0 t start
-  shift 2
+# runPrograms BUILD LABEL KIND ARG PROGRAM...: each PROGRAM of BUILD's devel
+# space with ARG, run from the source root (as catkin_add_gtest's
+# WORKING_DIRECTORY) with its output in BUILD/PROGRAM.log; a line "LABEL:
+# PROGRAM ok (N s)" or "... FAILED (exit E, N s)" with the log's tail, then
+# "LABEL: N KIND, M failed" and the failed ones' names. STC_PROGRAM_LIMIT
+# seconds a program, when set, guard a hang. Returns non-zero when any failed.
+runPrograms() {
+  local build="$1" label="$2" kind="$3" arg="$4" failed=() t start rc
+  shift 4
   for t in "$@"; do
     start=$(date +%s)
-    if (cd "$STC_ROOT" && "$build/devel/lib/sphere_tree_collision/$t" --gtest_brief=1 >"$build/$t.log" 2>&1); then
+    (cd "$STC_ROOT" && timeout "${STC_PROGRAM_LIMIT:-0}" "$build/devel/lib/sphere_tree_collision/$t" "$arg" >"$build/$t.log" 2>&1)
+    rc=$?
+    if [ $rc -eq 0 ]; then
       echo "$label: $t ok ($(($(date +%s) - start)) s)"
     else
-      failed=$((failed + 1))
-      echo "$label: $t FAILED ($(($(date +%s) - start)) s), log: $build/$t.log"
+      failed+=("$t")
+      echo "$label: $t FAILED (exit $rc, $(($(date +%s) - start)) s), log: $build/$t.log"
       tail -n 40 "$build/$t.log"
     fi
   done
-  echo "$label: $# gtests, $failed failed"
-  [ "$failed" -eq 0 ]
+  echo "$label: $# $kind, ${#failed[@]} failed"
+  [ ${#failed[@]} -eq 0 ] || { echo "$label: failed: ${failed[*]}"; return 1; }
+}
+# runGtests BUILD LABEL TEST...: runPrograms for gtests, brief.
+runGtests() {
+  local build="$1" label="$2"
+  shift 2
+  runPrograms "$build" "$label" gtests --gtest_brief=1 "$@"
 }
 # demoTicks SETUP EXPECTED: with only SETUP's environment on the ROS paths and
 # a master of its own, runs `roslaunch sphere_tree_collision demo.launch

@@ -33,6 +33,8 @@ check catkin_lint -- /usr/bin/catkin_lint --strict --skip-path build "$STC_ROOT"
 check installed_demo -- bash "$STC_ROOT/scripts/check_install.sh"
 # What the README's demo runs: by package name from the devel space, after the install above.
 check demo_by_name -- bash "$STC_ROOT/scripts/check_demo.sh"
+# Every bench in its short mode (--smoke): none crashes or fails unseen.
+check benches -- bash "$STC_ROOT/scripts/bench_smoke.sh"
 # libFuzzer under ASan + UBSan on the message-to-core path, about 60 s (docs/fuzzing.md).
 wait "$side_builds" || true
 check fuzz -- bash "$STC_ROOT/scripts/fuzz.sh"
