@@ -8,7 +8,7 @@
 // response) on rocks and cubes at the same density, N = 1k..50k, with the
 // fitted exponent of time per tick against N.
 //
-// Usage: bench_broad_phase [--quick]     (--quick: smaller N, 20 ticks)
+// Usage: bench_broad_phase [--quick|--smoke]  (--quick: smaller N, 20 ticks; --smoke: one small N, 3 ticks)
 // Prints three markdown tables.
 #include "sphere_tree_collision/sweep_and_prune.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
@@ -339,12 +339,14 @@ std::string worldTable(const std::vector<std::size_t>& sizes, int ticks) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false;
+  bool quick = false, smoke = false;  // smoke: that the bench runs (scripts/bench_smoke.sh)
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--quick")) {
       quick = true;
+    } else if (!std::strcmp(argv[i], "--smoke")) {
+      smoke = true;
     } else {
-      std::fprintf(stderr, "usage: %s [--quick]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--quick|--smoke]\n", argv[0]);
       return 2;
     }
   }
@@ -354,27 +356,31 @@ int main(int argc, char** argv) {
       fclManager<fcl::DynamicAABBTreeCollisionManager_Arrayd>("FCL DynamicAABBTree_Array"),
       fclManager<fcl::SaPCollisionManagerd>("FCL SaP"),
   };
-  const int ticks = quick ? 20 : 100;
+  const int ticks = smoke ? 3 : quick ? 20 : 100;
   const double speed = 0.02;  // 2% of a box side per tick, e.g. 1.2 sides/s at 60 Hz
 
   std::ostringstream by_n, by_speed;
   by_n << tableHeader(contenders);
   by_speed << tableHeader(contenders);
   bool agree = true;
-  const std::vector<std::size_t> sizes = quick ? std::vector<std::size_t>{1000, 10000}
-                                               : std::vector<std::size_t>{1000, 10000, 50000};
+  const std::vector<std::size_t> sizes = smoke   ? std::vector<std::size_t>{500}
+                                          : quick ? std::vector<std::size_t>{1000, 10000}
+                                                  : std::vector<std::size_t>{1000, 10000, 50000};
+  const std::size_t coherence_n = smoke ? 500 : 10000;
   // FCL's SaP manager takes ~1.5 s per tick at 50k: fewer ticks there, the same for all.
   for (std::size_t n : sizes) agree &= runCase(contenders, {n, speed, n >= 50000 ? 30 : ticks}, by_n);
-  for (double s : {0.005, 0.02, 0.08}) agree &= runCase(contenders, {10000, s, ticks}, by_speed);
+  for (double s : {0.005, 0.02, 0.08}) agree &= runCase(contenders, {coherence_n, s, ticks}, by_speed);
 
   std::printf("\n### Scaling with N (speed %.3f)\n\n%s", speed, by_n.str().c_str());
-  std::printf("\n### Coherence: N = 10000, speed varied\n\n%s", by_speed.str().c_str());
+  std::printf("\n### Coherence: N = %zu, speed varied\n\n%s", coherence_n, by_speed.str().c_str());
   std::printf("\npair counts %s on every tick\n", agree ? "AGREE" : "DISAGREE");
   std::fflush(stdout);
 
-  const std::vector<std::size_t> world_sizes = quick ? std::vector<std::size_t>{1000, 2000, 5000}
-                                                     : std::vector<std::size_t>{1000, 2000, 5000, 10000, 20000, 50000};
-  const std::string world = worldTable(world_sizes, 10);
+  const std::vector<std::size_t> world_sizes =
+      smoke   ? std::vector<std::size_t>{300, 600}  // two sizes: the fitted exponent needs two points
+      : quick ? std::vector<std::size_t>{1000, 2000, 5000}
+              : std::vector<std::size_t>{1000, 2000, 5000, 10000, 20000, 50000};
+  const std::string world = worldTable(world_sizes, smoke ? 2 : 10);
   std::printf("\n### Whole World tick against N (rocks and cubes, 2%% of a box per tick, full depth)\n\n%s",
               world.c_str());
   return agree ? 0 : 1;

@@ -30,6 +30,7 @@
 //               a bare NAME picks that scene's cases from the default list)
 //   --variants  Bullet shapes to run: compound,hull (default both; empty: none)
 //   --bullet-only  skip this package's run (to run the engines apart, in parallel)
+//   --smoke     every scene at 100 bodies at most, 0.05 s, no settling: that the bench runs, scripts/bench_smoke.sh
 //   --iterations N  this package's velocity and position iterations per tick
 //               (ResponseOptions::iterations; default: the World's, 20). Bullet
 //               runs its default 10 always: --iterations 10 compares the two
@@ -533,6 +534,7 @@ std::vector<std::string> splitList(const std::string& s) {
 Options parse(int argc, char** argv) {
   Options o;
   std::string scenes;
+  bool smoke = false;
   for (stc_bench::Args args(argc, argv); args.more();) {
     const std::string a = args.flag();
     if (a == "--seconds") {
@@ -550,6 +552,10 @@ Options parse(int argc, char** argv) {
         else if (v == "hull") o.variants.push_back(BulletShape::Hull);
         else throw InputError("--variants", "unknown value '" + v + "' (expected compound, hull)");
       }
+    } else if (a == "--smoke") {
+      smoke = true;
+      o.seconds = 0.05;
+      o.settle = 0.0;
     } else if (a == "--bullet-only") {
       o.bullet_only = true;
     } else if (a == "--iterations") {
@@ -565,6 +571,9 @@ Options parse(int argc, char** argv) {
     }
   }
   o.cases = scenes.empty() ? kDefaultCases : stc_bench::parseSceneCases(scenes, kDefaultCases);
+  if (smoke) {
+    for (Case& c : o.cases) c.bodies = std::min(c.bodies, 100);
+  }
   return o;
 }
 

@@ -5,7 +5,8 @@
 // bodies and ticks; mean ms per tick of each phase; fast bodies, pairs
 // swept, leaf box pairs tested and bodies held back per tick.
 //
-// Usage: bench_continuous [--seconds S] [SCENE[:N] ...]
+// Usage: bench_continuous [--seconds S] [--smoke] [SCENE[:N] ...]
+//   --smoke: 3 ticks of small scenes, that the bench runs (scripts/bench_smoke.sh)
 //   default: packed_box:500 bouncing_box:100 rockfall:1000 corner_drift:500, 10 s
 //   e.g.     bench_continuous --seconds 2 rockfall:1000
 #include "sphere_tree_collision/scenes.hpp"
@@ -82,6 +83,7 @@ void runScene(SceneKind kind, int count, double seconds) {  // count 0: the scen
 
 int main(int argc, char** argv) {
   double seconds = 10.0;
+  bool smoke = false;
   std::vector<std::pair<SceneKind, int>> scenes;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -89,13 +91,19 @@ int main(int argc, char** argv) {
       seconds = std::atof(argv[++i]);
       continue;
     }
+    if (a == "--smoke") {
+      smoke = true;
+      seconds = 0.05;
+      continue;
+    }
     const std::size_t colon = a.find(':');
     const SceneKind kind = parseScene(a.substr(0, colon));
     scenes.emplace_back(kind, colon == std::string::npos ? 0 : std::atoi(a.c_str() + colon + 1));
   }
   if (scenes.empty()) {
-    scenes = {{SceneKind::PackedBox, 500}, {SceneKind::BouncingBox, 100}, {SceneKind::Rockfall, 1000},
-              {SceneKind::CornerDrift, 500}};
+    const int n = smoke ? 10 : 100;  // the bodies of the smallest scene
+    scenes = {{SceneKind::PackedBox, 5 * n}, {SceneKind::BouncingBox, n}, {SceneKind::Rockfall, 10 * n},
+              {SceneKind::CornerDrift, 5 * n}};
   }
   std::printf("%.0f s at dt = 1/60 s, unlimited budget. Speeds in m/s (stored: the velocity a tick moves with; "
               "real: |dx|/dt), phase times mean wall ms per tick, tick CPU = thread CPU ms per tick; sweep "

@@ -31,6 +31,7 @@
 // Usage: bench_error_vs_runtime [--quick] [--csv FILE] [--markdown FILE]
 //          [--snapshots N] [--repeats R] [--scene packed_box|rockfall]
 //          [--gaze entity|screen] [--queues K] [--ratio R] [--cost-exponent A]
+//          [--smoke]  (--quick with 1 snapshot, 1 repeat and no CSV: that the bench runs, scripts/bench_smoke.sh)
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
@@ -58,7 +59,8 @@ using namespace stc;
 
 struct Options {
   bool quick = false;
-  std::string csv = "docs/error_vs_runtime.csv";
+  bool smoke = false;
+  std::string csv = "docs/error_vs_runtime.csv";  // empty: none
   std::string markdown;
   int snapshots = 12;
   int repeats = 7;
@@ -310,7 +312,7 @@ void runScene(SceneKind kind, const Options& opt, std::map<RowKey, Row>& rows, L
   const double dt = ev.spec().dt;
   double t = 0.0;
   for (int i = 0; i < warmup; ++i, t += dt) ev.sim().step(dt, Budget::unlimited());
-  const int snapshots = opt.quick ? 3 : opt.snapshots;
+  const int snapshots = opt.smoke ? 1 : opt.quick ? 3 : opt.snapshots;
   for (int s = 0; s < snapshots; ++s) {
     for (int i = 0; i < every; ++i, t += dt) ev.sim().step(dt, Budget::unlimited());
     GazeParams follow;
@@ -398,7 +400,7 @@ std::string report(const std::map<RowKey, Row>& rows, const Options& opt) {
                 opt.queues, opt.ratio, opt.cost_exponent,
                 opt.gaze == "screen" ? "saccades to random screen points every 0.3 s"
                                      : "on a random moving entity, a new one every snapshot",
-                opt.quick ? 3 : opt.snapshots, opt.repeats);
+                opt.smoke ? 1 : opt.quick ? 3 : opt.snapshots, opt.repeats);
   md += buf;
   for (const char* scene : {"packed_box", "rockfall"}) {
     if (!rowOf(scene, "round_robin", "unlimited", 1.0, 0)) continue;
@@ -452,6 +454,7 @@ int main(int argc, char** argv) {
   for (stc_bench::Args args(argc, argv); args.more();) {
     const std::string& a = args.flag();
     if (a == "--quick") opt.quick = true;
+    else if (a == "--smoke") opt.quick = true, opt.smoke = true, opt.repeats = 1, opt.csv.clear();
     else if (a == "--csv") opt.csv = args.value();
     else if (a == "--markdown") opt.markdown = args.value();
     else if (a == "--snapshots") opt.snapshots = std::stoi(args.value());
@@ -469,7 +472,7 @@ int main(int argc, char** argv) {
   for (SceneKind kind : {SceneKind::PackedBox, SceneKind::Rockfall}) {
     if (opt.scene.empty() || opt.scene == toString(kind)) runScene(kind, opt, rows, load);
   }
-  writeCsv(opt.csv, rows);
+  if (!opt.csv.empty()) writeCsv(opt.csv, rows);
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "Load: 1-minute load average %.1f before and %.1f after, on %u cores; %ld of %ld ticks lost "

@@ -7,6 +7,7 @@
 // Prints markdown tables (docs/fracture.md).
 //
 //   bench_fracture [rocks] [seconds]    defaults 200 rocks, 6 s of simulated time
+//   bench_fracture --smoke              20 rocks, 0.5 s: that the bench runs (scripts/bench_smoke.sh)
 #include "sphere_tree_collision/scenes.hpp"
 
 #include "tick_clock.hpp"
@@ -14,6 +15,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -69,8 +71,9 @@ std::size_t countOver(const std::vector<double>& v, double limit) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int rocks = argc > 1 ? std::atoi(argv[1]) : 200;
-  const double seconds = argc > 2 ? std::atof(argv[2]) : 6.0;
+  const bool smoke = argc > 1 && std::strcmp(argv[1], "--smoke") == 0;
+  const int rocks = smoke ? 20 : argc > 1 ? std::atoi(argv[1]) : 200;
+  const double seconds = smoke ? 0.5 : argc > 2 ? std::atof(argv[2]) : 6.0;
   const std::vector<double> strengths = {0.0, 200.0, 100.0, 50.0};
   std::printf("rockfall, %d rocks (0.4 m, resolution 8), %.1f s simulated, min_piece_voxels 8 attach, "
               "thread CPU clock\n\n", rocks, seconds);

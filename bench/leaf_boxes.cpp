@@ -13,6 +13,7 @@
 // leaf pairs a box test in the narrow phase would leave.
 //
 // Usage: bench_leaf_boxes [--scene cube_box] [--bodies 10000] [--ticks 150] [--margin 0.1]
+//          [--smoke]  (200 bodies, 3 ticks: that the bench runs, scripts/bench_smoke.sh)
 #include "bench_args.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/shape_bounds.hpp"
@@ -42,6 +43,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--bodies") o.bodies = std::stoi(args.required());
     else if (a == "--ticks") o.ticks = std::stoi(args.required());
     else if (a == "--margin") o.margin = std::stod(args.required());
+    else if (a == "--smoke") o.bodies = 200, o.ticks = 3;
     else throw InputError(a, "unknown option (see the comment at the top of bench/leaf_boxes.cpp)");
   }
   if (o.bodies < 1) throw InputError("--bodies", "must be >= 1");

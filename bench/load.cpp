@@ -17,7 +17,7 @@
 //    all-static, all-sphere. Mean phase times per tick (best of 3 runs, runs
 //    interleaved, since the machine may be shared) and thread CPU time.
 //
-// Usage: bench_load [--quick] [--markdown FILE]
+// Usage: bench_load [--quick|--smoke] [--markdown FILE]   (--smoke: that the bench runs, scripts/bench_smoke.sh)
 #include "fcl_mesh.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
@@ -392,10 +392,16 @@ int main(int argc, char** argv) {
       lean_entities = 300;
       lean_ticks = 10;
       reps = 1;
+    } else if (a == "--smoke") {
+      entities = 2 * kBurst;  // two bursts
+      settle_ticks = 3;
+      lean_entities = 100;
+      lean_ticks = 3;
+      reps = 1;
     } else if (a == "--markdown" && i + 1 < argc) {
       markdown = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: bench_load [--quick] [--markdown FILE]\n");
+      std::fprintf(stderr, "usage: bench_load [--quick|--smoke] [--markdown FILE]\n");
       return 2;
     }
   }

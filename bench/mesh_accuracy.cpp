@@ -11,7 +11,8 @@
 //              positives, and whether h (with the voxelisation margin) bounds
 //              the true mesh gap
 //
-// Usage: bench_mesh_accuracy [--poses N] [--markdown FILE]   (writes docs/meshes.md when asked)
+// Usage: bench_mesh_accuracy [--poses N] [--smoke] [--markdown FILE]   (writes docs/meshes.md when asked;
+//   --smoke: 50 poses, resolution 16, 5 levels: that the bench runs, scripts/bench_smoke.sh)
 #include "doc_output.hpp"
 #include "mesh_accuracy.hpp"
 #include "mesh_generators.hpp"
@@ -43,14 +44,19 @@ using stc::bench::num;
 
 int main(int argc, char** argv) {
   int poses = 6000;
+  int resolution = kResolution, levels = kLevels;
   std::string markdown_path;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--poses") == 0 && i + 1 < argc) {
       poses = std::atoi(argv[++i]);
+    } else if (std::strcmp(argv[i], "--smoke") == 0) {
+      poses = 50;
+      resolution = 16;
+      levels = 5;
     } else if (std::strcmp(argv[i], "--markdown") == 0 && i + 1 < argc) {
       markdown_path = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: %s [--poses N] [--markdown FILE]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--poses N] [--smoke] [--markdown FILE]\n", argv[0]);
       return 2;
     }
   }
@@ -70,18 +76,18 @@ int main(int argc, char** argv) {
     for (int r = 0; r < 5; ++r) {
       const auto t0 = std::chrono::steady_clock::now();
       stc::VoxeliseOptions options;
-      options.resolution = kResolution;
+      options.resolution = resolution;
       const stc::VoxelisedMesh v = stc::voxeliseMesh(mesh, options);
       const auto t1 = std::chrono::steady_clock::now();
       stc::SphereTreeOptions tree_options;
-      tree_options.max_levels = kLevels;
+      tree_options.max_levels = levels;
       const stc::SphereTree tree = stc::SphereTree::build(
           v.shape, stc::computeMassProperties(v.shape, 1.0).centre_of_mass, tree_options);
       const auto t2 = std::chrono::steady_clock::now();
       voxelise_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
       tree_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
     }
-    bodies.push_back(stc::truth::makeMeshBody(name, mesh, kResolution, kLevels));
+    bodies.push_back(stc::truth::makeMeshBody(name, mesh, resolution, levels));
     const MeshBody& b = bodies.back();
     const stc::VoxelShape& s = b.voxels.shape;
     const double a = s.voxelSize();
@@ -131,7 +137,7 @@ int main(int argc, char** argv) {
          "are generated in code (test/support/mesh_generators.cpp): a robot link (capsule through a box flange, "
          "one cap triangle missing, every triangle with its own vertices as in an STL file) and a bumpy, "
          "star-shaped, bunny-sized scan (displaced icosphere). Resolution "
-      << kResolution << " voxels along the longest side, " << kLevels
+      << resolution << " voxels along the longest side, " << levels
       << "-level trees (tight fit; the last level is single voxels).\n\n"
       << "## Use\n\n"
       << "- `stc::loadTriangleMesh(resource, scale, up_axis)` (library stc_mesh, assimp: STL, OBJ, DAE; a plain "

@@ -17,7 +17,8 @@
 // default collide request answers). Agreement: both colliding, ours only (a false positive of
 // the sphere approximation), FCL only (a missed collision: must be 0).
 //
-// Usage: bench_narrow_phase [--poses N] [--passes P] [--resolution R] [--levels L] [--markdown FILE]
+// Usage: bench_narrow_phase [--poses N] [--passes P] [--resolution R] [--levels L] [--smoke] [--markdown FILE]
+//   --smoke: 50 poses, 1 pass: that the bench runs (scripts/bench_smoke.sh)
 #include "fcl_mesh.hpp"
 #include "pose_sampling.hpp"
 #include "sphere_tree_collision/pair_test.hpp"
@@ -208,8 +209,9 @@ int main(int argc, char** argv) {
     else if (arg == "--levels" && has_value) levels = std::atoi(argv[++i]);
     else if (arg == "--passes" && has_value) passes = std::max(1, std::atoi(argv[++i]));
     else if (arg == "--markdown" && has_value) markdown = argv[++i];
+    else if (arg == "--smoke") poses = 50, passes = 1;
     else {
-      std::fprintf(stderr, "usage: %s [--poses N] [--passes P] [--resolution R] [--levels L] [--markdown FILE]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--poses N] [--passes P] [--resolution R] [--levels L] [--smoke] [--markdown FILE]\n", argv[0]);
       return 2;
     }
   }

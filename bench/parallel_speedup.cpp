@@ -28,7 +28,7 @@
 // by it, and the speed-up given for each class.
 //
 // Usage: bench_parallel_speedup [--scenes corner_drift:500,rockfall:1000,packed_box:500,cube_box:10000]
-//          [--threads 2] [--seconds 6] [--cube-seconds 1.5] [--settle 1]
+//          [--threads 2] [--seconds 6] [--cube-seconds 1.5] [--settle 1] [--smoke]
 //   --seconds: simulated time timed per scene (cube_box: --cube-seconds);
 //   --settle: simulated time run first, untimed, at one thread (so the
 //   scene is moving and colliding when timing starts).

@@ -61,9 +61,15 @@ struct SceneTiming {
   double settle = 1.0;
 
   // Takes `flag` and its value when it is --scenes, --seconds, --cube-seconds
-  // or --settle (false: not one of them); throws InputError naming it.
+  // or --settle, or --smoke (every scene small, 3 ticks, no settling: that the
+  // bench runs, scripts/bench_smoke.sh); false: not one of them. Throws
+  // InputError naming it.
   bool take(const std::string& flag, Args& args) {
-    if (flag == "--scenes") {
+    if (flag == "--smoke") {
+      for (SceneCase& c : cases) c.bodies = std::min(c.bodies, 100);
+      seconds = cube_seconds = 0.05;
+      settle = 0.0;
+    } else if (flag == "--scenes") {
       cases = parseSceneCases(args.required(), cases);
     } else if (flag == "--seconds") {
       seconds = std::stod(args.required());

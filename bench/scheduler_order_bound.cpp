@@ -33,7 +33,8 @@
 //                  first), whole; then the queues over the rest
 // Printed: true P left, summed over the snapshots, over round-robin's.
 //
-// Usage: bench_scheduler_order_bound [--scene packed_box|rockfall] [--snapshots N]
+// Usage: bench_scheduler_order_bound [--scene packed_box|rockfall] [--snapshots N] [--smoke]
+//   --smoke: 1 snapshot, that the bench runs, scripts/bench_smoke.sh
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
@@ -266,6 +267,7 @@ int main(int argc, char** argv) {
     const std::string& a = args.flag();
     if (a == "--scene") scene = args.value();
     else if (a == "--snapshots") snapshots = std::stoi(args.value());
+    else if (a == "--smoke") snapshots = 1;
     else return args.unknown();
   }
   const SceneKind kind = parseScene(scene);
@@ -287,8 +289,10 @@ int main(int argc, char** argv) {
 
   const std::vector<double> shares = {0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.4};
   const Priority by_reach = [](const PairTest& t, const PairFacts& f) {
-    double g = 0.5;  // before any step: a constant (the root test costs 1)
-    if (t.stepsDone() > 0) {
+    // Before any step, and after a step that found no sphere pair (separate at
+    // the roots: resolved, its priority unused), a constant (the root test costs 1).
+    double g = 0.5;
+    if (t.hasLastPair()) {
       const SpherePair first = t.lastPairs()[0];
       g = t.bodyA().tree->node(first.a).radius + t.bodyB().tree->node(first.b).radius;
     }

@@ -20,7 +20,8 @@
 // it; run() less step() is the scheduler's own work.
 //
 // Usage: bench_scheduler_overhead [--scene packed_box|rockfall] [--scheduler NAME|all] [--ticks N]
-//          [--no-retry] [--queues K --ratio R --cost-exponent A]
+//          [--no-retry] [--queues K --ratio R --cost-exponent A] [--smoke]
+//   --smoke: 3 ticks, no retry: that the bench runs, scripts/bench_smoke.sh
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
@@ -77,6 +78,7 @@ int main(int argc, char** argv) {
     else if (a == "--scheduler") only = args.value();
     else if (a == "--ticks") ticks = std::stoi(args.value());
     else if (a == "--no-retry") retry_s = 1e9;
+    else if (a == "--smoke") ticks = 3, retry_s = 1e9;
     else if (a == "--queues") queues.queue_count = std::stoi(args.value());
     else if (a == "--ratio") queues.queue_ratio = std::stod(args.value());
     else if (a == "--cost-exponent") queues.cost_exponent = std::stod(args.value());

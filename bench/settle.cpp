@@ -27,6 +27,7 @@
 //              it ends earlier once every mover sleeps
 //   --seconds  timed window (default 5)
 //   --every    seconds between lines (default 5)
+//   --smoke    200 bodies, 0.1 s settling, 0.05 s timed: that the bench runs, scripts/bench_smoke.sh
 //   (the timed window also prints its wall ms per tick by phase)
 //   --sleep-off  WorldConfig::sleeping.enabled = false (what the pile costs awake)
 //   --rolling C  every body's Material::rolling_resistance set to C after the
@@ -71,6 +72,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--every") o.every = std::stod(next());
     else if (a == "--sleep-off") o.sleep_off = true;
     else if (a == "--rolling") o.rolling = std::stod(next());
+    else if (a == "--smoke") o.bodies = 200, o.settle = 0.1, o.seconds = 0.05, o.every = 0.05;
     else throw InputError(a, "unknown option");
   }
   if (!(o.every > 0.0)) throw InputError("--every", "must be > 0");

@@ -4,7 +4,8 @@
 // them (docs/response.md). Prints markdown tables.
 //
 //   bench_stability            all scenes, default response options
-//   bench_stability --quick    shorter runs (a smoke check of the bench itself)
+//   bench_stability --quick    shorter runs
+//   bench_stability --smoke    a few ticks of each: that the bench runs, scripts/bench_smoke.sh
 #include "stability_scenes.hpp"
 
 #include "sphere_tree_collision/dynamics.hpp"
@@ -52,7 +53,8 @@ Row stackRow(const std::string& label, Scene scene) {
 
 int main(int argc, char** argv) {
   const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
-  const double t = quick ? 0.25 : 1.0;  // fraction of the full durations
+  const bool smoke = argc > 1 && std::strcmp(argv[1], "--smoke") == 0;
+  const double t = smoke ? 0.01 : quick ? 0.25 : 1.0;  // fraction of the full durations
 
   std::vector<Row> rows;
   rows.push_back(stackRow("stack of 10 cubes, 10 s", stack(10, 0.05, 1.0 / 60.0, 10.0 * t, 2.0 * t)));

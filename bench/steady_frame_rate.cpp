@@ -22,7 +22,8 @@
 // Usage: bench_steady_frame_rate [--scene corner_drift|rockfall|all] [--entities N]
 //          [--tick-budget-ms 16.7] [--seconds 60] [--budget-off] [--wall-clock]
 //          [--trace-escape] [--sphere-tests N] [--solver-iterations N]
-//          [--position-correction F] [--markdown FILE]
+//          [--position-correction F] [--markdown FILE] [--smoke]
+//   --smoke: both scenes at 100 entities for 0.05 s: that the bench runs, scripts/bench_smoke.sh
 #include "bench_args.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -205,6 +206,7 @@ int main(int argc, char** argv) {
     else if (a == "--wall-clock") wall_clock = true;
     else if (a == "--trace-escape") trace_escape = true;
     else if (a == "--markdown") markdown = args.value();
+    else if (a == "--smoke") entities = 100, seconds = 0.05;
     else return args.unknown();
   }
   struct Case { SceneKind kind; int entities; };

@@ -13,7 +13,8 @@
 // against FCL's distance to the shape's surface mesh (the reference), and the
 // largest disagreement is printed.
 //
-// Usage: bench_tightness [--markdown FILE]   (writes docs/tightness.md when asked)
+// Usage: bench_tightness [--smoke] [--markdown FILE]   (writes docs/tightness.md when asked;
+//   --smoke: the first preset only, that the bench runs, scripts/bench_smoke.sh)
 #include "doc_output.hpp"
 #include "fcl_mesh.hpp"
 #include "sphere_union.hpp"
@@ -137,11 +138,14 @@ using stc::bench::num;
 
 int main(int argc, char** argv) {
   std::string markdown_path;
+  std::vector<std::string> presets = stc::presetNames();
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--markdown") == 0 && i + 1 < argc) {
       markdown_path = argv[++i];
+    } else if (std::strcmp(argv[i], "--smoke") == 0) {
+      presets.resize(1);
     } else {
-      std::fprintf(stderr, "usage: %s [--markdown FILE]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--smoke] [--markdown FILE]\n", argv[0]);
       return 2;
     }
   }
@@ -151,7 +155,7 @@ int main(int argc, char** argv) {
            "tight vol | tight/paper worst | tight/paper vol |\n"
         << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   FclCheck fcl_check;
-  for (const std::string& name : stc::presetNames()) {
+  for (const std::string& name : presets) {
     stc::PresetParams params;
     params.resolution = kResolution;
     params.voxel_size = 0.05;

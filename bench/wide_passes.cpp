@@ -11,7 +11,7 @@
 // one-at-a-time / four-wide ratios.
 //
 // Usage: bench_wide_passes [--scenes corner_drift:500,rockfall:1000,packed_box:500,cube_box:10000]
-//          [--seconds 3] [--cube-seconds 1.5] [--settle 1]
+//          [--seconds 3] [--cube-seconds 1.5] [--settle 1] [--smoke]
 //   --seconds: simulated time timed per scene (cube_box: --cube-seconds);
 //   --settle: simulated time run first, untimed (both worlds).
 // Last lines: WIDE scene=<name> tick_x=<ratio of tick CPU p50> response_x=<ratio of response p50>.

@@ -7,8 +7,13 @@ jobs="${STC_JOBS:-$(nproc)}"
 # before the first configure, the generated messages' Python package is found by
 # the Python rostests (example_client) of a fresh build too.
 mkdir -p "$STC_BUILD/devel/lib/python3/dist-packages"
+# `make install` goes outside the package folder: roslaunch searches the whole
+# folder, and a second demo.launch there stops the demo. (An install space an
+# older check_install.sh left in the build directory goes for the same reason.)
+rm -rf "$STC_BUILD/install"
+install_prefix="${STC_INSTALL_PREFIX:-${TMPDIR:-/tmp}/sphere_tree_collision_install}"
 cmake -S "$STC_ROOT" -B "$STC_BUILD" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_INSTALL_PREFIX="$STC_BUILD/install" >/dev/null
+  -DCMAKE_INSTALL_PREFIX="$install_prefix" >/dev/null
 cmake --build "$STC_BUILD" -- -j"$jobs"
 if [ "${1:-}" = "--tests" ]; then
   make -C "$STC_BUILD" -j"$jobs" tests

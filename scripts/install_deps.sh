@@ -8,6 +8,7 @@ packages=(
   librostest-dev python3-rostest python3-roslaunch libtf2-msgs-dev
   libstd-srvs-dev libros-rosgraph-msgs-dev
   python3-rospy python3-geometry-msgs python3-std-srvs  # scripts/example_client.py
+  rosbash  # rosrun, roscd
   libtbb-dev  # oneTBB: the parallel tick (WorldConfig::threads)
   libeigen3-dev libyaml-cpp-dev libfcl-dev libgtest-dev googletest
   libassimp-dev  # mesh loading (stc_mesh): STL, OBJ, DAE

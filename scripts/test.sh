@@ -31,6 +31,10 @@ make -C "$STC_BUILD" run_tests -j1 2>&1 | tee "$STC_BUILD/run_tests.log" | grep 
 check() { /usr/bin/python3 "$STC_ROOT/scripts/run_check.py" "$STC_BUILD/test_results" "$@" || true; }
 check catkin_lint -- /usr/bin/catkin_lint --strict --skip-path build "$STC_ROOT"
 check installed_demo -- bash "$STC_ROOT/scripts/check_install.sh"
+# What the README's demo runs: by package name from the devel space, after the install above.
+check demo_by_name -- bash "$STC_ROOT/scripts/check_demo.sh"
+# Every bench in its short mode (--smoke): none crashes or fails unseen.
+check benches -- bash "$STC_ROOT/scripts/bench_smoke.sh"
 # libFuzzer under ASan + UBSan on the message-to-core path, about 60 s (docs/fuzzing.md).
 wait "$side_builds" || true
 check fuzz -- bash "$STC_ROOT/scripts/fuzz.sh"
