@@ -129,6 +129,7 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
         }
         frontier_cache_.carry(kept, frontier);
         ++chunk.frontier_kept;
+        appendSweepHit(tests[i], ia, ib, i, priorities[i], before, out);
         continue;
       }
     }
@@ -147,23 +148,34 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
       PairContactCache::record(tests[i], reuseBody(step, ia), reuseBody(step, ib), kFrontierTolerance * leaf_radius,
                                out.data() + before, out.data() + out.size(), frontier);
     }
-    if (out.size() == before && sweep_hit_of_pair_[i] >= 0) {
-      // The sweep held a body back at this pair's first touch but the test
-      // (interrupted, or not accepted) gave no contact: the hit is the contact,
-      // so the response turns the approach the sweep stopped.
-      const SweepHit& hit = sweep_scratch_.hits[static_cast<std::size_t>(sweep_hit_of_pair_[i])];
-      Contact c;
-      c.a = tests[i].bodyA().id;
-      c.b = tests[i].bodyB().id;
-      c.index_a = ia;
-      c.index_b = ib;
-      c.point = hit.point;
-      c.normal = hit.normal;
-      c.resolved = true;
-      c.priority = priorities[i];
-      out.push_back(c);
-    }
+    appendSweepHit(tests[i], ia, ib, i, priorities[i], before, out);
   }
+}
+
+// The sweep held a body back at pair i's first touch, but the test gave no
+// contact proven at the leaves (interrupted: none, or its frontier's, whose
+// separations are at least 0 and whose normals run along the line of centres
+// of spheres that may be the roots): the hit is a contact too, so the
+// response turns the approach the sweep stopped. Without it a budgeted tick
+// held the body back tick after tick while its velocity kept gravity's gain
+// (stored m/s, real mm/s), until the pair resolved and released it.
+void Physics::appendSweepHit(const PairTest& test, std::uint32_t ia, std::uint32_t ib, std::size_t i,
+                             double priority, std::size_t before, std::vector<Contact>& out) const {
+  if (sweep_hit_of_pair_[i] < 0) return;
+  for (std::size_t k = before; k < out.size(); ++k) {
+    if (out[k].resolved) return;  // the leaves' contacts turn it
+  }
+  const SweepHit& hit = sweep_scratch_.hits[static_cast<std::size_t>(sweep_hit_of_pair_[i])];
+  Contact c;
+  c.a = test.bodyA().id;
+  c.b = test.bodyB().id;
+  c.index_a = ia;
+  c.index_b = ib;
+  c.point = hit.point;
+  c.normal = hit.normal;
+  c.resolved = true;
+  c.priority = priority;
+  out.push_back(c);
 }
 
 void Physics::buildContacts(const StepContext& step) {
