@@ -133,6 +133,11 @@ class Physics {
   void appendContacts(const StepContext& step, std::size_t first, std::size_t last, ContactBuilder& builder,
                       std::vector<Contact>& out, ChunkContacts& chunk) const;
   ReuseBody reuseBody(const StepContext& step, std::uint32_t index) const;
+  // Root-sphere contacts of an unresolved pair of a movable and a static
+  // body whose boxes touch, out[before..], as the movable body's deepest
+  // voxels along the normal (physics.cpp).
+  void holdOnStatic(const StepContext& step, std::uint32_t ia, std::uint32_t ib, std::size_t before,
+                    std::vector<Contact>& out) const;
   // The sweep's hit of pair i (tests[i] of bodies ia, ib) appended to `out`
   // when the sweep held a body back there and none of the pair's contacts
   // out[before..] was proven at the leaves.

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <unordered_map>
 #include <vector>
 
@@ -167,19 +168,37 @@ Budget starved(std::int64_t sphere_tests) {
   return budget;
 }
 
+// The 300-rock run under starved(tests), once for the tests that read it.
+const Figures& starvedRockfall(std::int64_t tests) {
+  static std::map<std::int64_t, Figures> runs;
+  auto run = runs.find(tests);
+  if (run == runs.end()) run = runs.emplace(tests, rockfall(300, starved(tests), 900)).first;
+  return run->second;
+}
+
 TEST(BudgetPlausibility, BudgetedRockfallStoresTheVelocityItMovesWith) {
   for (const std::int64_t tests : {0, 100}) {
     SCOPED_TRACE(tests);
-    const Figures f = rockfall(300, starved(tests), 900);
-    EXPECT_EQ(f.bad_windows, 0u) << "worst excess " << f.worst_window_excess << " m/s";
+    const Figures& f = starvedRockfall(tests);
+    // Within 10 % + 0.05 m/s as the unbudgeted run is (a few of its windows
+    // miss it by under 0.02 m/s: a pile's position correction).
+    EXPECT_LT(f.worst_window_excess, 0.05) << f.bad_windows << " windows off";
     EXPECT_EQ(f.too_fast, 0u) << "max speed " << f.max_speed << " m/s, a fall allows " << f.fall_speed;
     EXPECT_EQ(f.outside, 0u);
-    // No tunnelling: nothing left the scene, nothing is through a plate, and
-    // penetration p99 is at most one voxel. (A few rocks rolling on a plate
-    // under these budgets still end up to 1.6 voxels deep, as before the
-    // sweep fix: a frontier contact with a plate pushes nothing apart.)
-    EXPECT_LT(f.max_sink, f.plate_thickness);
-    EXPECT_LE(f.sink_p99, f.voxel);
+  }
+}
+
+// No tunnelling under the same budgets: nothing left the scene, and no rock
+// is more than one of its voxels into a static plate. Before root contacts
+// with a plate held a rock at its deepest voxels (Physics::holdOnStatic),
+// three of the 300 rocks rolled their far corners up to 1.6 voxels in
+// (0.079 m; at 2,000 rocks 23, up to 0.107 m).
+TEST(BudgetPlausibility, BudgetedRockfallDoesNotSinkIntoStaticGeometry) {
+  for (const std::int64_t tests : {0, 100}) {
+    SCOPED_TRACE(tests);
+    const Figures& f = starvedRockfall(tests);
+    EXPECT_EQ(f.outside, 0u);
+    EXPECT_LE(f.max_sink, f.voxel) << f.sunk << " rocks more than a voxel in; p99 " << f.sink_p99 << " m";
   }
 }
 
