@@ -83,7 +83,9 @@ class Physics {
   void sweep(const StepContext& step);
   // Tick phase 4a: contacts of tests[0..pair_count) (pair_bodies: the same
   // pairs the sweep saw), plus the sweep's hit for a pair whose test gave no
-  // contact, into contacts.
+  // contact proven at the leaves, into contacts; an unresolved pair's root
+  // contact between a movable and a static body acts at the movable body's
+  // deepest voxels (holdOnStatic).
   void buildContacts(const StepContext& step);
   // Tick phase 4b, after buildContacts: impulses on those contacts when
   // options->enabled, within budget.
