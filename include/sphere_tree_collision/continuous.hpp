@@ -80,7 +80,9 @@ std::size_t markFastBodies(const std::vector<BodyState>& bodies, const std::vect
 // earliest hit (position lerp, orientation slerp). Its velocity is kept: the
 // narrow phase of the same tick finds the contact there, and the response
 // turns the approach (Physics::buildContacts adds the hit as a contact when the
-// narrow phase gave that pair none). scratch.hits and scratch.clamped say
+// narrow phase gave that pair none proven at the leaves: an interrupted pair's
+// frontier contacts need not turn it, and the body, held back tick after
+// tick, stored gravity's gain without moving). scratch.hits and scratch.clamped say
 // where. Pairs already overlapping at the start are resting contacts, left to
 // the solver.
 // A body held back changes its pairs' relative motion: cubes falling side by

@@ -83,7 +83,9 @@ class Physics {
   void sweep(const StepContext& step);
   // Tick phase 4a: contacts of tests[0..pair_count) (pair_bodies: the same
   // pairs the sweep saw), plus the sweep's hit for a pair whose test gave no
-  // contact, into contacts.
+  // contact proven at the leaves, into contacts; an unresolved pair's root
+  // contact between a movable and a static body acts at the movable body's
+  // deepest voxels (holdOnStatic).
   void buildContacts(const StepContext& step);
   // Tick phase 4b, after buildContacts: impulses on those contacts when
   // options->enabled, within budget.
@@ -133,6 +135,16 @@ class Physics {
   void appendContacts(const StepContext& step, std::size_t first, std::size_t last, ContactBuilder& builder,
                       std::vector<Contact>& out, ChunkContacts& chunk) const;
   ReuseBody reuseBody(const StepContext& step, std::uint32_t index) const;
+  // Root-sphere contacts of an unresolved pair of a movable and a static
+  // body whose boxes touch, out[before..], as the movable body's deepest
+  // voxels along the normal (physics.cpp).
+  void holdOnStatic(const StepContext& step, std::uint32_t ia, std::uint32_t ib, std::size_t before,
+                    std::vector<Contact>& out) const;
+  // The sweep's hit of pair i (tests[i] of bodies ia, ib) appended to `out`
+  // when the sweep held a body back there and none of the pair's contacts
+  // out[before..] was proven at the leaves.
+  void appendSweepHit(const PairTest& test, std::uint32_t ia, std::uint32_t ib, std::size_t i, double priority,
+                      std::size_t before, std::vector<Contact>& out) const;
 
   std::vector<ChunkContacts> chunk_contacts_;
   std::size_t builder_turn_ = 0;

@@ -7,6 +7,7 @@
 #include "grow_capacity.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace stc {
 namespace {
@@ -129,6 +130,8 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
         }
         frontier_cache_.carry(kept, frontier);
         ++chunk.frontier_kept;
+        holdOnStatic(step, ia, ib, before, out);
+        appendSweepHit(tests[i], ia, ib, i, priorities[i], before, out);
         continue;
       }
     }
@@ -147,23 +150,99 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
       PairContactCache::record(tests[i], reuseBody(step, ia), reuseBody(step, ib), kFrontierTolerance * leaf_radius,
                                out.data() + before, out.data() + out.size(), frontier);
     }
-    if (out.size() == before && sweep_hit_of_pair_[i] >= 0) {
-      // The sweep held a body back at this pair's first touch but the test
-      // (interrupted, or not accepted) gave no contact: the hit is the contact,
-      // so the response turns the approach the sweep stopped.
-      const SweepHit& hit = sweep_scratch_.hits[static_cast<std::size_t>(sweep_hit_of_pair_[i])];
-      Contact c;
-      c.a = tests[i].bodyA().id;
-      c.b = tests[i].bodyB().id;
-      c.index_a = ia;
-      c.index_b = ib;
-      c.point = hit.point;
-      c.normal = hit.normal;
-      c.resolved = true;
-      c.priority = priorities[i];
+    holdOnStatic(step, ia, ib, before, out);
+    appendSweepHit(tests[i], ia, ib, i, priorities[i], before, out);
+  }
+}
+
+namespace {
+
+// A body's voxels deepest along `u` (world, unit) in each quadrant of the
+// plane across `u` about its centre of mass: up to four far corners of leaf
+// boxes (exact for the voxels), in `points`; returns how many.
+int deepestPoints(const ShapeBounds& bounds, const Pose& pose, const Vec3& u, Vec3 (&points)[4]) {
+  const Vec3 u_body = pose.orientation.conjugate() * u;
+  Vec3 t1, t2;
+  tangentBasis(u_body, t1, t2);
+  const Vec3 sign(u_body.x() < 0.0 ? -1.0 : 1.0, u_body.y() < 0.0 ? -1.0 : 1.0, u_body.z() < 0.0 ? -1.0 : 1.0);
+  const SphereTree& tree = *bounds.tree;
+  double best[4];
+  std::fill(best, best + 4, -std::numeric_limits<double>::infinity());
+  Vec3 found[4];
+  for (std::int32_t n = tree.levelBegin(0); n < tree.levelBegin(tree.levelCount()); ++n) {
+    if (!tree.isLeaf(n)) continue;
+    const std::size_t k = static_cast<std::size_t>(n);
+    const Vec3 corner = tree.node(n).centre + bounds.box_offset[k] + bounds.box_half[k].cwiseProduct(sign);
+    const int q = (corner.dot(t1) < 0.0 ? 1 : 0) + (corner.dot(t2) < 0.0 ? 2 : 0);
+    const double along = corner.dot(u_body);
+    if (along > best[q]) {
+      best[q] = along;
+      found[q] = corner;
+    }
+  }
+  int count = 0;
+  for (int q = 0; q < 4; ++q) {
+    if (best[q] > -std::numeric_limits<double>::infinity()) points[count++] = pose.position + pose.orientation * found[q];
+  }
+  return count;
+}
+
+}  // namespace
+
+// An unresolved pair's contact from the two root spheres, between a movable
+// and a static body, whose boxes touch (separation 0: its overlap is not
+// proven, so it pushes nothing apart) acts at one point, where the boxes
+// overlap: a rock rolling on a plate under a tick budget turned its far
+// corners into the plate a few mm a tick, below the sweep's threshold,
+// until they were more than a voxel deep. It becomes the movable body's
+// deepest voxels along the normal, one per quadrant around it: a manifold
+// that holds the body up where it touches.
+void Physics::holdOnStatic(const StepContext& step, std::uint32_t ia, std::uint32_t ib, std::size_t before,
+                           std::vector<Contact>& out) const {
+  const BodyState& a = (*step.bodies)[ia];
+  const BodyState& b = (*step.bodies)[ib];
+  if (a.is_static == b.is_static) return;
+  const std::uint32_t mover = a.is_static ? ib : ia;
+  const ShapeBounds& bounds = (*step.shape_bounds)[(*step.body_shapes)[mover]];
+  const Pose& pose = (*step.bodies)[mover].pose;
+  const std::size_t end = out.size();
+  for (std::size_t k = before; k < end; ++k) {
+    if (out[k].resolved || out[k].node_a != 0 || out[k].node_b != 0 || out[k].separation > 0.0) continue;
+    Vec3 points[4];
+    const int count = deepestPoints(bounds, pose, a.is_static ? Vec3(-out[k].normal) : out[k].normal, points);
+    out[k].point = points[0];
+    for (int p = 1; p < count; ++p) {
+      Contact c = out[k];
+      c.point = points[p];
       out.push_back(c);
     }
   }
+}
+
+// The sweep held a body back at pair i's first touch, but the test gave no
+// contact proven at the leaves (interrupted: none, or its frontier's, whose
+// separations are at least 0 and whose normals run along the line of centres
+// of spheres that may be the roots): the hit is a contact too, so the
+// response turns the approach the sweep stopped. Without it a budgeted tick
+// held the body back tick after tick while its velocity kept gravity's gain
+// (stored m/s, real mm/s), until the pair resolved and released it.
+void Physics::appendSweepHit(const PairTest& test, std::uint32_t ia, std::uint32_t ib, std::size_t i,
+                             double priority, std::size_t before, std::vector<Contact>& out) const {
+  if (sweep_hit_of_pair_[i] < 0) return;
+  for (std::size_t k = before; k < out.size(); ++k) {
+    if (out[k].resolved) return;  // the leaves' contacts turn it
+  }
+  const SweepHit& hit = sweep_scratch_.hits[static_cast<std::size_t>(sweep_hit_of_pair_[i])];
+  Contact c;
+  c.a = test.bodyA().id;
+  c.b = test.bodyB().id;
+  c.index_a = ia;
+  c.index_b = ib;
+  c.point = hit.point;
+  c.normal = hit.normal;
+  c.resolved = true;
+  c.priority = priority;
+  out.push_back(c);
 }
 
 void Physics::buildContacts(const StepContext& step) {
