@@ -8,7 +8,8 @@
 //
 // What is a moving entity on screen: the demo draws sphere-tree level 2 for
 // movable entities only (static_tree_markers false: walls have none), in the
-// level's teal, and rocks' voxels in warm greys (red > green > blue); walls,
+// level's teal, and rocks' voxels in warm greys (red > green > blue) where a
+// config shows them (demo.rviz hides them); walls (one grey box per tile),
 // grid and background are neutral or blue-grey. Contacts (green, orange), the
 // gaze (magenta) and the error bounds (amber) are other hues and not counted.
 #include "rostest_util.hpp"
