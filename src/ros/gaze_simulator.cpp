@@ -20,13 +20,18 @@ GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) 
   // What needs no image is checked first: a bad parameter ends the node at
   // once, not after the world node's camera arrives (or never does).
   const std::string mode = paramOr<std::string>(pnh, "mode", "saccades");
-  if (mode != "fixed" && mode != "saccades" && mode != "circle" && mode != "follow") {
-    throw InputError("mode", "unknown value '" + mode + "' (expected one of: fixed, circle, saccades, follow)");
+  if (mode != "fixed" && mode != "saccades" && mode != "circle" && mode != "follow" && mode != "active") {
+    throw InputError("mode", "unknown value '" + mode + "' (expected one of: fixed, circle, saccades, follow, active)");
   }
   const double rate = positiveParam(pnh, "rate", 30.0);
   if (mode == "follow") {
     target_ = paramOr<std::string>(pnh, "target", "");
     if (target_.empty()) throw InputError("target", "follow needs the tf frame of an entity");
+  }
+  if (mode == "active") {
+    min_speed_ = positiveParam(pnh, "min_speed", min_speed_);
+    switch_ratio_ = positiveParam(pnh, "switch_ratio", switch_ratio_);
+    if (switch_ratio_ > 1.0) throw InputError("switch_ratio", "must be in (0, 1]");
   }
 
   // The world node's perception camera, as it publishes it (latched): the
@@ -68,11 +73,16 @@ GazeSimulator::GazeSimulator(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) 
     if (circle_radius_ > 0.5 * std::min(width_, height_)) {
       throw InputError("circle_radius", "the circle must fit the image");
     }
-  } else {  // follow (its target is checked above)
-    mode_ = Mode::Follow;
-    if (camera_frame_.empty()) throw InputError("mode", "follow needs the camera in tf (world node ~published_camera_frame)");
+  } else {  // follow (its target is checked above) and active
+    mode_ = mode == "follow" ? Mode::Follow : Mode::Active;
+    if (camera_frame_.empty()) throw InputError("mode", mode + " needs the camera in tf (world node ~published_camera_frame)");
     tf_ = std::make_unique<tf2_ros::Buffer>();
     listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_, nh_);
+    if (mode_ == Mode::Active) {
+      states_sub_ = nh_.subscribe<sphere_tree_collision::EntityStates>(
+          ros::names::append(world_node, "entity_states"), 1,
+          [this](const sphere_tree_collision::EntityStates::ConstPtr& m) { states_ = m; });
+    }
   }
 
   pub_ = nh_.advertise<sphere_tree_collision::GazePoint>("gaze", 10);
@@ -97,6 +107,55 @@ std::optional<stc::Vec2> GazeSimulator::followPixel() {
   return last_follow_;
 }
 
+std::optional<stc::Vec2> GazeSimulator::activePixel(const ros::Time& now) {
+  if (!states_) return last_follow_;
+  const auto& m = *states_;
+  geometry_msgs::TransformStamped to_camera;
+  try {
+    to_camera = tf_->lookupTransform(camera_frame_, m.header.frame_id, ros::Time(0));
+  } catch (const tf2::TransformException& e) {
+    ROS_WARN_THROTTLE(5.0, "gaze_simulator: no camera pose for active: %s", e.what());
+    return last_follow_;
+  }
+  const auto& t = to_camera.transform;
+  const stc::Quat q(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z);
+  const stc::Vec3 origin(t.translation.x, t.translation.y, t.translation.z);
+  // Where each entity is now (its last state moved on at its velocity), and
+  // where that is on the image; entities off the image are not candidates.
+  const double ahead = std::clamp((now - m.header.stamp).toSec(), 0.0, 0.5);
+  struct Seen {
+    double speed = -1.0;
+    stc::Vec2 pixel;
+    std::size_t index = 0;
+  };
+  Seen fastest, current;
+  for (std::size_t i = 0; i < m.poses.size() && i < m.twists.size() && i < m.ids.size(); ++i) {
+    const auto& p = m.poses[i].position;
+    const auto& v = m.twists[i].linear;
+    const stc::Vec3 velocity(v.x, v.y, v.z);
+    const stc::Vec3 c = q * (stc::Vec3(p.x, p.y, p.z) + ahead * velocity) + origin;
+    if (!(c.z() > stc::Perception::kNearDepth)) continue;
+    const cv::Point2d px = camera_.project3dToPixel(cv::Point3d(c.x(), c.y(), c.z()));
+    if (!(px.x >= 0 && px.y >= 0 && px.x <= width_ && px.y <= height_)) continue;
+    const Seen seen{velocity.norm(), stc::Vec2(px.x, px.y), i};
+    if (seen.speed > fastest.speed) fastest = seen;
+    if (active_id_ && m.ids[i] == *active_id_) current = seen;
+  }
+  // Stay on the rock looked at while it moves about as fast as the fastest
+  // (no flicker between two falling together); else go to the fastest; with
+  // nothing moving, rest on the last one seen (the pile).
+  const bool keep = current.speed >= 0.0 &&
+                    (current.speed >= switch_ratio_ * fastest.speed || fastest.speed < min_speed_);
+  if (keep) {
+    last_follow_ = current.pixel;
+  } else if (fastest.speed >= min_speed_) {
+    active_id_ = m.ids[fastest.index];
+    last_follow_ = fastest.pixel;
+  }
+  if (last_follow_) follow_stamp_ = now;
+  return last_follow_;
+}
+
 void GazeSimulator::publish() {
   // The pixel is a function of the stamp the message carries (time since the
   // first message), so a subscriber can check the motion from stamps alone.
@@ -118,6 +177,9 @@ void GazeSimulator::publish() {
     }
     case Mode::Follow:
       pixel = followPixel();
+      break;
+    case Mode::Active:
+      pixel = activePixel(stamp);
       break;
   }
   if (!pixel) return;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 
 namespace stc_ros {
 namespace {
@@ -51,7 +52,8 @@ int groupId(stc::EntityId id, std::size_t group) {
   return static_cast<int>((static_cast<std::uint64_t>(id) * kMaxGroups + group) & 0x7fffffffu);
 }
 
-const std::string kContactsNs = "contacts", kNormalsNs = "contact_normals", kGazeNs = "gaze", kVoxelsNs = "voxels";
+const std::string kContactsNs = "contacts", kNormalsNs = "contact_normals", kGazeNs = "gaze", kVoxelsNs = "voxels",
+                  kStaticBoxesNs = "static_boxes";
 
 }  // namespace
 
@@ -62,13 +64,21 @@ const MarkerBuilder::ShapeGeometry& MarkerBuilder::geometry(const stc::World& wo
   const stc::ShapeInfo& info = world.shape(id);
   const stc::VoxelShape& v = info.voxels;
   const double s = v.voxelSize();
+  stc::Vec3 lo = stc::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (int k = 0; k < v.nz(); ++k) {
     for (int j = 0; j < v.ny(); ++j) {
       for (int i = 0; i < v.nx(); ++i) {
         if (!v.isSurfaceVoxel(i, j, k)) continue;
-        g.surface_voxels.push_back(toPointMsg(stc::Vec3(i + 0.5, j + 0.5, k + 0.5) * s - info.body_origin));
+        const stc::Vec3 centre = stc::Vec3(i + 0.5, j + 0.5, k + 0.5) * s - info.body_origin;
+        g.surface_voxels.push_back(toPointMsg(centre));
+        lo = lo.cwiseMin(centre);
+        hi = hi.cwiseMax(centre);
       }
     }
+  }
+  if (!g.surface_voxels.empty()) {
+    g.box_centre = 0.5 * (lo + hi);
+    g.box_size = (hi - lo).array() + s;
   }
   const stc::SphereTree& tree = info.tree;
   g.levels.resize(static_cast<std::size_t>(tree.levelCount()));
@@ -158,7 +168,18 @@ void MarkerBuilder::addEntity(const stc::World& world, std::size_t index, const 
     m.frame_locked = frame_locked;
     if (!frame_locked) setPose(m, body.pose);
   };
-  if (options.voxels) {
+  if (body.is_static && !options.static_voxels) {
+    // One box instead of every voxel: a wall of thousands of voxels costs rviz
+    // as much as one cube (the rockfall's ravine: ~24,000 cubes become ~370).
+    // A static entity never moves: the box is placed in the world frame, not
+    // frame-locked, so rviz does not look up hundreds of wall frames each frame.
+    Marker& m = next(out, kStaticBoxesNs, static_cast<int>(id & 0x7fffffffu), Marker::CUBE, stamp, options.frame);
+    setPose(m, stc::Pose{body.pose.apply(g.box_centre), body.pose.orientation});
+    m.scale.x = g.box_size.x();
+    m.scale.y = g.box_size.y();
+    m.scale.z = g.box_size.z();
+    m.color = toColorMsg(color[0], color[1], color[2], color[3]);
+  } else if (options.voxels) {
     Marker& m = next(out, kVoxelsNs, static_cast<int>(id & 0x7fffffffu), Marker::CUBE_LIST, when, frame);
     place(m);
     m.scale.x = m.scale.y = m.scale.z = world.shape(shape).voxels.voxelSize() * kVoxelFill;
@@ -181,7 +202,10 @@ void MarkerBuilder::addEntity(const stc::World& world, std::size_t index, const 
 void MarkerBuilder::deleteEntity(const stc::World& world, stc::EntityId id, stc::ShapeId shape, bool is_static,
                                  const MarkerOptions& options, visualization_msgs::MarkerArray& out) {
   const ShapeGeometry& g = geometry(world, shape);
-  if (options.voxels) {
+  if (is_static && !options.static_voxels) {
+    next(out, kStaticBoxesNs, static_cast<int>(id & 0x7fffffffu), Marker::CUBE, ros::Time(0), options.frame).action =
+        Marker::DELETE;
+  } else if (options.voxels) {
     next(out, kVoxelsNs, static_cast<int>(id & 0x7fffffffu), Marker::CUBE_LIST, ros::Time(0), options.frame).action =
         Marker::DELETE;
   }

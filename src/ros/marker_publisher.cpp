@@ -12,6 +12,7 @@ MarkerOptions markerOptionsOf(const NodeParams& params) {
   o.levels = params.marker_levels;
   o.voxels = params.show_voxels;
   o.static_trees = params.static_tree_markers;
+  o.static_voxels = params.static_voxel_markers;
   o.max_contacts = static_cast<std::size_t>(params.max_contact_markers);
   o.contact_size = params.contact_marker_size;
   return o;

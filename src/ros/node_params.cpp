@@ -17,7 +17,7 @@ using stc::InputError;
 // Every private parameter the node reads; others are reported as unknown.
 const std::set<std::string>& knownParams() {
   static const std::set<std::string> kNames{
-      "scene", "scene_entities", "scene_seed", "entity_size", "world_frame", "rate", "marker_rate", "marker_levels", "marker_mode", "marker_keyframe_period", "show_voxels", "static_tree_markers", "publish_tf",
+      "scene", "scene_entities", "scene_seed", "entity_size", "world_frame", "rate", "marker_rate", "marker_levels", "marker_mode", "marker_keyframe_period", "show_voxels", "static_tree_markers", "static_voxel_markers", "publish_tf",
       "max_contact_markers", "contact_marker_size", "detection_budget", "sphere_test_budget", "tick_budget", "scheduler", "queue_count", "queue_ratio",
       "unresolved_policy", "max_entities", "max_voxels", "tree_levels", "sphere_fit", "gravity",
       "response", "solver_iterations", "gaze_timeout", "default_resolution", "default_density", "default_voxel_size", "camera_frame", "published_camera_frame",
@@ -139,6 +139,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   p.entities_rate = positiveParam(nh, "entities_rate", p.entities_rate);
   readParam(nh, "publish_clock", p.publish_clock);
   readParam(nh, "static_tree_markers", p.static_tree_markers);
+  readParam(nh, "static_voxel_markers", p.static_voxel_markers);
   readParam(nh, "publish_tf", p.publish_tf);
   p.marker_keyframe_period = nonNegativeParam(nh, "marker_keyframe_period", p.marker_keyframe_period);
   std::string mode = "auto";

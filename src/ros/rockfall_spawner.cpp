@@ -35,6 +35,7 @@ RockfallSpawner::RockfallSpawner(ros::NodeHandle nh, ros::NodeHandle pnh) {
   resolution_ = intParamIn(pnh, "resolution", resolution_, 2, 64);
   shape_count_ = intParamIn(pnh, "shape_count", shape_count_, 1, 1000);
   max_rocks_ = intParamIn(pnh, "max_rocks", max_rocks_, 1, 1000000);
+  count_ = static_cast<std::uint64_t>(intParamIn(pnh, "count", 0, 0, 100000000));  // 0: drops for ever
   density_ = positiveParam(pnh, "density", density_);
   restitution_ = paramOr(pnh, "restitution", restitution_);
   friction_ = paramOr(pnh, "friction", friction_);  // the world validates these, by name
@@ -50,6 +51,7 @@ RockfallSpawner::RockfallSpawner(ros::NodeHandle nh, ros::NodeHandle pnh) {
 
 void RockfallSpawner::drop() {
   if (spawn_.getNumSubscribers() == 0) return;  // no world yet: nothing to drop into
+  if (count_ > 0 && dropped_ >= count_) return;  // all dropped: the pile comes to rest
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const stc::Vec3 at = region_min_ + (region_max_ - region_min_).cwiseProduct(stc::Vec3(unit(random_), unit(random_), unit(random_)));
   // A uniformly random rotation from three uniforms (Shoemake).

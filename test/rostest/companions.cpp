@@ -1,4 +1,4 @@
-// Companion nodes: gaze_simulator's four modes put the gaze where they say,
+// Companion nodes: gaze_simulator's five modes put the gaze where they say,
 // and rockfall_spawner drops valid rocks at its rate, keeping at most
 // max_rocks alive (oldest despawned first).
 #include "rostest_util.hpp"
@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 #include <sphere_tree_collision/Despawn.h>
+#include <sphere_tree_collision/EntityStates.h>
 #include <sphere_tree_collision/GazePoint.h>
 #include <sphere_tree_collision/SpawnEntity.h>
 #include <sphere_tree_collision/TickStats.h>
@@ -160,6 +161,54 @@ TEST(Companions, FollowGazeTracksTheEntitysProjection) {
         return checked >= 10;
       },
       stc_test::kLivenessSeconds));
+}
+
+// Active: the gaze is on an entity on the image (the fastest, by the node), where the
+// latest entity_states (moved on at its velocity to the gaze's stamp) puts it.
+// The rockfall spawner's rocks fall in front of the camera: something moves.
+TEST(Companions, ActiveGazeIsOnAnEntityOnTheImage) {
+  ros::NodeHandle nh;
+  tf2_ros::Buffer tf;
+  tf2_ros::TransformListener listener(tf, nh, false);
+  Recorder<sphere_tree_collision::EntityStates> states(nh, "/collision_world/entity_states", 1);
+  Recorder<GazePoint> gaze(nh, "/active/gaze");
+  ASSERT_TRUE(gaze.waitFor(1, stc_test::kLivenessSeconds)) << "no active gaze: nothing moved on the image?";
+  ASSERT_TRUE(states.waitFor(1, stc_test::kLivenessSeconds));
+  ASSERT_TRUE(stc_test::spinUntil([&] { return tf.canTransform("world", "perception_camera", ros::Time(0)); },
+                                  stc_test::kLivenessSeconds));
+  const auto cam = tf.lookupTransform("world", "perception_camera", ros::Time(0));
+  stc::Camera camera;
+  camera.camera_to_world.position = stc_ros::toEigen(cam.transform.translation);
+  camera.camera_to_world.orientation = stc_ros::toEigen(cam.transform.rotation).normalized();
+  stc::Perception perception;
+  perception.setCamera(camera);
+  // Near some entity's projection (the simulator may have used the states
+  // message before or after ours: a falling rock moves a few pixels between).
+  constexpr double kNearPixels = 60.0;
+  int checked = 0, near = 0;
+  gaze.keep_all = true;
+  gaze.clear();
+  ASSERT_TRUE(stc_test::spinUntil(
+      [&] {
+        while (checked < 20 && !gaze.all.empty()) {
+          const GazePoint g = gaze.all.front();
+          gaze.all.erase(gaze.all.begin());
+          EXPECT_TRUE(onImage(g)) << g.x << ", " << g.y;
+          const auto& m = states.last;
+          const double ahead = std::max(0.0, (g.header.stamp - m.header.stamp).toSec());
+          double best = 1e9;
+          for (std::size_t i = 0; i < m.poses.size(); ++i) {
+            const auto& v = m.twists[i].linear;
+            const stc::Vec3 at = stc_ros::toEigen(m.poses[i].position) + ahead * stc::Vec3(v.x, v.y, v.z);
+            if (const auto pixel = perception.project(at)) best = std::min(best, std::hypot(g.x - pixel->x(), g.y - pixel->y()));
+          }
+          near += best < kNearPixels;
+          ++checked;
+        }
+        return checked >= 20;
+      },
+      stc_test::kLivenessSeconds));
+  EXPECT_GE(near, 16) << "of 20 active gazes, " << near << " within " << kNearPixels << " px of an entity";
 }
 
 TEST(Companions, RockfallDropsValidRocksAndKeepsAtMostMaxRocks) {

@@ -90,11 +90,12 @@ class Child {
   pid_t pid_ = -1;
 };
 
-// Starts Xvfb on a free display; returns ":N", or "" when it does not come up.
-inline std::string startXvfb(Child& xvfb, const std::string& exe, const std::string& log_path) {
+// Starts Xvfb on a free display (width x height pixels); returns ":N", or "" when it does not come up.
+inline std::string startXvfb(Child& xvfb, const std::string& exe, const std::string& log_path,
+                             int width = kScreenWidth, int height = kScreenHeight) {
   int fds[2];
   if (::pipe(fds) != 0) return "";
-  const std::string size = std::to_string(kScreenWidth) + "x" + std::to_string(kScreenHeight) + "x24";
+  const std::string size = std::to_string(width) + "x" + std::to_string(height) + "x24";
   const bool started = xvfb.start({exe, "-displayfd", std::to_string(fds[1]), "-screen", "0", size, "-nolisten", "tcp"},
                                   "", log_path, fds[1]);
   ::close(fds[1]);

@@ -32,6 +32,7 @@ struct MarkerOptions {
   std::vector<int> levels{1, 2};  // sphere-tree levels to draw
   bool voxels = true;
   bool static_trees = true;       // false: no tree levels for static entities (large walls hide the scene)
+  bool static_voxels = true;      // false: a static entity drawn as one box around its voxels (ns static_boxes), cheap to render
   std::size_t max_contacts = 2000;
   double contact_size = 0.04;     // metres: diameter of the lowest-priority contact sphere
 };
@@ -79,6 +80,7 @@ class MarkerBuilder {
   struct ShapeGeometry {
     bool built = false;
     std::vector<geometry_msgs::Point> surface_voxels;  // voxel centres, body frame
+    stc::Vec3 box_centre = stc::Vec3::Zero(), box_size = stc::Vec3::Zero();  // around the voxels, body frame
     std::vector<std::vector<RadiusGroup>> levels;      // [level][group], at most kMaxGroups per level
   };
   const ShapeGeometry& geometry(const stc::World& world, stc::ShapeId id);

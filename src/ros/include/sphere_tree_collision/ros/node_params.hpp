@@ -45,6 +45,7 @@ struct NodeParams {
   double marker_keyframe_period = 2.0;  // s, incremental mode: full snapshot this often (0: never)
   bool show_voxels = true;
   bool static_tree_markers = true;
+  bool static_voxel_markers = true;  // false: static entities drawn as the box around their voxels
   bool publish_tf = true;
   int max_contact_markers = 2000;
   double contact_marker_size = 0.04;  // m

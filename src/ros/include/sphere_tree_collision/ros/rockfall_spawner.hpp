@@ -3,7 +3,8 @@
 // ~region_max] (by default above the upper ravine of the built-in "rockfall"
 // scene), moving downhill at ~speed along ~direction, tumbling. Rock shapes
 // cycle through ~shape_count seeds so the world shares their trees. Beyond
-// ~max_rocks the oldest rock is despawned. Breaking is not modelled.
+// ~max_rocks the oldest rock is despawned; after ~count drops (0: never) it
+// stops, and the pile comes to rest. Breaking is not modelled.
 #pragma once
 
 #include "sphere_tree_collision/types.hpp"
@@ -30,6 +31,7 @@ class RockfallSpawner {
   int resolution_ = 8, shape_count_ = 4, max_rocks_ = 60;
   std::uint32_t seed_ = 1;
   std::uint64_t dropped_ = 0;
+  std::uint64_t count_ = 0;  // rocks to drop in all (0: no end)
   std::deque<std::string> live_;  // names of the rocks spawned, oldest first
   std::mt19937 random_;
   ros::Publisher spawn_, despawn_;
