@@ -40,7 +40,8 @@ struct Picture {
 constexpr Picture kPictures[] = {{10.0, false, "demo_10s"}, {60.0, false, "demo_60s"}, {90.0, true, "demo_rest"}};
 constexpr double kRestSpeed = 0.05;     // m/s: no entity faster is "at rest"
 constexpr double kRestGuardSeconds = 240.0;  // tick time by which the pile must be at rest
-constexpr int kScreenWidth = 1920, kScreenHeight = 1080;
+using stc_rviz::kScreenWidth;
+using stc_rviz::kScreenHeight;
 // Pixels in moving entities' colours (of 1920 x 1080). The demo's view shows
 // 50,000 (10 s) to 120,000 (at rest); rocks out of the view leave next to none.
 constexpr long kMinMoverPixels = 5000;
@@ -89,7 +90,7 @@ TEST(DemoPictures, MovingEntitiesInViewAt10sAnd60sAndThePileAtRest) {
   stc_rviz::Child xvfb, rviz;
   // The screen of issue 50's user: Xvfb has no window manager, so rviz's
   // --fullscreen cannot resize the window, and demo.rviz's 1920x1080 fills it.
-  const std::string display = stc_rviz::startXvfb(xvfb, *xvfb_exe, dir + "/xvfb.log", kScreenWidth, kScreenHeight);
+  const std::string display = stc_rviz::startXvfb(xvfb, *xvfb_exe, dir + "/xvfb.log");
   ASSERT_FALSE(display.empty()) << "Xvfb did not start (log: " << dir << "/xvfb.log)";
   ASSERT_TRUE(rviz.start({*rviz_exe, "-d", rviz_config, "--fullscreen"}, display, dir + "/rviz.log"));
 

@@ -27,8 +27,11 @@
 
 namespace stc_rviz {
 
-constexpr int kScreenWidth = 1280;
-constexpr int kScreenHeight = 800;
+// The screen the shipped rviz configs fill: rviz/demo.rviz opens a 1920x1080
+// window (full screen on such a screen); on a smaller one only its top-left
+// part shows, and the view the tests judge is cut.
+constexpr int kScreenWidth = 1920;
+constexpr int kScreenHeight = 1080;
 constexpr int kColourfulSpread = 40;  // max(r,g,b) - min(r,g,b) above this: "in colour"
 
 inline std::optional<std::string> findExecutable(const std::string& name) {
@@ -90,12 +93,11 @@ class Child {
   pid_t pid_ = -1;
 };
 
-// Starts Xvfb on a free display (width x height pixels); returns ":N", or "" when it does not come up.
-inline std::string startXvfb(Child& xvfb, const std::string& exe, const std::string& log_path,
-                             int width = kScreenWidth, int height = kScreenHeight) {
+// Starts Xvfb on a free display of kScreenWidth x kScreenHeight; returns ":N", or "" when it does not come up.
+inline std::string startXvfb(Child& xvfb, const std::string& exe, const std::string& log_path) {
   int fds[2];
   if (::pipe(fds) != 0) return "";
-  const std::string size = std::to_string(width) + "x" + std::to_string(height) + "x24";
+  const std::string size = std::to_string(kScreenWidth) + "x" + std::to_string(kScreenHeight) + "x24";
   const bool started = xvfb.start({exe, "-displayfd", std::to_string(fds[1]), "-screen", "0", size, "-nolisten", "tcp"},
                                   "", log_path, fds[1]);
   ::close(fds[1]);
