@@ -61,7 +61,7 @@ struct ResponseOptions {
   double reuse_tolerance = 0.0;
   // With threads > 1: a solver stage (contact_partition.hpp) of fewer
   // manifolds than this runs on the calling thread, a bigger one's blocks on
-  // the workers (each hand-off may wake a worker; docs/architecture.md). >= 1.
+  // the workers (each hand-off may wake a worker; docs/parallel.md). >= 1.
   int solver_task_manifolds = 32;
 };
 // Throws InputError naming the field ("response.iterations", ...).

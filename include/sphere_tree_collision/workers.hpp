@@ -51,7 +51,7 @@ struct LoopTimes {
 // The threads of one Workers::withTeam call: the calling thread (member 0)
 // and the arena's other threads, which stay awake between the stages it
 // posts, so a stage starts within microseconds instead of after a worker's
-// wake-up (0.3-8 ms on this 2-core VM: docs/architecture.md).
+// wake-up (0.3-8 ms on this 2-core VM: docs/parallel.md).
 class Team {
  public:
   static constexpr std::size_t kMaxBlocks = 64;  // of one forBlocks round

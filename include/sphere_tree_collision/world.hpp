@@ -59,7 +59,7 @@ struct WorldConfig {
   SleepOptions sleeping;  // islands at rest sleep (islands.hpp); validated as "sleeping.*"
   // Threads of the tick (workers.hpp): 0 = every core, 1 = the calling thread
   // alone (no task library), n = n. Results at an unlimited budget do not
-  // depend on it (docs/architecture.md, the parallel tick). Throws
+  // depend on it (docs/parallel.md). Throws
   // InputError("threads") outside [0, kMaxThreads].
   int threads = 1;
 };

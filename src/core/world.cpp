@@ -328,7 +328,7 @@ TickReport World::step(double dt, const Budget& budget) {
   if (timed_tick) report.tick_budget_s = std::max(budget.tick_seconds, 0.0);
   double t0i = 0.0, t1 = 0.0, t2 = 0.0, t2s = 0.0, t3 = 0.0, t4 = 0.0, t5 = 0.0, scheduled = 0.0;
   // One team for the phases: the workers stay awake from loop to loop
-  // (waking one costs more than many a loop here: docs/architecture.md).
+  // (waking one costs more than many a loop here: docs/parallel.md).
   const LoopTimes loops_before = workers_.loopTimes();
   workers_.withTeam([&](Team&) {
     t0i = breakPending(t0, tick_end, report);  // splits the last tick had no time for

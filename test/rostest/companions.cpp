@@ -39,6 +39,17 @@ bool recordSpan(Recorder<GazePoint>& gaze, double seconds) {
   return stc_test::spinUntil([&] { return stampSpan(gaze.all) >= seconds; }, stc_test::kLivenessSeconds);
 }
 
+// The node's perception camera as tf has it (the simulators project with it).
+stc::Perception perceptionFromTf(const tf2_ros::Buffer& tf) {
+  const auto cam = tf.lookupTransform("world", "perception_camera", ros::Time(0));
+  stc::Camera camera;
+  camera.camera_to_world.position = stc_ros::toEigen(cam.transform.translation);
+  camera.camera_to_world.orientation = stc_ros::toEigen(cam.transform.rotation).normalized();
+  stc::Perception perception;
+  perception.setCamera(camera);
+  return perception;
+}
+
 TEST(Companions, FixedGazeStaysOnItsPixel) {
   ros::NodeHandle nh;
   Recorder<GazePoint> gaze(nh, "/fixed/gaze");
@@ -133,12 +144,7 @@ TEST(Companions, FollowGazeTracksTheEntitysProjection) {
   ASSERT_TRUE(stc_test::spinUntil(
       [&] { return tf.canTransform("world", "probe", ros::Time(0)) && tf.canTransform("world", "perception_camera", ros::Time(0)); },
       stc_test::kLivenessSeconds));
-  const auto cam = tf.lookupTransform("world", "perception_camera", ros::Time(0));
-  stc::Camera camera;
-  camera.camera_to_world.position = stc_ros::toEigen(cam.transform.translation);
-  camera.camera_to_world.orientation = stc_ros::toEigen(cam.transform.rotation).normalized();
-  stc::Perception perception;
-  perception.setCamera(camera);
+  const stc::Perception perception = perceptionFromTf(tf);
   // The simulator stamps each gaze with the tf stamp of the probe pose it
   // projected: the probe's pose at that stamp must project onto the gaze.
   gaze.keep_all = true;
@@ -176,12 +182,7 @@ TEST(Companions, ActiveGazeIsOnAnEntityOnTheImage) {
   ASSERT_TRUE(states.waitFor(1, stc_test::kLivenessSeconds));
   ASSERT_TRUE(stc_test::spinUntil([&] { return tf.canTransform("world", "perception_camera", ros::Time(0)); },
                                   stc_test::kLivenessSeconds));
-  const auto cam = tf.lookupTransform("world", "perception_camera", ros::Time(0));
-  stc::Camera camera;
-  camera.camera_to_world.position = stc_ros::toEigen(cam.transform.translation);
-  camera.camera_to_world.orientation = stc_ros::toEigen(cam.transform.rotation).normalized();
-  stc::Perception perception;
-  perception.setCamera(camera);
+  const stc::Perception perception = perceptionFromTf(tf);
   // Near some entity's projection (the simulator may have used the states
   // message before or after ours: a falling rock moves a few pixels between).
   constexpr double kNearPixels = 60.0;
