@@ -3,11 +3,19 @@
 // Bullet's btDiscreteDynamicsWorld with its defaults (dynamic AABB tree broad
 // phase, sequential impulses with 10 iterations and split impulse, sleeping
 // on), on the same bodies: same poses, velocities, masses, inertia, gravity,
-// dt and materials. Bullet gets each voxel shape twice, one run each:
+// dt and materials. Bullet gets each voxel shape three ways, one run each:
 //   compound  btCompoundShape of the shape's leaf spheres (its SphereTree);
-//   hull      btConvexHullShape of the corners of the occupied voxels, shrunk
-//             by its collision margin so that hull + margin is the voxel hull.
+//   hull      btConvexHullShape of the corners of the surface voxels, shrunk
+//             by its collision margin (Bullet's default 0.04 m, at most a
+//             quarter of the hull's inner radius) so that hull + margin is
+//             the voxel hull;
+//   lean      Bullet at its best: a full box of voxels (the cubes, the wall
+//             plates) as a btBoxShape; any other shape as a btConvexHullShape
+//             of its surface-voxel corners reduced by optimizeConvexHull()
+//             to the hull's vertices, with a 1 cm margin (so its surface is
+//             1 cm outside the voxel hull).
 // Walls (static plates) are built the same way as the movers in each run.
+// Each run prints, per shape, what Bullet got: spheres, or vertices and margin.
 // Materials combine as in this package: restitution max, friction sqrt(a b),
 // rolling resistance the larger (see combinedRolling).
 //
@@ -17,7 +25,8 @@
 // against mean |dx|/dt (they agree when stored velocity is real motion),
 // final mean speed, bodies out of the scene's bounds (at the end; ever).
 // Ends with one SUMMARY line per scene: this package's thread-CPU p50 and
-// p99, Bullet's best (lowest) thread-CPU p50 and the ratio of the two p50s.
+// p99, Bullet's best (lowest) thread-CPU p50, which variant that was, and the
+// ratio of the two p50s.
 //
 // Usage: bench_bullet_compare [--seconds S] [--settle S] [--scenes LIST] [--variants LIST] [--iterations N]
 //                             [--reuse T] [--markdown FILE]
@@ -26,9 +35,9 @@
 //               ticks are those of a settling scene, where both engines put
 //               islands at rest to sleep (docs/sleeping.md)
 //   --scenes    comma separated, each NAME or NAME:BODIES (default: corner_drift:500,
-//               packed_box:500, rockfall:1000, rockfall:5000, cube_box:10000;
-//               a bare NAME picks that scene's cases from the default list)
-//   --variants  Bullet shapes to run: compound,hull (default both; empty: none)
+//               packed_box:500, rockfall:1000, rockfall:5000, cube_box:10000,
+//               pyramid:5050; a bare NAME picks that scene's cases from the default list)
+//   --variants  Bullet shapes to run: compound,hull,lean (default all three; empty: none)
 //   --bullet-only  skip this package's run (to run the engines apart, in parallel)
 //   --smoke     every scene at 100 bodies at most, 0.05 s, no settling: that the bench runs, scripts/bench_smoke.sh
 //   --iterations N  this package's velocity and position iterations per tick
@@ -76,7 +85,8 @@ const std::vector<Case> kDefaultCases{{SceneKind::CornerDrift, 500},
                                       {SceneKind::PackedBox, 500},
                                       {SceneKind::Rockfall, 1000},
                                       {SceneKind::Rockfall, 5000},
-                                      {SceneKind::CubeBox, 10000}};
+                                      {SceneKind::CubeBox, 10000},
+                                      {SceneKind::Pyramid, 5050}};
 
 // What one engine did over one run of one scene.
 struct Run {
@@ -219,8 +229,11 @@ Run runPackage(const Case& c, int ticks, int settle_ticks, const PackageOptions&
 // ---------------------------------------------------------------------------
 // Bullet
 
-enum class BulletShape { Compound, Hull };
-const char* toString(BulletShape s) { return s == BulletShape::Compound ? "compound" : "hull"; }
+enum class BulletShape { Compound, Hull, Lean };
+const char* toString(BulletShape s) {
+  return s == BulletShape::Compound ? "compound" : s == BulletShape::Hull ? "hull" : "lean";
+}
+constexpr double kLeanMargin = 0.01;  // m: the lean hulls' collision margin
 
 btVector3 bt(const Vec3& v) { return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z())); }
 Vec3 eig(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
@@ -313,6 +326,8 @@ class BulletScene {
     for (std::size_t i = 0; i < world.entityCount(); ++i) add(world, i);
     for (EntityId id : spec.movers) movers_.push_back(bodies_[*world.indexOf(id)].get());
   }
+  // What Bullet got for each shape, one line each: "<shape>: <what>".
+  const std::vector<std::string>& shapeNotes() const { return notes_; }
   ~BulletScene() {
     for (auto& body : bodies_) world_.removeRigidBody(body.get());
   }
@@ -366,8 +381,32 @@ class BulletScene {
     s.principal = eigen.eigenvectors();
     if (s.principal.determinant() < 0.0) s.principal.col(2) *= -1.0;
     s.moments = eigen.eigenvalues();
-    s.shape = kind_ == BulletShape::Compound ? leafCompound(info, s.principal)
-                                             : voxelHull(info, s.principal);
+    const VoxelShape& v = info.voxels;
+    const Vec3 half = 0.5 * v.extent();
+    char note[160];
+    if (kind_ == BulletShape::Compound) {
+      s.shape = leafCompound(info, s.principal);
+      std::snprintf(note, sizeof note, "%d leaf spheres", static_cast<btCompoundShape*>(s.shape)->getNumChildShapes());
+    } else if (kind_ == BulletShape::Lean && v.occupiedCount() == static_cast<std::int64_t>(v.nx()) * v.ny() * v.nz() &&
+               (half - info.body_origin).norm() <= 1e-9 * half.norm()) {
+      // A full box, centred on its centre of mass: its grid axes are principal.
+      s.principal = Mat3::Identity();
+      s.moments = inertia.diagonal();
+      auto* box = new btBoxShape(bt(half));
+      s.shape = own(box);
+      std::snprintf(note, sizeof note, "btBoxShape %.3f x %.3f x %.3f m, margin %.3f m (inside the box)",
+                    2.0 * half.x(), 2.0 * half.y(), 2.0 * half.z(), static_cast<double>(box->getMargin()));
+    } else {
+      auto* hull = static_cast<btConvexHullShape*>(kind_ == BulletShape::Hull ? voxelHull(info, s.principal)
+                                                                              : leanHull(info, s.principal));
+      s.shape = hull;
+      std::snprintf(note, sizeof note, "btConvexHullShape %d vertices, margin %.3f m", hull->getNumPoints(),
+                    static_cast<double>(hull->getMargin()));
+    }
+    char line[256];
+    std::snprintf(line, sizeof line, "%s (%d x %d x %d voxels of %.3f m, %lld occupied): %s", info.key.c_str(),
+                  v.nx(), v.ny(), v.nz(), v.voxelSize(), static_cast<long long>(v.occupiedCount()), note);
+    notes_.push_back(line);
     return shapes_.emplace(id, s).first->second;
   }
 
@@ -390,7 +429,8 @@ class BulletScene {
     return compound;
   }
 
-  btCollisionShape* voxelHull(const ShapeInfo& info, const Mat3& principal) {
+  // The corners of the surface voxels, in Bullet's body frame, x y z each.
+  static std::vector<double> surfaceCorners(const ShapeInfo& info, const Mat3& principal) {
     const VoxelShape& v = info.voxels;
     std::vector<double> corners;
     for (int k = 0; k < v.nz(); ++k) {
@@ -405,6 +445,11 @@ class BulletScene {
         }
       }
     }
+    return corners;
+  }
+
+  btCollisionShape* voxelHull(const ShapeInfo& info, const Mat3& principal) {
+    const std::vector<double> corners = surfaceCorners(info, principal);
     // Faces moved in by Bullet's default margin (at most a quarter of the
     // hull's inner radius); the margin puts them back.
     btConvexHullComputer computer;
@@ -419,6 +464,21 @@ class BulletScene {
     return hull;
   }
 
+  // Every surface corner, then optimizeConvexHull(): the hull's own vertices
+  // alone (collinear and coplanar corners dropped), with a 1 cm margin.
+  btCollisionShape* leanHull(const ShapeInfo& info, const Mat3& principal) {
+    const std::vector<double> corners = surfaceCorners(info, principal);
+    auto* hull = new btConvexHullShape();
+    own(hull);
+    for (std::size_t i = 0; i < corners.size(); i += 3) {
+      hull->addPoint(btVector3(btScalar(corners[i]), btScalar(corners[i + 1]), btScalar(corners[i + 2])), false);
+    }
+    hull->optimizeConvexHull();
+    hull->setMargin(btScalar(kLeanMargin));
+    hull->recalcLocalAabb();
+    return hull;
+  }
+
   BulletShape kind_;
   btDefaultCollisionConfiguration config_;
   btCollisionDispatcher dispatcher_{&config_};
@@ -427,6 +487,7 @@ class BulletScene {
   btDiscreteDynamicsWorld world_{&dispatcher_, &broad_phase_, &solver_, &config_};
   std::vector<std::unique_ptr<btCollisionShape>> owned_;
   std::map<ShapeId, BulletBodyShape> shapes_;
+  std::vector<std::string> notes_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;  // dense order of the World
   std::vector<btRigidBody*> movers_;
 };
@@ -439,6 +500,7 @@ Run runBullet(const Case& c, int ticks, int settle_ticks, BulletShape kind) {
     spec = built.spec;
     scene = std::make_unique<BulletScene>(built.world, spec, kind);
   }
+  for (const std::string& note : scene->shapeNotes()) std::printf("  Bullet %s: %s\n", toString(kind), note.c_str());
   for (int t = 0; t < settle_ticks; ++t) scene->step(spec.dt);
   Run run;
   run.engine = std::string("Bullet ") + toString(kind);
@@ -518,7 +580,7 @@ struct Options {
   bool bullet_only = false;
   PackageOptions package;
   std::vector<Case> cases;
-  std::vector<BulletShape> variants{BulletShape::Compound, BulletShape::Hull};
+  std::vector<BulletShape> variants{BulletShape::Compound, BulletShape::Hull, BulletShape::Lean};
   std::string markdown;
 };
 
@@ -550,7 +612,8 @@ Options parse(int argc, char** argv) {
       for (const std::string& v : splitList(args.value())) {
         if (v == "compound") o.variants.push_back(BulletShape::Compound);
         else if (v == "hull") o.variants.push_back(BulletShape::Hull);
-        else throw InputError("--variants", "unknown value '" + v + "' (expected compound, hull)");
+        else if (v == "lean") o.variants.push_back(BulletShape::Lean);
+        else throw InputError("--variants", "unknown value '" + v + "' (expected compound, hull, lean)");
       }
     } else if (a == "--smoke") {
       smoke = true;
@@ -606,6 +669,7 @@ int main(int argc, char** argv) {
     std::printf("%s", rows.c_str());
     std::fflush(stdout);
     double best = NAN;
+    std::string best_variant = "none";
     for (BulletShape v : opt.variants) {
       const Run theirs = runBullet(c, ticks, settle_ticks, v);
       const std::string row = runRow(c, theirs);
@@ -614,7 +678,10 @@ int main(int argc, char** argv) {
       rows += row;
       bullet_phases_md += bulletPhaseRow(c, ours, theirs);
       const double p50 = percentile(theirs.cpu, 0.5);
-      if (!(best <= p50)) best = p50;
+      if (!(best <= p50)) {
+        best = p50;
+        best_variant = toString(v);
+      }
     }
     runs_md += rows;
     if (!opt.bullet_only) {
@@ -625,9 +692,9 @@ int main(int argc, char** argv) {
     const double p50 = percentile(ours.cpu, 0.5);
     std::snprintf(buf, sizeof buf,
                   "SUMMARY scene=%s bodies=%d p50_ms=%.3f p99_ms=%.3f bullet_best_p50_ms=%.3f "
-                  "ratio_p50=%.3f%s\n",
+                  "bullet_best=%s ratio_p50=%.3f%s\n",
                   toString(c.kind), c.bodies, 1e3 * p50, 1e3 * percentile(ours.cpu, 0.99), 1e3 * best,
-                  p50 / best, opt.package.summary().c_str());
+                  best_variant.c_str(), p50 / best, opt.package.summary().c_str());
     summary += buf;
   }
   std::string md;

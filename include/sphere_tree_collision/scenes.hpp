@@ -21,18 +21,20 @@ enum class SceneKind : std::uint8_t {
                 // in a walled tray that catches them; the ravine grows with the count
   CornerDrift,  // worst case: the packed box with gravity pointing into one corner
   CubeBox,      // cubes on a loose lattice in a closed box, falling into a pile under gravity
+  Pyramid,      // Box2D's large_pyramid: a plane pyramid of cubes at rest on a floor, rows
+                // offset by half a cube (5,050 cubes: a base of 100)
 };
-// "packed_box" | "bouncing_box" | "rockfall" | "corner_drift" | "cube_box";
+// "packed_box" | "bouncing_box" | "rockfall" | "corner_drift" | "cube_box" | "pyramid";
 // throws InputError("scene").
 SceneKind parseScene(const std::string& name);
 const char* toString(SceneKind kind);
 
 struct SceneParams {
-  int entities = 0;            // movable entities; 0: the scene's default (500, 100, 200, 500, 1000)
+  int entities = 0;            // movable entities; 0: the scene's default (500, 100, 200, 500, 1000, 5050)
   std::uint32_t seed = 1;      // poses, velocities and rock shapes
   double entity_size = 0.4;    // metres: largest extent of one entity
   int resolution = 8;          // voxels along an entity's largest extent
-  double speed = 1.0;          // m/s: scale of the random initial velocities
+  double speed = 1.0;          // m/s: scale of the random initial velocities (pyramid: at rest)
 };
 
 struct SceneSpec {

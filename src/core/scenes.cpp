@@ -14,12 +14,13 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 
-const std::array<std::pair<SceneKind, const char*>, 5> kScenes{{
+const std::array<std::pair<SceneKind, const char*>, 6> kScenes{{
     {SceneKind::PackedBox, "packed_box"},
     {SceneKind::BouncingBox, "bouncing_box"},
     {SceneKind::Rockfall, "rockfall"},
     {SceneKind::CornerDrift, "corner_drift"},
-    {SceneKind::CubeBox, "cube_box"}}};
+    {SceneKind::CubeBox, "cube_box"},
+    {SceneKind::Pyramid, "pyramid"}}};
 
 // Seeded draws that mean the same on every standard library (the
 // std:: distributions do not promise that).
@@ -151,6 +152,7 @@ int defaultCount(SceneKind kind) {
     case SceneKind::Rockfall: return 200;
     case SceneKind::CornerDrift: return 500;
     case SceneKind::CubeBox: return 1000;
+    case SceneKind::Pyramid: return 5050;  // a base of 100
   }
   return 100;
 }
@@ -266,6 +268,40 @@ void rockfall(SceneBuilder& b, SceneSpec& spec, const SceneParams& p, int count,
   spec.dt = 1.0 / 60.0;
 }
 
+// Pyramid: the layout of Box2D's large_pyramid benchmark, in one vertical
+// plane (x along the rows, z up): a base row of cubes side by side on a static
+// floor, each row above one cube shorter and shifted half a cube along x, so
+// every cube rests on two below. The cubes start touching and at rest, axis
+// aligned. `count` fills the rows from the base up: the base is the shortest
+// that holds them all (5,050 cubes: 100), the top row may be short. The floor
+// reaches a pyramid's width beyond each side along x (Box2D's ground is twice
+// the pyramid's width) and half its width to each side across; its edges are
+// the bounds. `speed` and `seed` are not used.
+void pyramid(SceneBuilder& b, SceneSpec& spec, const SceneParams& p, int count) {
+  const double size = p.entity_size;
+  int base = 1;
+  while (base * (base + 1) / 2 < count) ++base;
+  const double half_base = 0.5 * base * size;
+  const Material cube{0.0, 0.6};  // Box2D's default friction, no bounce
+  const double hx = 2.0 * half_base, hy = std::max(2.0 * size, 0.5 * half_base);
+  const double tile = std::max(2.5 * size, hx / 8.0);
+  b.wall(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), hx, hy, tile, cube);
+  const ShapeId shape = b.preset("cube", p.resolution, size, p.seed);
+  int placed = 0;
+  for (int row = 0; placed < count; ++row) {
+    for (int j = 0; j < base - row && placed < count; ++j, ++placed) {
+      Pose pose;
+      pose.position = Vec3(-half_base + (0.5 * (row + 1) + j) * size, 0.0, (row + 0.5) * size);
+      b.mover(shape, pose, Vec3::Zero(), Vec3::Zero(), cube);
+    }
+  }
+  const double height = base * size;
+  spec.bounds.min = Vec3(-hx, -hy, 0.0);
+  spec.bounds.max = Vec3(hx, hy, height + size);
+  spec.camera = cameraOn(Vec3(0.0, 0.0, 0.4 * height), 0.65 * height, Vec3(0.3, -1.0, 0.35));
+  spec.dt = 1.0 / 60.0;
+}
+
 }  // namespace
 
 SceneKind parseScene(const std::string& name) {
@@ -289,7 +325,8 @@ Vec3 sceneGravity(SceneKind kind) {
     case SceneKind::PackedBox: return Vec3::Zero();
     case SceneKind::BouncingBox:
     case SceneKind::Rockfall:
-    case SceneKind::CubeBox: return Vec3(0.0, 0.0, -kG);
+    case SceneKind::CubeBox:
+    case SceneKind::Pyramid: return Vec3(0.0, 0.0, -kG);
     case SceneKind::CornerDrift: return -kG * Vec3::Ones().normalized();  // into the box's (0,0,0) corner
   }
   return Vec3::Zero();
@@ -322,6 +359,8 @@ SceneSpec populateScene(World& world, SceneKind kind, const SceneParams& params)
   Draw draw(params.seed);
   if (kind == SceneKind::Rockfall) {
     rockfall(builder, spec, params, count, draw);
+  } else if (kind == SceneKind::Pyramid) {
+    pyramid(builder, spec, params, count);
   } else {
     boxScene(builder, spec, params, count, draw);
   }

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <string>
 
 namespace stc {
@@ -22,7 +23,7 @@ WorldConfig configFor(SceneKind kind) {
 
 constexpr SceneKind kAllScenes[] = {SceneKind::PackedBox, SceneKind::BouncingBox,
                                     SceneKind::Rockfall, SceneKind::CornerDrift,
-                                    SceneKind::CubeBox};
+                                    SceneKind::CubeBox, SceneKind::Pyramid};
 
 bool inside(const Aabb& box, const Vec3& p) {
   return p.allFinite() && (p.array() >= box.min.array()).all() && (p.array() <= box.max.array()).all();
@@ -173,6 +174,65 @@ TEST(Scenes, CubeBoxIsOneCubeShapeUnderGravityStartingApart) {
   const TickReport report = world.step(0.0, Budget::unlimited());
   EXPECT_GT(report.broad_pairs, 0u);
   EXPECT_EQ(report.colliding, 0u);
+}
+
+// Box2D's large_pyramid: a base of 100 cubes, each row one shorter and half a
+// cube along, the cubes touching, at rest, on a floor at z = 0.
+TEST(Scenes, PyramidIsBox2DsLargePyramid) {
+  World world(configFor(SceneKind::Pyramid));
+  const SceneSpec spec = populateScene(world, SceneKind::Pyramid);
+  ASSERT_EQ(spec.movers.size(), 5050u);
+  const ShapeId shape = world.bodyShapes()[*world.indexOf(spec.movers.front())];
+  const VoxelShape& voxels = world.shape(shape).voxels;
+  EXPECT_EQ(voxels.occupiedCount(), static_cast<std::int64_t>(voxels.nx()) * voxels.ny() * voxels.nz());
+  const double size = voxels.extent().x();
+  EXPECT_NEAR(size, SceneParams{}.entity_size, 1e-12);
+  std::map<long, std::vector<double>> rows;  // row -> x of its cubes
+  for (EntityId id : spec.movers) {
+    const BodyState& b = world.bodies()[*world.indexOf(id)];
+    EXPECT_EQ(world.bodyShapes()[*world.indexOf(id)], shape);
+    EXPECT_EQ(b.linear_velocity, Vec3::Zero());
+    EXPECT_EQ(b.angular_velocity, Vec3::Zero());
+    EXPECT_NEAR(b.pose.position.y(), 0.0, 1e-12);
+    const double row = b.pose.position.z() / size - 0.5;
+    EXPECT_NEAR(row, std::round(row), 1e-9);
+    rows[std::lround(row)].push_back(b.pose.position.x());
+  }
+  ASSERT_EQ(rows.size(), 100u);
+  for (auto& [row, xs] : rows) {
+    SCOPED_TRACE(row);
+    std::sort(xs.begin(), xs.end());
+    ASSERT_EQ(xs.size(), static_cast<std::size_t>(100 - row));
+    for (std::size_t j = 1; j < xs.size(); ++j) EXPECT_NEAR(xs[j] - xs[j - 1], size, 1e-9);  // touching
+    if (row > 0) EXPECT_NEAR(xs.front() - rows[row - 1].front(), 0.5 * size, 1e-9);
+  }
+  EXPECT_NEAR(rows[0].front() + rows[0].back(), 0.0, 1e-9);  // centred on x = 0
+  // Smaller counts fill the rows from the base up: 60 cubes stand on a base of 11.
+  World small(configFor(SceneKind::Pyramid));
+  SceneParams p;
+  p.entities = 60;
+  const SceneSpec s = populateScene(small, SceneKind::Pyramid, p);
+  std::size_t base = 0;
+  for (EntityId id : s.movers) base += small.bodies()[*small.indexOf(id)].pose.position.z() < size ? 1 : 0;
+  EXPECT_EQ(base, 11u);
+}
+
+// A small pyramid of the same layout stands: after 2 s no cube has moved more
+// than one of its voxels.
+TEST(Scenes, PyramidStands) {
+  World world(configFor(SceneKind::Pyramid));
+  SceneParams p;
+  p.entities = 55;  // a base of 10
+  const SceneSpec spec = populateScene(world, SceneKind::Pyramid, p);
+  std::vector<Vec3> start;
+  for (EntityId id : spec.movers) start.push_back(world.bodies()[*world.indexOf(id)].pose.position);
+  for (int tick = 0; tick < 120; ++tick) world.step(spec.dt, Budget::unlimited());
+  const double voxel = p.entity_size / p.resolution;
+  double moved = 0.0;
+  for (std::size_t k = 0; k < spec.movers.size(); ++k) {
+    moved = std::max(moved, (world.bodies()[*world.indexOf(spec.movers[k])].pose.position - start[k]).norm());
+  }
+  EXPECT_LT(moved, voxel);
 }
 
 TEST(Scenes, SameSeedSamePosesOtherSeedOtherPoses) {
