@@ -80,6 +80,7 @@ class WorldNode {
   template <typename F>
   void guarded(const char* what, F&& callback);
   void runTick();
+  void releaseFreedMemory();
   void onQuarantined(const stc::QuarantinedEntity& q, const ros::Time& stamp);
   void onBroken(const stc::BrokenEntity& broken);
   bool despawnPieces(const std::string& name);
@@ -110,6 +111,7 @@ class WorldNode {
   double dt_ = 0.0;
   std::uint64_t tick_ = 0;
   std::uint64_t ticks_per_states_ = 1;
+  std::size_t peak_entities_ = 0;  // most entities since memory was last handed back
   std::uint64_t beats_ = 0;  // timer callbacks: ticks and those while paused (~entities' rate)
   bool paused_ = false;
   std::uint64_t steps_pending_ = 0;  // paused: ticks ~step still asks for
