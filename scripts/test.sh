@@ -12,20 +12,17 @@ set +u
 source "$STC_BUILD/devel/setup.bash"
 set -u
 # The fuzzers' sanitizer build (about 4 minutes of compiling on 2 cores), then
-# the assertions' build (about 3), then the sanitized node's (about 11), go on while the tests run, most of which wait
+# the assertions' build (about 3), go on while the tests run, most of which wait
 # on ROS masters and nodes; no test depends on timing. Their logs are kept for
 # the checks below, which build again (up to date then, or failing the same
 # way) and run them.
 fuzz_build_log="$STC_BUILD/fuzz_build.log"
 asserts_build_log="$STC_BUILD/asserts_build.log"
-sanitize_build_log="$STC_BUILD/sanitize_build.log"
 {
   bash "$STC_ROOT/scripts/fuzz.sh" --build-only >"$fuzz_build_log" 2>&1 ||
     { echo "fuzz build failed, log: $fuzz_build_log"; tail -n 20 "$fuzz_build_log"; }
   bash "$STC_ROOT/scripts/asserts.sh" --build-only >"$asserts_build_log" 2>&1 ||
     { echo "asserts build failed, log: $asserts_build_log"; tail -n 20 "$asserts_build_log"; }
-  bash "$STC_ROOT/scripts/sanitize.sh" --rostests --build-only >"$sanitize_build_log" 2>&1 ||
-    { echo "sanitized node build failed, log: $sanitize_build_log"; tail -n 20 "$sanitize_build_log"; }
 } &
 side_builds=$!
 # run_tests exits 0 even when a test fails: the result files decide.
@@ -46,6 +43,4 @@ wait "$side_builds" || true
 check fuzz -- bash "$STC_ROOT/scripts/fuzz.sh"
 # The core's debug assertions, at 2 and 4 threads among others (scripts/asserts.sh).
 check asserts -- bash "$STC_ROOT/scripts/asserts.sh"
-# The node under ASan + UBSan through its hostile-input rostests (docs/fuzzing.md).
-check sanitized_node -- bash "$STC_ROOT/scripts/sanitize.sh" --rostests
 /usr/bin/python3 "$STC_ROOT/scripts/count_results.py" "$STC_BUILD/test_results"
