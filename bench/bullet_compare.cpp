@@ -661,6 +661,10 @@ int main(int argc, char** argv) {
   std::string summary;
   std::printf("# bench_bullet_compare: %.1f s simulated per run (%d ticks at 60 Hz) after %.1f s untimed, load %.2f\n",
               opt.seconds, ticks, opt.settle, loadAverage());
+  std::printf("Bullet variants: compound = btCompoundShape of the leaf spheres; hull = btConvexHullShape of the "
+              "surface-voxel corners, faces moved in by Bullet's default margin; lean = full voxel boxes as "
+              "btBoxShape, other shapes as optimizeConvexHull() hulls of the surface-voxel corners, margin %.3f m\n",
+              kLeanMargin);
   for (const Case& c : opt.cases) {
     std::printf("## %s (load %.2f)\n", label(c).c_str(), loadAverage());
     std::fflush(stdout);
