@@ -9,7 +9,8 @@
 #                                         (hammer, bad_input), sanitized node and
 #                                         test nodes; last line "sanitize: N rostests, M failed"
 # Any sanitizer report, failed assertion or failed test fails it. With
-# --build-only it builds and stops (scripts/test.sh builds while the tests run).
+# --build-only it builds and stops. Neither use is in the test command
+# (docs/fuzzing.md says why).
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 build="${STC_SANITIZE_BUILD:-$STC_ROOT/build_sanitize}"
