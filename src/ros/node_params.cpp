@@ -2,6 +2,7 @@
 
 #include "sphere_tree_collision/ros/conversions.hpp"
 #include "sphere_tree_collision/ros/param_reading.hpp"
+#include "sphere_tree_collision/ros/tick_budget_rule.hpp"
 
 #include <algorithm>
 #include <climits>
@@ -41,11 +42,11 @@ auto parsed(const std::string& name, F&& parse) {
 
 }  // namespace
 
-stc::Budget NodeParams::budget() const {
+stc::Budget NodeParams::budget(double publish_s) const {
   stc::Budget b;
   if (detection_budget_ms >= 0.0) b.seconds = detection_budget_ms * 1e-3;
   if (sphere_test_budget >= 0) b.sphere_tests = sphere_test_budget;
-  if (tick_budget_ms > 0.0) b.tick_seconds = tick_budget_ms * 1e-3;
+  b.tick_seconds = tickBudgetSeconds(tick_budget_ms, 1.0 / rate, publish_s);
   return b;
 }
 
@@ -77,7 +78,7 @@ void applyTunable(const TunableParams& t, NodeParams& params) {
   p.detection_budget_ms = t.detection_budget;
   if (t.sphere_test_budget < -1) throw InputError("sphere_test_budget", "must be >= 0, or -1 for none");
   p.sphere_test_budget = t.sphere_test_budget;
-  p.tick_budget_ms = requireNonNegative("tick_budget", t.tick_budget);
+  p.tick_budget_ms = checkedTickBudgetMs(t.tick_budget);
 
   p.world.scheduler.kind = parsed("scheduler", [&] { return stc::parseScheduler(t.scheduler); });
   p.world.scheduler.queue_count = requireIn("queue_count", t.queue_count, 1, 64);

@@ -8,6 +8,7 @@
 #include <malloc.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <exception>
 
@@ -81,7 +82,7 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   camera_info_ = std::make_unique<PerceptionCameraInfo>(
       nh_, pnh_, world_, params_.camera.frame.empty() ? params_.camera.published_frame : params_.camera.frame,
       params_.camera.info_topic);
-  budget_ = params_.budget();
+  budget_ = params_.budget(publish_cost_.seconds());
   dt_ = 1.0 / params_.rate;
   if (!params_.error_report.empty()) error_report_ = std::make_unique<ErrorReport>(params_.error_report);
   markers_ = std::make_unique<MarkerPublisher>(
@@ -113,7 +114,9 @@ WorldNode::WorldNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
            params_.rate, stc::toString(params_.world.scheduler.kind),
            params_.detection_budget_ms < 0 ? "none" : std::to_string(params_.detection_budget_ms).c_str(),
            params_.sphere_test_budget < 0 ? "no limit" : std::to_string(params_.sphere_test_budget).c_str(),
-           params_.tick_budget_ms > 0 ? std::to_string(params_.tick_budget_ms).c_str() : "none");
+           params_.tick_budget_ms > 0   ? std::to_string(params_.tick_budget_ms).c_str()
+           : params_.tick_budget_ms == 0 ? "1/~rate less publishing"
+                                         : "none");
   diagnostics_ = std::make_unique<NodeDiagnostics>(nh_, pnh_, params_);
   tuning_ = std::make_unique<LiveTuning>(pnh_, params_, [this](const NodeParams& next) { retune(next); });
   services_->start();  // last: nothing after it can throw
@@ -123,8 +126,9 @@ void WorldNode::retune(const NodeParams& next) {
   world_.setScheduler(next.world.scheduler);  // the only step that can throw: first
   world_.setResponse(next.world.response);  // checked by applyTunable already
   world_.setUnresolvedPolicy(next.world.unresolved_policy);
-  budget_ = next.budget();
+  budget_ = next.budget(publish_cost_.seconds());
   markers_->retune(next);
+  diagnostics_->retune(next);
   params_ = next;
 }
 
@@ -236,10 +240,15 @@ std::uint64_t WorldNode::queueSteps(std::uint32_t n) {
 }
 
 void WorldNode::runTick() {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
   const ros::Time now = clock_.beginTick(dt_);
   if (camera_from_tf_ || tf_buffer_) updateCameraFromTf();
   expireGaze(now);
+  budget_ = params_.budget(publish_cost_.seconds());  // ~tick_budget 0: 1/~rate less the node's own work
+  const Clock::time_point step_start = Clock::now();
   const stc::TickReport report = world_.step(dt_, budget_);
+  const Clock::time_point step_end = Clock::now();
   ++tick_;
   for (const stc::BrokenEntity& b : world_.broken()) onBroken(b);
   for (const stc::QuarantinedEntity& q : world_.quarantined()) onQuarantined(q, now);
@@ -260,6 +269,8 @@ void WorldNode::runTick() {
                     report.unresolved, report.unresolved_accepted, static_cast<long long>(report.sphere_tests),
                     report.contacts, report.total_s * 1e3, world_.perception().hasFixation() ? "on" : "off",
                     static_cast<unsigned long long>(rejected_[0] + rejected_[1] + rejected_[2] + rejected_[3]));
+  // Everything of the tick but the step is the node's own work (mostly publishing).
+  publish_cost_.add(std::chrono::duration<double>((step_start - start) + (Clock::now() - step_end)).count(), dt_);
 }
 
 void WorldNode::onQuarantined(const stc::QuarantinedEntity& q, const ros::Time& stamp) {
@@ -359,6 +370,8 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.perceived_inaccuracy = r.perceived_inaccuracy;
   s.contacts = static_cast<std::uint32_t>(r.contacts);
   s.tick_budget_ms = r.tick_budget_s * 1e3;
+  s.period_ms = dt_ * 1e3;
+  s.publish_ms = publish_cost_.seconds() * 1e3;  // not yet this tick's: the figure its budget came from
   s.narrow_budget_ms = r.narrow_budget_s * 1e3;
   s.response_budget_ms = r.response_budget_s * 1e3;
   s.reserve_ms = r.reserve_s * 1e3;

@@ -78,6 +78,7 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"sphere_test_budget", -5}}, "sphere_test_budget"},
       {world, {{"tick_budget", -16.7}}, "tick_budget"},
       {world, {{"tick_budget", "fast"}}, "tick_budget"},
+      {world, {{"tick_budget", -2.0}}, "tick_budget"},  // -1 is none; other negatives are typos
       {world, {{"marker_levels", list({1, 9})}}, "marker_levels"},
       {world, {{"camera_position", list({1, 2, 3})}, {"camera_look_at", list({1, 2, 3})}}, "camera_look_at"},
       {world, {{"camera_fov_y", 200.0}}, "camera_fov_y"},

@@ -2,6 +2,7 @@
 // every tick, markers every ~rate / ~marker_rate ticks (judged by the stamps
 // and tick numbers the messages carry, never by arrival rates).
 #include "rostest_util.hpp"
+#include "sphere_tree_collision/ros/tick_budget_rule.hpp"
 
 #include <gtest/gtest.h>
 #include <sphere_tree_collision/ContactArray.h>
@@ -178,6 +179,22 @@ TEST(Smoke, TickStatsAndContactsEveryTick) {
     EXPECT_GE(s.contacts_ms, 0.0);
     EXPECT_LE(s.contacts_ms, s.response_ms) << "tick " << s.tick;
   }
+  // The default ~tick_budget (0): each step got the reported period less the node's
+  // publishing as measured before it (tick_budget_rule.hpp; test_tick_budget_rule
+  // checks the rule itself), a finite budget > 0, and the publishing was measured.
+  double tick_rate = 0.0;
+  ASSERT_TRUE(ros::param::get("~tick_rate", tick_rate));
+  bool publishing_measured = false;
+  for (const auto& s : stats.all) {
+    EXPECT_NEAR(s.period_ms, 1e3 / tick_rate, 1e-9) << "tick " << s.tick;
+    EXPECT_GE(s.publish_ms, 0.0) << "tick " << s.tick;
+    const double expected_ms = stc_ros::tickBudgetSeconds(0.0, s.period_ms * 1e-3, s.publish_ms * 1e-3) * 1e3;
+    EXPECT_NEAR(s.tick_budget_ms, expected_ms, 1e-9) << "tick " << s.tick;
+    EXPECT_GT(s.tick_budget_ms, 0.0) << "tick " << s.tick;
+    EXPECT_LE(s.tick_budget_ms, 1e3 / tick_rate + 1e-9) << "tick " << s.tick;
+    publishing_measured = publishing_measured || s.publish_ms > 0.0;
+  }
+  EXPECT_TRUE(publishing_measured);
   // The gaze of the marker test has expired: no projection work from then on.
   ASSERT_TRUE(stc_test::spinUntil([&] { return !stats.last.gaze_active; }, stc_test::kLivenessSeconds));
   const std::uint64_t expired_at = stats.last.tick;

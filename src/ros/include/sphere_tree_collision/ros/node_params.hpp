@@ -51,7 +51,7 @@ struct NodeParams {
   double contact_marker_size = 0.04;  // m
   double detection_budget_ms = 8.0;  // < 0: none
   std::int64_t sphere_test_budget = -1;  // < 0: none
-  double tick_budget_ms = 0.0;       // whole tick (integrate .. response); 0: none
+  double tick_budget_ms = 0.0;       // whole tick (integrate .. response); 0: 1/rate less publishing, -1: none (tick_budget_rule.hpp)
   double gaze_timeout = 0.5;         // s
   // ~default_resolution, ~default_density, ~default_voxel_size: what spawns and
   // scene entries left at 0 (or out) get.
@@ -61,7 +61,8 @@ struct NodeParams {
   stc::WorldConfig world;            // scheduler, policy, tree, limits, response
   CameraParams camera;
 
-  stc::Budget budget() const;
+  // The step's budgets, the tick's with the node's publishing measured at publish_s.
+  stc::Budget budget(double publish_s) const;
 };
 
 // What may change while the node runs (dynamic_reconfigure, cfg/World.cfg),

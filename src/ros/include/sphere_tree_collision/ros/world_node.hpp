@@ -14,6 +14,7 @@
 #include "sphere_tree_collision/ros/node_diagnostics.hpp"
 #include "sphere_tree_collision/ros/node_params.hpp"
 #include "sphere_tree_collision/ros/perception_camera_info.hpp"
+#include "sphere_tree_collision/ros/tick_budget_rule.hpp"
 #include "sphere_tree_collision/ros/tick_clock.hpp"
 #include "sphere_tree_collision/ros/world_services.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -107,7 +108,8 @@ class WorldNode {
   NodeParams params_;
   TickClock clock_;
   stc::World world_;
-  stc::Budget budget_;
+  stc::Budget budget_;  // this tick's (the tick budget follows publish_cost_ under ~tick_budget 0)
+  PublishCost publish_cost_;  // the node's own work a tick
   double dt_ = 0.0;
   std::uint64_t tick_ = 0;
   std::uint64_t ticks_per_states_ = 1;
