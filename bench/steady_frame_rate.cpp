@@ -37,6 +37,7 @@
 #include "bench_args.hpp"
 #include "plausibility.hpp"
 #include "scene_cases.hpp"
+#include "sphere_tree_collision/gaze_model.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
