@@ -13,7 +13,7 @@ round, and the table gives each one's median and range. A screenshot of each
 variant's first trial (rviz_fps_<variant>.png in --shots) shows what it draws.
 
 Usage (after `source <build>/devel/setup.bash`):
-  bench/rviz_fps.py [--rounds 5] [--variants demo,aa,...] [--markdown FILE] [--shots DIR] [--smoke]
+  bench/rviz_fps.py [--rounds 4] [--variants demo,aa,...] [--markdown FILE] [--shots DIR] [--smoke]
 """
 import argparse
 import os
@@ -152,9 +152,9 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--variants", default="aa,demo,level1,walls_hidden,marker_rate5",
                    help="comma-separated, of: " + ", ".join(VARIANTS))
-    p.add_argument("--rounds", type=int, default=5)
+    p.add_argument("--rounds", type=int, default=4)
     p.add_argument("--startup", type=float, default=5.0, help="s from roslaunch to rviz")
-    p.add_argument("--warmup", type=float, default=35.0, help="s of rviz's run before the window")
+    p.add_argument("--warmup", type=float, default=30.0, help="s of rviz's run before the window")
     p.add_argument("--window", type=float, default=15.0, help="s counted")
     p.add_argument("--markdown", help="write the table here too")
     p.add_argument("--shots", help="directory for a screenshot per variant")
