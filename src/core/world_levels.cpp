@@ -1,0 +1,96 @@
+// World: the island levels of a limited response (island_levels.hpp) wired
+// into the tick: what the allowance is, the joins after the broad phase, and
+// what a unit of cost took.
+#include "sphere_tree_collision/world.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace stc {
+namespace {
+
+// Of what the tick budget leaves after the phases that must run (integrate,
+// broad phase, swept test, fracture: last tick's, see kLevelCostDecay), the
+// share the full islands' mandatory response may take (contacts, one velocity
+// and one position pass). The rest is the narrow phase's and the solver's
+// further passes.
+constexpr double kResponseShare = 0.5;
+// The phases that must run: their learnt cost follows a rise at once and
+// forgets it by this factor a tick (as the narrow phase's reserve, world.cpp).
+constexpr double kLevelCostDecay = 0.95;
+// A unit of island cost: a running mean, this much of each tick's measure (a
+// spike's share of a tick's cost is not the next tick's cost per unit; with
+// the spike kept, as the phases', the median tick of rockfall 5,000 used 2.8
+// of its 16.7 ms while 85 % of its bodies waited).
+constexpr double kCostUnitWeight = 0.25;
+
+}  // namespace
+
+bool World::responseLimited(const Budget& budget) {
+  return budget.tick_seconds < std::numeric_limits<double>::infinity() ||
+         budget.response_contacts < std::numeric_limits<std::int64_t>::max();
+}
+
+void World::chooseLevels(const Budget& budget, TickReport& report) {
+  double allowance = std::numeric_limits<double>::infinity();
+  if (budget.response_contacts < std::numeric_limits<std::int64_t>::max()) {
+    allowance = static_cast<double>(std::max<std::int64_t>(budget.response_contacts, 0));
+  }
+  if (budget.tick_seconds < std::numeric_limits<double>::infinity() && cost_unit_s_ > 0.0) {
+    const double left = std::max(budget.tick_seconds - must_run_s_, 0.0);
+    allowance = std::min(allowance, kResponseShare * left / cost_unit_s_);
+  }
+  IslandLevels::Inputs in;
+  in.bodies = &bodies_;
+  in.contacts = &contacts_;  // last tick's (emptied when entities came or went)
+  in.perception = &perception_;
+  in.allowance = allowance;
+  levels_.choose(in, report.levels);
+}
+
+// After the broad phase's pairs are set up: a held island that a moving
+// body's box reaches (directly, or through held bodies whose boxes overlap)
+// runs this tick. Releasing it changes which pairs are tested and may wake a
+// sleeper, which moves from now on too: until nothing more joins. Then the
+// joined bodies are integrated, from where they were held; their boxes
+// (IslandLevels::heldBox) already cover where that takes them.
+void World::joinHeldIslands(double dt, TickReport& report) {
+  const std::vector<BroadPair>& pairs = broad_phase_.pairs();
+  const auto pair_at = [&](std::size_t k) { return pairs_seen_[k].indices; };
+  bool joined = false;
+  while (levels_.join(bodies_, pairs.size(), pair_at, report.levels)) {
+    joined = true;
+    if (setUpPairTests()) setUpPairTests();
+  }
+  if (!joined) return;
+  StepContext step = physicsStep();
+  step.dt = dt;
+  step.integrate_only = &levels_.joined();
+  physics_.integrate(step);
+}
+
+void World::learnLevelCosts(double must_run_s, double response_mandatory_s, const TickReport& report) {
+  must_run_s_ = std::max(must_run_s, kLevelCostDecay * must_run_s_);
+  const double units = static_cast<double>(contacts_.size() + report.levels.bodies_full);
+  if (!(units > 0.0)) return;
+  const double measured = response_mandatory_s / units;
+  cost_unit_s_ = cost_unit_s_ > 0.0 ? cost_unit_s_ + kCostUnitWeight * (measured - cost_unit_s_) : measured;
+}
+
+const std::vector<std::uint8_t>& World::outOfStep() {
+  const std::vector<std::uint8_t>& asleep = islands_.held();
+  out_of_step_.resize(bodies_.size());
+  for (std::size_t i = 0; i < bodies_.size(); ++i) out_of_step_[i] = (asleep[i] != 0 || levels_.isHeld(i)) ? 1 : 0;
+  return out_of_step_;
+}
+
+ResponseLevel World::responseLevel(EntityId id) const {
+  const auto index = indexOf(id);
+  if (!index) return ResponseLevel::Full;
+  if (bodies_[*index].is_static) return ResponseLevel::Static;
+  if (islands_.isSleeping(*index)) return ResponseLevel::Asleep;
+  return levels_.isHeld(*index) ? ResponseLevel::Held : ResponseLevel::Full;
+}
+
+}  // namespace stc
