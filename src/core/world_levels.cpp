@@ -11,18 +11,16 @@ namespace stc {
 namespace {
 
 // Of what the tick budget leaves after the phases that must run (integrate,
-// broad phase, swept test, fracture: last tick's, see kLevelCostDecay), the
+// broad phase, swept test, fracture: their running mean, kCostUnitWeight), the
 // share the full islands' mandatory response may take (contacts, one velocity
 // and one position pass). The rest is the narrow phase's and the solver's
 // further passes.
 constexpr double kResponseShare = 0.5;
-// The phases that must run: their learnt cost follows a rise at once and
-// forgets it by this factor a tick (as the narrow phase's reserve, world.cpp).
-constexpr double kLevelCostDecay = 0.95;
-// A unit of island cost: a running mean, this much of each tick's measure (a
-// spike's share of a tick's cost is not the next tick's cost per unit; with
-// the spike kept, as the phases', the median tick of rockfall 5,000 used 2.8
-// of its 16.7 ms while 85 % of its bodies waited).
+// The phases that must run and a unit of island cost: running means, this
+// much of each tick's measure. A spike is not the next tick's cost: with each
+// spike kept and forgotten by 0.95 a tick (as the narrow phase's reserve,
+// world.cpp), the median tick of rockfall 5,000 used 2.8 of its 16.7 ms while
+// 85 % of its bodies waited.
 constexpr double kCostUnitWeight = 0.25;
 
 }  // namespace
@@ -71,7 +69,7 @@ void World::joinHeldIslands(double dt, TickReport& report) {
 }
 
 void World::learnLevelCosts(double must_run_s, double response_mandatory_s, const TickReport& report) {
-  must_run_s_ = std::max(must_run_s, kLevelCostDecay * must_run_s_);
+  must_run_s_ = must_run_s_ > 0.0 ? must_run_s_ + kCostUnitWeight * (must_run_s - must_run_s_) : must_run_s;
   const double units = static_cast<double>(contacts_.size() + report.levels.bodies_full);
   if (!(units > 0.0)) return;
   const double measured = response_mandatory_s / units;
