@@ -95,6 +95,7 @@ struct Run {
   // noticeable each island was).
   double islands_full = 0.0, islands_held = 0.0, islands_joined = 0.0, bodies_held = 0.0;
   int most_ticks_held = 0;
+  std::vector<double> largest_island;  // bodies, a tick
   double held_body_ticks = 0.0, held_priority = 0.0;
 };
 
@@ -156,6 +157,7 @@ Run simulate(const Case& c, double seconds, const Budget& budget, bool budgeted,
     run.held_body_ticks += static_cast<double>(r.levels.bodies_held);
     run.held_priority += r.levels.held_priority;
     run.most_ticks_held = std::max(run.most_ticks_held, r.levels.most_ticks_held);
+    if (r.levels.used) run.largest_island.push_back(static_cast<double>(r.levels.largest_island));
     for (const Contact& contact : world.contacts()) {
       run.contacts += 1.0;
       if (contact.resolved) continue;
@@ -367,15 +369,18 @@ int main(int argc, char** argv) {
   md += "\nIsland levels of the budgeted runs (TickReport::levels, island_levels.hpp): islands a tick stepped "
         "fully / held still (mean), of the held ones joined to the tick by a moving body, bodies held a tick; "
         "the longest wait, ticks; the lag: simulated time a mover lost by the end, mean over the movers, s; "
-        "the perceived cost: held island-ticks weighted by their gaze priority (exp(-e / 100)), a tick.\n\n"
-        "| scene | bodies | islands full / held | joined | bodies held | longest wait | mean lag | perceived cost |\n"
-        "|---|---|---|---|---|---|---|---|\n";
+        "the perceived cost: held island-ticks weighted by their gaze priority (exp(-e / 100)), a tick; "
+        "the largest island's bodies, p50 / max.\n\n"
+        "| scene | bodies | islands full / held | joined | bodies held | longest wait | mean lag | perceived cost "
+        "| largest island |\n"
+        "|---|---|---|---|---|---|---|---|---|\n";
   for (const Run& r : runs) {
     if (!r.budgeted) continue;
     const double ticks = static_cast<double>(std::max<std::size_t>(r.cpu.size(), 1));
-    std::snprintf(buf, sizeof buf, "| %s | %d | %.1f / %.1f | %.1f | %.0f | %d | %.3f | %.3f |\n", r.scene.c_str(),
-                  r.bodies, r.islands_full, r.islands_held, r.islands_joined, r.bodies_held, r.most_ticks_held,
-                  r.held_body_ticks / std::max(r.bodies, 1) / 60.0, r.held_priority / ticks);
+    std::snprintf(buf, sizeof buf, "| %s | %d | %.1f / %.1f | %.1f | %.0f | %d | %.3f | %.3f | %.0f / %.0f |\n",
+                  r.scene.c_str(), r.bodies, r.islands_full, r.islands_held, r.islands_joined, r.bodies_held,
+                  r.most_ticks_held, r.held_body_ticks / std::max(r.bodies, 1) / 60.0, r.held_priority / ticks,
+                  percentile(r.largest_island, 0.5), maxOf(r.largest_island));
     md += buf;
   }
   std::printf("%s", md.c_str());

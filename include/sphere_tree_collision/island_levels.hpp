@@ -20,11 +20,13 @@
 //
 // A held body does not move this tick, so it must not be hit as a wall: its
 // broad-phase box covers where it would have gone (its bounding cube over
-// its path, heldBox), and any broad-phase pair of a held body with a body
-// that moves this tick (stepped, woken, new) joins the held body's island to
-// the tick: it is integrated after the broad phase (its box already covered
-// that) and solved with the others. Held bodies whose boxes overlap join
-// each other, so a join reaches everything a released body could touch.
+// its path, heldBox), and a broad-phase pair of a held body with a body that
+// moves this tick (stepped, woken, new) whose paths come near (the World's
+// test: their bounding spheres over the tick's path) joins the held body's
+// island to the tick: it is integrated after the broad phase (its box
+// already covered that) and solved with the others. Held bodies whose paths
+// come near join each other, so a join reaches everything a released body
+// could touch.
 // During the tick a held body is static to the phases (BodyState::is_static,
 // as sleepers, islands.hpp); the World releases it after Islands::endTick.
 #pragma once
@@ -56,6 +58,8 @@ struct IslandLevelReport {
   std::size_t islands_held = 0, bodies_held = 0;  // held still this tick
   std::size_t islands_joined = 0;   // chosen held, then stepped: a moving body reached them
   int most_ticks_held = 0;          // the longest wait of an island held now (ticks, this one included)
+  std::size_t largest_island = 0;   // bodies of the largest awake island (one that always runs when first)
+  double largest_cost = 0.0;        // its cost
   // Perceived cost of holding: the summed gaze priority (without aging) of
   // the islands held this tick. Summed over ticks it is the held ticks
   // weighted by how noticeable each island was.
@@ -92,13 +96,15 @@ class IslandLevels {
   // A tick without levels: every body Full, no waits (O(1) when already so).
   void unused();
   bool anyHeld() const { return held_count_ != 0; }
-  // After the broad phase: `pairs` (dense indices of every broad-phase pair,
-  // count of them) joins to the tick each held island a moving body (not
-  // static, so not held nor asleep) reaches, directly or through other held
-  // bodies. Their bodies are released (is_static false) and flagged in
-  // joined() for the late integration. True when something was released.
-  template <typename PairAt>
-  bool join(std::vector<BodyState>& bodies, std::size_t count, const PairAt& pair_at, IslandLevelReport& report);
+  // After the broad phase: of the broad-phase pairs pair_at(0..count) (dense
+  // indices) those that `near(a, b)` says can touch this tick join to the
+  // tick each held island a moving body (not static, so not held nor asleep)
+  // reaches, directly or through other held bodies. Their bodies are
+  // released (is_static false) and flagged in joined() for the late
+  // integration. True when something was released.
+  template <typename PairAt, typename Near>
+  bool join(std::vector<BodyState>& bodies, std::size_t count, const PairAt& pair_at, const Near& near,
+            IslandLevelReport& report);
   const std::vector<std::uint8_t>& joined() const { return joined_; }
   // After Islands::endTick: held bodies movable again; their wait grows,
   // every stepped body's is 0.
@@ -113,6 +119,7 @@ class IslandLevels {
     double key = 0.0;        // priority + aging
     double priority = 0.0;   // gaze priority alone
     double cost = 0.0;
+    std::uint32_t bodies = 0;
     std::uint32_t root = 0;  // the island's union-find root (a body index)
     int waited = 0;
   };
@@ -124,21 +131,22 @@ class IslandLevels {
   std::vector<std::int32_t> waited_;      // per body: ticks held in a row
   std::vector<double> cost_, priority_;   // per root
   std::vector<std::int32_t> island_wait_; // per root
+  std::vector<std::uint32_t> island_bodies_; // per root
   std::vector<Ranked> ranked_;
   std::vector<std::uint8_t> root_held_;   // per root of choose: its island is held
   std::size_t held_count_ = 0;
   bool any_marked_ = false;  // held_ or waited_ has a non-zero entry
 };
 
-template <typename PairAt>
-bool IslandLevels::join(std::vector<BodyState>& bodies, std::size_t count, const PairAt& pair_at,
+template <typename PairAt, typename Near>
+bool IslandLevels::join(std::vector<BodyState>& bodies, std::size_t count, const PairAt& pair_at, const Near& near,
                         IslandLevelReport& report) {
   if (held_count_ == 0) return false;
   // Held bodies keep their island's root from choose (parent_); overlapping
   // held bodies join; a held group a moving body touches is reached.
   for (std::size_t k = 0; k < count; ++k) {
     const auto [a, b] = pair_at(k);
-    if (held_[a] != 0 && held_[b] != 0) unite(a, b);
+    if (held_[a] != 0 && held_[b] != 0 && near(a, b)) unite(a, b);
   }
   std::fill(reached_.begin(), reached_.end(), 0);
   bool any = false;
@@ -147,6 +155,7 @@ bool IslandLevels::join(std::vector<BodyState>& bodies, std::size_t count, const
     if ((held_[a] != 0) == (held_[b] != 0)) continue;
     const std::uint32_t h = held_[a] != 0 ? a : b, other = held_[a] != 0 ? b : a;
     if (bodies[other].is_static) continue;  // static or asleep: does not move this tick
+    if (!near(h, other)) continue;
     reached_[find(h)] = 1;
     any = true;
   }

@@ -74,6 +74,7 @@ void IslandLevels::choose(const Inputs& in, IslandLevelReport& report) {
   cost_.resize(n);
   priority_.resize(n);
   island_wait_.resize(n);
+  island_bodies_.resize(n);
   root_held_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     parent_[i] = static_cast<std::uint32_t>(i);
@@ -83,6 +84,7 @@ void IslandLevels::choose(const Inputs& in, IslandLevelReport& report) {
     cost_[i] = 0.0;
     priority_[i] = 0.0;
     island_wait_[i] = 0;
+    island_bodies_[i] = 0;
     root_held_[i] = 0;
   }
   // Islands of last tick's contacts, and what each will cost: its contacts.
@@ -99,6 +101,7 @@ void IslandLevels::choose(const Inputs& in, IslandLevelReport& report) {
     if (candidate_[i] == 0) continue;
     const std::uint32_t root = find(static_cast<std::uint32_t>(i));
     cost_[root] += 1.0;  // the body itself: integration, its box
+    ++island_bodies_[root];
     if (gaze) priority_[root] = std::max(priority_[root], in.perception->gazeWeight(bodies[i].pose.position).weight);
     island_wait_[root] = std::max(island_wait_[root], waited_[i]);
   }
@@ -111,7 +114,12 @@ void IslandLevels::choose(const Inputs& in, IslandLevelReport& report) {
     r.key = r.priority + kAgingPerTick * r.waited;
     r.cost = cost_[i];
     r.root = static_cast<std::uint32_t>(i);
+    r.bodies = island_bodies_[i];
     ranked_.push_back(r);
+    if (r.bodies > report.largest_island) {
+      report.largest_island = r.bodies;
+      report.largest_cost = r.cost;
+    }
   }
   std::sort(ranked_.begin(), ranked_.end(), [](const Ranked& x, const Ranked& y) {
     return x.key != y.key ? x.key > y.key : x.root < y.root;

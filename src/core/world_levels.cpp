@@ -22,6 +22,17 @@ constexpr double kResponseShare = 0.5;
 // world.cpp), the median tick of rockfall 5,000 used 2.8 of its 16.7 ms while
 // 85 % of its bodies waited.
 constexpr double kCostUnitWeight = 0.25;
+// Metres added to the reach of two paths in the join test: rounding, and the
+// contact builder's slop.
+constexpr double kJoinMargin = 0.01;
+
+// Radius of a ball about the centre of mass holding the shape and its
+// tree's root sphere (which may reach past the shape: an unresolved pair
+// accepted at the roots gives contacts there).
+double reachOf(const ShapeInfo& shape) {
+  const SphereNode& root = shape.tree.node(0);
+  return std::max(shape.bounding_radius, root.centre.norm() + root.radius);
+}
 
 }  // namespace
 
@@ -56,8 +67,29 @@ void World::chooseLevels(const Budget& budget, TickReport& report) {
 void World::joinHeldIslands(double dt, TickReport& report) {
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
   const auto pair_at = [&](std::size_t k) { return pairs_seen_[k].indices; };
+  // Each body's path this tick as a segment of its centre: a held body's
+  // from where it is to where it would have gone, a moving one's from its
+  // start pose to now. Two can touch (or meet at their root spheres, as an
+  // unresolved pair accepted there does) only if balls about their centres
+  // holding shape and root sphere (reachOf) come within reach along them: the
+  // midpoints nearer than the radii plus the half paths.
+  const auto near = [&](std::uint32_t a, std::uint32_t b) {
+    const auto path = [&](std::uint32_t i, Vec3& mid, double& half) {
+      const Vec3 end = bodies_[i].pose.position;
+      const Vec3 start = levels_.isHeld(i) ? Vec3(end + bodies_[i].linear_velocity * dt)
+                                          : physics_.startPose(i).position;
+      mid = 0.5 * (start + end);
+      half = 0.5 * (end - start).norm();
+    };
+    Vec3 ma, mb;
+    double ha = 0.0, hb = 0.0;
+    path(a, ma, ha);
+    path(b, mb, hb);
+    const double reach = reachOf(shapes_[body_shapes_[a]]) + reachOf(shapes_[body_shapes_[b]]) + ha + hb + kJoinMargin;
+    return (ma - mb).squaredNorm() <= reach * reach;
+  };
   bool joined = false;
-  while (levels_.join(bodies_, pairs.size(), pair_at, report.levels)) {
+  while (levels_.join(bodies_, pairs.size(), pair_at, near, report.levels)) {
     joined = true;
     if (setUpPairTests()) setUpPairTests();
   }
