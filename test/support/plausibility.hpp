@@ -25,7 +25,8 @@ struct Plausibility {
   // correction moves a resting body a little; neither is a stored speed
   // without motion). A window's excess is |stored - real| - (10 % real +
   // 0.05 m/s); it is off when that is > 0. Ticks a mover was held still by
-  // its island's level (World::responseLevel) are left out: its time stood.
+  // its island's level (World::responseLevel) are left out: its time stood,
+  // and its windows are of kPlausibilityWindow ticks it was stepped.
   double worst_window_excess = -1.0;
   std::size_t windows = 0, bad_windows = 0;
   double max_speed = 0.0;   // m/s, the fastest mover at any tick
@@ -68,7 +69,6 @@ class PlausibilityCheck {
   std::vector<EntityId> movers_;
   std::unordered_map<EntityId, Track> track_;
   Plausibility f_;
-  int ticks_ = 0;
 };
 
 // One line: "NaN 0, outside 0, fastest 3.10 m/s (a fall allows 17.50), 0 too fast, ..."
