@@ -48,7 +48,11 @@
   X(fractures, r.fractures)                                                                              \
   X(fractures_waiting, r.fractures_deferred)                                                             \
   X(piece_trees, r.piece_trees)                                                                          \
-  X(fracture_ms, r.fracture_s * 1e3)
+  X(fracture_ms, r.fracture_s * 1e3)                                                                     \
+  X(islands_full, r.levels.islands_full)                                                                 \
+  X(islands_held, r.levels.islands_held)                                                                 \
+  X(bodies_held, r.levels.bodies_held)                                                                   \
+  X(islands_joined, r.levels.islands_joined)
 
 namespace stc_ros {
 
