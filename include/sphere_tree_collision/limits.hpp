@@ -28,10 +28,11 @@ void validateLimits(const PhysicalLimits& limits);
 // hold; named as the node's parameters (~max_mesh_bytes ...). The file's size
 // is checked before it is read, its vertices and triangles (every instance a
 // scene's nodes draw) before they are copied; its grid is limited by
-// VoxelLimits::max_voxels. Defaults: a binary STL of 1,000,000 triangles
-// (50 MB, 3 vertices each) passes.
+// VoxelLimits::max_voxels. assimp's memory while it parses is up to about 30
+// times the file's size (an OBJ of 8 MiB of bare faces: 260 MB): the size
+// bounds it. Defaults: a binary STL of 330,000 triangles passes.
 struct MeshLimits {
-  std::int64_t max_mesh_bytes = 64ll << 20;      // 64 MiB
+  std::int64_t max_mesh_bytes = 16ll << 20;      // 16 MiB
   std::int64_t max_mesh_vertices = 3'000'000;   // over all the file's meshes
   std::int64_t max_mesh_triangles = 1'000'000;
 };

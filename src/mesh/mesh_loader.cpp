@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 #include <system_error>
 
 namespace stc {
@@ -61,6 +62,37 @@ void validateScale(const Vec3& scale) {
                               const char* limit_name, std::int64_t limit) {
   throw InputError("mesh_resource", source + ": " + std::to_string(count) + " " + what + " above " + limit_name +
                                         " " + std::to_string(limit));
+}
+
+// Two things in a DAE's bytes that assimp (5.2) cannot be given, found in
+// the plain bytes (an element's name cannot be escaped in XML; a `<p>` whose
+// text is not plain is refused whole, entities and CDATA included):
+// - <instance_node>: assimp copies the node for every instance, nested ones
+//   too, before anything can count the copies: 5 KB nesting ten instances
+//   nine deep asked for 10^9 nodes (gigabytes), and one naming its own
+//   ancestor recurses without end.
+// - a <p> (a primitive's indices) holding anything but integers: assimp's
+//   reader does not move past a character it cannot read and appends an index
+//   for ever (fuzz_mesh found it: the node would hang, its memory growing).
+void refuseWhatAssimpMishandles(std::string_view dae, const std::string& source) {
+  if (dae.find("instance_node") != std::string_view::npos) {
+    throw InputError("mesh_resource", source + ": <instance_node> is not read (assimp copies instanced nodes "
+                                               "before they can be counted); flatten the file's nodes");
+  }
+  for (std::size_t at = dae.find("<p"); at != std::string_view::npos; at = dae.find("<p", at + 2)) {
+    const char next = at + 2 < dae.size() ? dae[at + 2] : '\0';
+    if (next != '>' && next != '/' && !std::isspace(static_cast<unsigned char>(next))) continue;  // <param ...
+    const std::size_t open_end = dae.find('>', at);
+    if (open_end == std::string_view::npos || dae[open_end - 1] == '/') continue;  // cut off, or <p/>
+    const std::size_t text_end = dae.find('<', open_end);
+    const std::string_view text = dae.substr(open_end + 1, text_end - open_end - 1);
+    const bool plain = text.find_first_not_of("0123456789+- \t\r\n") == std::string_view::npos &&
+                       (text_end == std::string_view::npos || dae.substr(text_end, 2) == "</");
+    if (!plain) {
+      throw InputError("mesh_resource", source + ": a <p> holds more than integers (at byte " +
+                                            std::to_string(open_end + 1) + ")");
+    }
+  }
 }
 
 bool isUnder(const std::filesystem::path& path, const std::filesystem::path& root) {
@@ -228,6 +260,7 @@ TriangleMesh parseTriangleMesh(const void* bytes, std::size_t size, const std::s
   if (size > static_cast<std::uint64_t>(limits.max_mesh_bytes)) {
     refuseAbove(source, static_cast<std::int64_t>(size), "bytes", "max_mesh_bytes", limits.max_mesh_bytes);
   }
+  if (format == "dae") refuseWhatAssimpMishandles(std::string_view(static_cast<const char*>(bytes), size), source);
   Assimp::Importer importer;
   importer.SetIOHandler(new NoFiles);  // owned by the importer
   // assimp turns a DAE whose up axis is not Y_UP so that it is (its root
