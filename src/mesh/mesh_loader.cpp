@@ -79,19 +79,27 @@ void refuseWhatAssimpMishandles(std::string_view dae, const std::string& source)
     throw InputError("mesh_resource", source + ": <instance_node> is not read (assimp copies instanced nodes "
                                                "before they can be counted); flatten the file's nodes");
   }
-  for (std::size_t at = dae.find("<p"); at != std::string_view::npos; at = dae.find("<p", at + 2)) {
+  // Each byte is looked at a bounded number of times (the next search starts
+  // past the text just checked): no quadratic scan of a file of "<p <p <p".
+  std::size_t at = dae.find("<p");
+  while (at != std::string_view::npos) {
     const char next = at + 2 < dae.size() ? dae[at + 2] : '\0';
-    if (next != '>' && next != '/' && !std::isspace(static_cast<unsigned char>(next))) continue;  // <param ...
+    if (next != '>' && next != '/' && !std::isspace(static_cast<unsigned char>(next))) {  // <param ...
+      at = dae.find("<p", at + 2);
+      continue;
+    }
     const std::size_t open_end = dae.find('>', at);
-    if (open_end == std::string_view::npos || dae[open_end - 1] == '/') continue;  // cut off, or <p/>
-    const std::size_t text_end = dae.find('<', open_end);
+    if (open_end == std::string_view::npos) return;  // cut off: assimp refuses it
+    const std::size_t text_end = std::min(dae.find('<', open_end), dae.size());
     const std::string_view text = dae.substr(open_end + 1, text_end - open_end - 1);
+    const bool empty_element = dae[open_end - 1] == '/';  // <p/>
     const bool plain = text.find_first_not_of("0123456789+- \t\r\n") == std::string_view::npos &&
-                       (text_end == std::string_view::npos || dae.substr(text_end, 2) == "</");
-    if (!plain) {
+                       (text_end == dae.size() || dae.substr(text_end, 2) == "</");
+    if (!empty_element && !plain) {
       throw InputError("mesh_resource", source + ": a <p> holds more than integers (at byte " +
                                             std::to_string(open_end + 1) + ")");
     }
+    at = dae.find("<p", text_end);
   }
 }
 
