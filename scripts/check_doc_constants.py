@@ -72,6 +72,12 @@ CHECKS = [
     ("~world_extent default",
      "include/sphere_tree_collision/limits.hpp", r"double world_extent = ([0-9.]+);",
      "docs/ros_interface.md", r"^\| `~world_extent` \| ([0-9.]+) \|"),
+    ("~max_mesh_vertices default",
+     "include/sphere_tree_collision/limits.hpp", r"max_mesh_vertices = ([0-9']+);",
+     "docs/ros_interface.md", r"^\| `~max_mesh_bytes`, `~max_mesh_vertices`, `~max_mesh_triangles` \| [^,]+, ([0-9]+), [0-9]+ \|"),
+    ("~max_mesh_triangles default",
+     "include/sphere_tree_collision/limits.hpp", r"max_mesh_triangles = ([0-9']+);",
+     "docs/ros_interface.md", r"^\| `~max_mesh_bytes`, `~max_mesh_vertices`, `~max_mesh_triangles` \| [^,]+, [0-9]+, ([0-9]+) \|"),
     ("sleeping.time_to_sleep",
      "include/sphere_tree_collision/islands.hpp", r"double time_to_sleep = ([0-9.]+);",
      "docs/sleeping.md", r"`sleeping\.time_to_sleep` \(([0-9.]+) s\)"),
@@ -91,7 +97,7 @@ def find(root, path, pattern):
     raw = match.group(1)
     value = WORDS.get(raw)
     if value is None:
-        value = float(raw)
+        value = float(raw.replace("'", ""))  # C++ digit separators
     line_no = text.count("\n", 0, match.start(1)) + 1
     line = text.splitlines()[line_no - 1].strip()
     return value, line_no, line

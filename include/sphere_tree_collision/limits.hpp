@@ -24,6 +24,23 @@ struct PhysicalLimits {
 // finite and > 0, or min_density > max_density.
 void validateLimits(const PhysicalLimits& limits);
 
+// What a mesh file (STL, OBJ, DAE: untrusted bytes, parsed by assimp) may
+// hold; named as the node's parameters (~max_mesh_bytes ...). The file's size
+// is checked before it is read, its vertices and triangles (every instance a
+// scene's nodes draw) before they are copied; its grid is limited by
+// VoxelLimits::max_voxels. assimp's memory while it parses is up to about 30
+// times the file's size (an OBJ of 8 MiB of bare faces: 260 MB): the size
+// bounds it. Defaults: a binary STL of 330,000 triangles passes.
+struct MeshLimits {
+  std::int64_t max_mesh_bytes = 16ll << 20;      // 16 MiB
+  std::int64_t max_mesh_vertices = 3'000'000;   // over all the file's meshes
+  std::int64_t max_mesh_triangles = 1'000'000;
+};
+
+// Throws InputError naming the limit ("max_mesh_bytes", ...) unless each is
+// in [1, 2^31 - 1] (a vertex index is 32-bit).
+void validateMeshLimits(const MeshLimits& limits);
+
 // Throws InputError("gravity") when not finite or above max_gravity.
 void validateGravity(const Vec3& gravity, const PhysicalLimits& limits);
 

@@ -53,6 +53,11 @@ struct WorldConfig {
   UnresolvedPolicy unresolved_policy = UnresolvedPolicy::Accept;
   SphereTreeOptions tree;
   VoxelLimits voxel_limits;
+  MeshLimits mesh_limits;  // what a mesh file may hold (limits.hpp); validated by name
+  // Folders a mesh named by a file:// URI or a path may be read from
+  // (canonical, as canonicalMeshRoots gives them; mesh_loader.hpp). Empty:
+  // only package:// resources (resolved by the ROS layer) are read.
+  std::vector<std::string> mesh_roots;
   std::size_t max_entities = 20000;
   ResponseOptions response;
   PhysicalLimits limits;  // inputs beyond them are rejected; bodies beyond them quarantined

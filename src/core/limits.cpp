@@ -2,6 +2,8 @@
 #include "sphere_tree_collision/limits.hpp"
 
 #include <cmath>
+#include <string>
+#include <utility>
 #include <sstream>
 
 namespace stc {
@@ -49,6 +51,17 @@ void validateLimits(const PhysicalLimits& limits) {
   if (limits.min_density > limits.max_density) {
     throw InputError("min_density", number(limits.min_density) + " is above max_density " +
                                         number(limits.max_density));
+  }
+}
+
+void validateMeshLimits(const MeshLimits& limits) {
+  const std::pair<std::int64_t, const char*> fields[] = {{limits.max_mesh_bytes, "max_mesh_bytes"},
+                                                         {limits.max_mesh_vertices, "max_mesh_vertices"},
+                                                         {limits.max_mesh_triangles, "max_mesh_triangles"}};
+  for (const auto& [value, name] : fields) {
+    if (value < 1 || value > 2147483647) {
+      throw InputError(name, "must be in [1, 2147483647], got " + std::to_string(value));
+    }
   }
 }
 

@@ -72,7 +72,7 @@ Grid sizeGrid(const MeshStats& stats, const VoxeliseOptions& options) {
   }
   if (cells > static_cast<double>(limits.max_voxels)) {
     throw InputError("max_voxels", options.source + ": voxelising at " + number(voxel) + " m needs " +
-                                       number(cells) + " voxels, limit is " +
+                                       number(cells) + " voxels above max_voxels " +
                                        std::to_string(limits.max_voxels));
   }
   return g;

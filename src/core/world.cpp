@@ -83,6 +83,7 @@ World::World(const WorldConfig& config)
       narrow_chunks_used_(static_cast<std::size_t>(workers_.threads())) {
   index_of_ = std::make_unique<detail::FlatHashMap>();
   validateLimits(config_.limits);
+  validateMeshLimits(config_.mesh_limits);
   validateGravity(config_.gravity, config_.limits);
   validateFractureOptions(config_.fracture);
   validateSleepOptions(config_.sleeping);

@@ -25,7 +25,16 @@ ShapeId addMeshShape(World& world, const std::string& resource, const Vec3& scal
   const std::string key = meshShapeKey(resource, scale, options, up_axis);
   if (const auto found = world.findShape(key)) return *found;
   options.source = resource;
-  VoxelisedMesh voxels = voxeliseMesh(loadTriangleMesh(resource, scale, up_axis), options);
+  const TriangleMesh mesh = loadTriangleMesh(resource, scale, up_axis, world.config().mesh_limits);
+  VoxelisedMesh voxels;
+  try {
+    voxels = voxeliseMesh(mesh, options);
+  } catch (const InputError& e) {
+    // The file's grid, not a field of the request, is too large: named as the
+    // other limits of a mesh file are.
+    if (e.field() != "max_voxels") throw;
+    throw InputError("mesh_resource", std::string(e.what()).substr(e.field().size() + 2));
+  }
   return world.addShape(key, std::move(voxels.shape));
 }
 

@@ -132,7 +132,8 @@ stc::EntityId addRequest(stc::World& world, EntityRequest request, const Request
     options.resolution = request.preset_params.resolution;
     options.limits = world.config().voxel_limits;
     request.spec.shape =
-        stc::addMeshShape(world, resolveMeshResource(request.mesh_resource), request.mesh_scale, options,
+        stc::addMeshShape(world, resolveMeshResource(request.mesh_resource, world.config().mesh_roots),
+                          request.mesh_scale, options,
                           request.mesh_up_axis);
   } else if (!request.preset.empty()) {
     if (request.grid) throw stc::InputError("preset", "give either a preset or an explicit grid, not both");

@@ -1,5 +1,6 @@
 #include "sphere_tree_collision/ros/node_params.hpp"
 
+#include "sphere_tree_collision/mesh_loader.hpp"
 #include "sphere_tree_collision/ros/conversions.hpp"
 #include "sphere_tree_collision/ros/param_reading.hpp"
 #include "sphere_tree_collision/ros/tick_budget_rule.hpp"
@@ -26,7 +27,8 @@ const std::set<std::string>& knownParams() {
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
       "min_voxel_size", "max_voxel_size", "entity_states_rate", "entities_rate", "publish_clock", "error_report",
       "min_piece_voxels", "small_pieces", "strength_exponent", "threads", "reuse_tolerance",
-      "diagnostic_period", "camera_info_topic"};  // diagnostic_period: read by diagnostic_updater
+      "diagnostic_period", "camera_info_topic", "mesh_roots", "max_mesh_bytes", "max_mesh_vertices",
+      "max_mesh_triangles"};  // diagnostic_period: read by diagnostic_updater
   return kNames;
 }
 
@@ -199,6 +201,16 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   p.world.response.reuse_tolerance = reuse;
   p.world.max_entities = static_cast<std::size_t>(
       intParamIn(nh, "max_entities", static_cast<int>(p.world.max_entities), 1, 10000000));
+  // Folders file:// and path meshes may be read from (none: package:// only).
+  std::vector<std::string> roots;
+  readParam(nh, "mesh_roots", roots);
+  p.world.mesh_roots = stc::canonicalMeshRoots(roots, "mesh_roots");
+  stc::MeshLimits& mesh = p.world.mesh_limits;  // what a mesh file may hold (docs/meshes.md)
+  mesh.max_mesh_bytes = intParamIn(nh, "max_mesh_bytes", static_cast<int>(mesh.max_mesh_bytes), 1, INT_MAX);
+  mesh.max_mesh_vertices =
+      intParamIn(nh, "max_mesh_vertices", static_cast<int>(mesh.max_mesh_vertices), 1, INT_MAX);
+  mesh.max_mesh_triangles =
+      intParamIn(nh, "max_mesh_triangles", static_cast<int>(mesh.max_mesh_triangles), 1, INT_MAX);
   int max_voxels = static_cast<int>(p.world.voxel_limits.max_voxels);
   p.world.voxel_limits.max_voxels = intParamIn(nh, "max_voxels", max_voxels, 1, 1 << 30);
   stc::PhysicalLimits& limits = p.world.limits;

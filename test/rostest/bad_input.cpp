@@ -161,6 +161,9 @@ TEST_F(BadInput, EveryMalformedKindIsRejectedByFieldAndNothingChanges) {
          return m;
        }())},
       {"spawn", "preset", spawn(spawnWith([](SpawnEntity& m) { m.preset = "cube\n"; }))},
+      // A path outside ~mesh_roots (none here: only package:// is read), existing or not (issue 47).
+      {"spawn", "mesh_resource", spawn(spawnWith([](SpawnEntity& m) { m.preset.clear(); m.mesh_resource = "file:///etc/passwd"; }))},
+      {"spawn", "mesh_resource", spawn(spawnWith([](SpawnEntity& m) { m.preset.clear(); m.mesh_resource = "/nonexistent/a.stl"; }))},
       {"despawn", "id", [&] { sphere_tree_collision::Despawn d; d.id = 999999; despawn_.publish(d); }},
       {"despawn", "name", [&] { sphere_tree_collision::Despawn d; d.name = "nobody"; despawn_.publish(d); }},
       {"gaze", "header.stamp", [&] { gaze_.publish(gaze(100, 100, 5.0)); }},   // stale

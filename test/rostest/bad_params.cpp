@@ -22,6 +22,14 @@ XmlRpc::XmlRpcValue list(std::initializer_list<double> values) {
   return v;
 }
 
+XmlRpc::XmlRpcValue strings(std::initializer_list<const char*> values) {
+  XmlRpc::XmlRpcValue v;
+  v.setSize(static_cast<int>(values.size()));
+  int i = 0;
+  for (const char* x : values) v[i++] = std::string(x);
+  return v;
+}
+
 struct Case {
   std::string program;  // collision_world_node, gaze_simulator, rockfall_spawner
   std::vector<std::pair<std::string, XmlRpc::XmlRpcValue>> params;
@@ -105,6 +113,12 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"entity_states_rate", "often"}}, "entity_states_rate"},
       {world, {{"publish_clock", "yes"}}, "publish_clock"},
       {world, {{"error_report", "/nonexistent_dir/report.csv"}}, "error_report"},
+      {world, {{"max_mesh_bytes", -1}}, "max_mesh_bytes"},
+      {world, {{"max_mesh_vertices", "many"}}, "max_mesh_vertices"},
+      {world, {{"max_mesh_triangles", 0}}, "max_mesh_triangles"},
+      {world, {{"mesh_roots", strings({"/tmp", "meshes"})}}, "mesh_roots[1]"},  // not absolute
+      {world, {{"mesh_roots", strings({"/nonexistent_dir"})}}, "mesh_roots[0]"},
+      {world, {{"mesh_roots", "/tmp"}}, "mesh_roots"},  // a list of folders, not one
       {"gaze_simulator", {{"mode", "blink"}}, "mode"},
       {"gaze_simulator", {{"mode", "follow"}}, "target"},
       {"rockfall_spawner", {{"rate", 0.0}}, "rate"},
@@ -127,7 +141,8 @@ TEST(BadParams, AGoodSetKeepsRunning) {
   const Case good{"collision_world_node",
                   {{"rate", 30}, {"scheduler", "round_robin"}, {"marker_levels", list({0, 3})}, {"tick_budget", 16.7},
                    {"camera_position", list({0, -3, 1})}, {"camera_look_at", list({0, 0, 0.5})},
-                   {"reuse_tolerance", 0.05}, {"default_density", 2500.0}, {"default_voxel_size", 0.1}},
+                   {"reuse_tolerance", 0.05}, {"default_density", 2500.0}, {"default_voxel_size", 0.1},
+                   {"mesh_roots", strings({"/tmp"})}, {"max_mesh_triangles", 500000}},
                   ""};
   const auto [status, output] = run(good, 1000, 3.0);
   EXPECT_FALSE(status.has_value()) << "exited with " << status.value_or(-1) << ":\n" << output;

@@ -147,6 +147,12 @@ class CachedMesh : public ::testing::Test {
     m.voxel_size = voxel_size;
     return m;
   }
+  // Plain paths are read only under ~mesh_roots: here the test's folder.
+  stc::WorldConfig config() const {
+    stc::WorldConfig c;
+    c.mesh_roots = stc::canonicalMeshRoots({dir_.path()});
+    return c;
+  }
   stc::truth::TempDir dir_;
   std::string path_ = dir_.file("cube.stl");
 };
@@ -157,7 +163,7 @@ class CachedMesh : public ::testing::Test {
 TEST_F(CachedMesh, ABadVoxelSizeIsRefusedWhetherTheShapeIsCachedOrNot) {
   for (const bool cached : {false, true}) {
     SCOPED_TRACE(cached ? "cached" : "not cached");
-    stc::World world;
+    stc::World world(config());
     if (cached) ASSERT_NE(addRequest(world, toEntityRequest(mesh(0.0))), stc::kInvalidEntity);
     const std::size_t before = world.entityCount();
     for (const double bad : {-0.05, kNaN, -kInf, kInf}) {
@@ -172,7 +178,7 @@ TEST_F(CachedMesh, ABadVoxelSizeIsRefusedWhetherTheShapeIsCachedOrNot) {
 TEST_F(CachedMesh, ControlBytesInStringsAreRefusedByField) {
   for (const bool cached : {false, true}) {
     SCOPED_TRACE(cached ? "cached" : "not cached");
-    stc::World world;
+    stc::World world(config());
     if (cached) ASSERT_NE(addRequest(world, toEntityRequest(mesh(0.0))), stc::kInvalidEntity);
     const std::size_t before = world.entityCount();
     for (const std::string tail : {std::string(1, '\0') + ".obj", std::string("\n"), std::string("\x7f")}) {

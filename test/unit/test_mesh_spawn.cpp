@@ -15,6 +15,7 @@
 #include <ros/package.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <string>
 
@@ -24,6 +25,12 @@ namespace {
 class MeshSpawn : public ::testing::Test {
  protected:
   void SetUp() override { stc::truth::writeStlBinary(stc::truth::cubeMesh(0.4), path_); }
+  // file:// and plain paths are read only under ~mesh_roots: here the test's folder.
+  stc::WorldConfig config() const {
+    stc::WorldConfig c;
+    c.mesh_roots = stc::canonicalMeshRoots({dir_.path()});
+    return c;
+  }
   stc::truth::TempDir dir_;
   std::string path_ = dir_.file("cube.stl");
 };
@@ -34,7 +41,7 @@ TEST_F(MeshSpawn, SceneFileEntriesShareTheMeshShape) {
                                      "', scale: [1, 1, 0.5], resolution: 8, position: [0, 0, 1]}\n"
                                      "  - {name: b, mesh_resource: 'file://" + path_ +
                                      "', scale: [1, 1, 0.5], resolution: 8, position: [2, 0, 1]}\n");
-  stc::World world;
+  stc::World world(config());
   const std::vector<stc::EntityId> ids = addScene(world, scene);
   ASSERT_EQ(ids.size(), 2u);
   const stc::ShapeId shape = world.bodyShapes()[0];
@@ -149,7 +156,7 @@ TEST_F(MeshSpawn, SpawnMessageWithAMeshAddsItScaled) {
   msg.voxel_size = 0.05;
   msg.density = 1000.0;
   msg.pose.orientation.w = 1.0;
-  stc::World world;
+  stc::World world(config());
   const stc::EntityId id = addRequest(world, toEntityRequest(msg));
   ASSERT_NE(id, stc::kInvalidEntity);
   const stc::VoxelShape& v = world.shape(world.bodyShapes()[0]).voxels;
@@ -174,7 +181,7 @@ TEST_F(MeshSpawn, ADaeUpAxisIsAsWrittenUnlessZUpIsAsked) {
   msg.voxel_size = 0.05;
   msg.density = 1000.0;
   msg.pose.orientation.w = 1.0;
-  stc::World world;
+  stc::World world(config());
   addRequest(world, toEntityRequest(msg));
   msg.up_axis = "z_up";
   msg.pose.position.x = 2.0;
@@ -212,17 +219,105 @@ TEST_F(MeshSpawn, ADaeUpAxisIsAsWrittenUnlessZUpIsAsked) {
 }
 
 TEST_F(MeshSpawn, PackageResourcesOfUnknownPackagesAreRejected) {
-  EXPECT_EQ(resolveMeshResource(path_), path_);
-  EXPECT_EQ(resolveMeshResource("file://" + path_), "file://" + path_);
+  const std::vector<std::string> roots = config().mesh_roots;
+  const std::string real = std::filesystem::canonical(path_).string();
+  EXPECT_EQ(resolveMeshResource(path_, roots), real);
+  EXPECT_EQ(resolveMeshResource("file://" + path_, roots), real);
   for (const std::string bad : {"package://no_such_package_xyz/meshes/a.stl", "package://only_a_name"}) {
     try {
-      resolveMeshResource(bad);
+      resolveMeshResource(bad, roots);
       FAIL() << bad;
     } catch (const stc::InputError& e) {
       EXPECT_EQ(e.field(), "mesh_resource");
       EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
     }
   }
+}
+
+// Issue 47 item 2: a file:// URI or a path is read only under ~mesh_roots
+// (`..` and symlinks resolved first); package:// always resolves, within its
+// package. A refused path gets the same words whether its file exists or not.
+TEST_F(MeshSpawn, FilePathsAreReadOnlyUnderTheMeshRoots) {
+  if (ros::package::getPath("sphere_tree_collision").empty()) ::setenv("ROS_PACKAGE_PATH", ".", 1);
+  const std::vector<std::string> roots = config().mesh_roots;
+  stc::truth::TempDir outside;
+  const std::string secret = outside.file("secret.stl");
+  stc::truth::writeStlBinary(stc::truth::cubeMesh(0.4), secret);
+  const std::string link = dir_.file("link.stl");  // inside the roots, leading out
+  std::filesystem::create_symlink(secret, link);
+  const std::string sub = dir_.file("sub");
+  std::filesystem::create_directory(sub);
+  // The reason of a refusal, the resource named in it replaced by "R".
+  const auto refusal = [](const std::string& resource, const std::vector<std::string>& r) -> std::string {
+    try {
+      resolveMeshResource(resource, r);
+    } catch (const stc::InputError& e) {
+      EXPECT_EQ(e.field(), "mesh_resource") << e.what();
+      std::string what = e.what();
+      const std::size_t at = what.find(resource);
+      EXPECT_NE(at, std::string::npos) << what << " names the resource as given";
+      return at == std::string::npos ? what : what.replace(at, resource.size(), "R");
+    }
+    return "accepted";
+  };
+  const std::string words = refusal(secret, roots);
+  EXPECT_NE(words, "accepted");
+  EXPECT_EQ(words.find(outside.path()), std::string::npos) << words;
+  for (const std::string& bad :
+       {outside.path() + "/missing.stl", "file://" + secret, link, "file://" + link, dir_.path() + "/../" +
+        std::filesystem::path(outside.path()).filename().string() + "/secret.stl",
+        sub + "/../../" + std::filesystem::path(outside.path()).filename().string() + "/secret.stl",
+        dir_.path() + "/missing.stl", sub + "/missing/../../cube.stl"}) {
+    EXPECT_EQ(refusal(bad, roots), words) << bad;
+  }
+  EXPECT_EQ(refusal(path_, {}), refusal(outside.path() + "/missing.stl", {})) << "no roots: no file is read";
+  EXPECT_NE(refusal(path_, {}).find("only package://"), std::string::npos) << refusal(path_, {});
+  EXPECT_EQ(resolveMeshResource(sub + "/../cube.stl", roots), std::filesystem::canonical(path_).string());
+  // package:// with no roots; a `..` that leads out of the package is refused.
+  EXPECT_NO_THROW(resolveMeshResource("package://sphere_tree_collision/meshes/bumpy_scan.stl", {}));
+  EXPECT_NO_THROW(resolveMeshResource("package://sphere_tree_collision/meshes/../meshes/bumpy_scan.stl", {}));
+  for (const std::string bad : {"package://sphere_tree_collision/../x/meshes/a.stl",
+                                "package://sphere_tree_collision/meshes/../../../etc/hostname.stl",
+                                "package://sphere_tree_collision//etc/hostname.stl"}) {
+    EXPECT_NE(refusal(bad, {}), "accepted") << bad;
+  }
+  // Through a spawn: refused by field, nothing added.
+  stc::World world(config());
+  sphere_tree_collision::SpawnEntity msg;
+  msg.mesh_resource = "file://" + link;
+  msg.voxel_size = 0.05;
+  msg.pose.orientation.w = 1.0;
+  EXPECT_EQ(refusal(msg.mesh_resource, world.config().mesh_roots), words);
+  try {
+    addRequest(world, toEntityRequest(msg));
+    ADD_FAILURE() << "read a file outside the roots";
+  } catch (const stc::InputError& e) {
+    EXPECT_EQ(e.field(), "mesh_resource");
+  }
+  EXPECT_EQ(world.entityCount(), 0u);
+  msg.mesh_resource = "file://" + path_;
+  EXPECT_NE(addRequest(world, toEntityRequest(msg)), stc::kInvalidEntity);
+}
+
+TEST(MeshRoots, EachMustBeAnAbsolutePathToAFolderAndIsNamedByIndex) {
+  stc::truth::TempDir dir;
+  const std::string file = dir.file("a.stl");
+  stc::truth::writeStlBinary(stc::truth::cubeMesh(0.4), file);
+  const auto field_of = [](const std::vector<std::string>& roots) -> std::string {
+    try {
+      stc::canonicalMeshRoots(roots);
+    } catch (const stc::InputError& e) {
+      return e.field();
+    }
+    return "accepted";
+  };
+  EXPECT_EQ(field_of({dir.path()}), "accepted");
+  EXPECT_EQ(field_of({dir.path(), "meshes"}), "mesh_roots[1]");  // relative
+  EXPECT_EQ(field_of({dir.path() + "/missing"}), "mesh_roots[0]");
+  EXPECT_EQ(field_of({file}), "mesh_roots[0]");  // a file, not a folder
+  EXPECT_EQ(field_of({""}), "mesh_roots[0]");
+  EXPECT_EQ(stc::canonicalMeshRoots({dir.path() + "/./"}), std::vector<std::string>{
+                                                               std::filesystem::canonical(dir.path()).string()});
 }
 
 TEST_F(MeshSpawn, AnOpenMeshIsRejectedAndNothingIsAdded) {
@@ -234,7 +329,7 @@ TEST_F(MeshSpawn, AnOpenMeshIsRejectedAndNothingIsAdded) {
   EntityRequest r;
   r.mesh_resource = sheet_path;
   r.spec.density = 1000.0;
-  stc::World world;
+  stc::World world(config());
   try {
     addRequest(world, r);
     FAIL() << "accepted an open sheet";

@@ -11,6 +11,8 @@
 #include "sphere_tree_collision/sphere_tree.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/inotify.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -294,6 +296,122 @@ TEST_F(MeshFiles, MeshShapesAreCachedByResourceScaleAndResolution) {
   EXPECT_EQ(errorOf([&] { addMeshShape(world, path, Vec3::Ones(), atResolution(17)); }).field(), "mesh_resource");
   EXPECT_GT(world.shape(a).tree.nodes().size(), 1u);
   EXPECT_DOUBLE_EQ(world.shape(a).voxels.surfaceMargin(), std::sqrt(3.0) * world.shape(a).voxels.voxelSize());
+}
+
+// Issue 47 item 2: what a mesh file may hold. Each limit is refused as
+// mesh_resource, the message giving the count and naming the limit; one
+// below the count passes.
+TEST_F(MeshFiles, EachLimitOfAMeshFileIsRefusedNamingIt) {
+  const std::string path = file("ball.stl");
+  truth::writeStlBinary(icosphere(0.5, 2), path);  // 320 triangles, 3 vertices each
+  const std::int64_t bytes = 84 + 50 * 320;
+  const auto refusal = [&](const MeshLimits& limits) {
+    const InputError e = errorOf([&] { loadTriangleMesh(path, Vec3::Ones(), ColladaUpAxis::AsWritten, limits); });
+    EXPECT_EQ(e.field(), "mesh_resource") << e.what();
+    return std::string(e.what());
+  };
+  MeshLimits limits;
+  limits.max_mesh_triangles = 319;
+  EXPECT_EQ(refusal(limits), "mesh_resource: " + path + ": 320 triangles above max_mesh_triangles 319");
+  limits = MeshLimits{};
+  limits.max_mesh_vertices = 959;
+  EXPECT_EQ(refusal(limits), "mesh_resource: " + path + ": 960 vertices above max_mesh_vertices 959");
+  limits = MeshLimits{};
+  limits.max_mesh_bytes = bytes - 1;
+  EXPECT_EQ(refusal(limits), "mesh_resource: " + path + ": " + std::to_string(bytes) +
+                                 " bytes above max_mesh_bytes " + std::to_string(bytes - 1));
+  limits = MeshLimits{};  // each exactly at its limit
+  limits.max_mesh_bytes = bytes;
+  limits.max_mesh_vertices = 960;
+  limits.max_mesh_triangles = 320;
+  EXPECT_EQ(loadTriangleMesh(path, Vec3::Ones(), ColladaUpAxis::AsWritten, limits).triangles.size(), 320u);
+
+  // The same from bytes in memory (what the fuzz target feeds).
+  std::string data(static_cast<std::size_t>(bytes), '\0');
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  ASSERT_NE(f, nullptr);
+  ASSERT_EQ(std::fread(data.data(), 1, data.size(), f), data.size());
+  std::fclose(f);
+  limits.max_mesh_bytes = bytes - 1;
+  EXPECT_EQ(errorOf([&] { parseTriangleMesh(data.data(), data.size(), "stl", "x", Vec3::Ones(),
+                                            ColladaUpAxis::AsWritten, limits); }).what(),
+            "mesh_resource: x: " + std::to_string(bytes) + " bytes above max_mesh_bytes " + std::to_string(bytes - 1));
+  EXPECT_EQ(errorOf([&] { parseTriangleMesh(data.data(), data.size(), "ply", "x"); }).field(), "mesh_resource");
+
+  // The grid: above max_voxels, refused as the file's, not as a field of the request.
+  World world;
+  VoxeliseOptions options = atResolution(16);  // 18^3 = 5,832 cells with the padding
+  options.limits.max_voxels = 5000;
+  const InputError grid = errorOf([&] { addMeshShape(world, path, Vec3::Ones(), options); });
+  EXPECT_EQ(grid.field(), "mesh_resource");
+  EXPECT_NE(std::string(grid.what()).find("5832 voxels above max_voxels 5000"), std::string::npos) << grid.what();
+  // The world's limits are the ones addMeshShape reads the file within.
+  WorldConfig config;
+  config.mesh_limits.max_mesh_triangles = 100;
+  World small(config);
+  EXPECT_NE(std::string(errorOf([&] { addMeshShape(small, path, Vec3::Ones(), atResolution(8)); }).what())
+                .find("320 triangles above max_mesh_triangles 100"),
+            std::string::npos);
+  EXPECT_EQ(small.shapeCount(), 0u);
+  config.mesh_limits.max_mesh_triangles = 0;
+  EXPECT_EQ(errorOf([&] { World bad(config); }).field(), "max_mesh_triangles");
+}
+
+// Only the bytes given are read: the material library an OBJ names (by an
+// absolute path and by one beside it) is not opened, and the mesh still loads.
+// inotify sees every open in the folder; opening it here shows it would.
+TEST_F(MeshFiles, AnObjMaterialLibraryIsNotOpened) {
+  const std::string mtl = file("lib.mtl");
+  { std::FILE* f = std::fopen(mtl.c_str(), "w"); ASSERT_NE(f, nullptr); std::fputs("newmtl red\nKd 1 0 0\n", f); std::fclose(f); }
+  const int watch = ::inotify_init1(IN_NONBLOCK);
+  ASSERT_GE(watch, 0);
+  ASSERT_GE(::inotify_add_watch(watch, dir_.path().c_str(), IN_OPEN), 0);
+  const auto opened = [watch] {
+    alignas(inotify_event) char events[4096];
+    return ::read(watch, events, sizeof events) > 0;
+  };
+  const std::string obj = "mtllib " + mtl + "\nmtllib lib.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                          "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  EXPECT_EQ(parseTriangleMesh(obj.data(), obj.size(), "obj", "tetra.obj").triangles.size(), 4u);
+  EXPECT_FALSE(opened()) << "a file beside the bytes was opened";
+  std::fclose(std::fopen(mtl.c_str(), "r"));
+  EXPECT_TRUE(opened()) << "inotify saw no open: the check above proves nothing";
+  ::close(watch);
+}
+
+// What assimp 5.2 mishandles is refused before it sees it. A DAE's <instance_node>: assimp copies the
+// instanced nodes first, so 5 KB nesting ten instances nine deep asked for
+// gigabytes, and a node instancing its own ancestor recursed without end.
+TEST_F(MeshFiles, ADaeWithInstancedNodesIsRefusedBeforeAssimpCopiesThem) {
+  std::string dae =
+      "<?xml version=\"1.0\"?><COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
+      "<library_geometries><geometry id=\"g\"><mesh><source id=\"p\"><float_array id=\"pa\" count=\"9\">"
+      "0 0 0 1 0 0 0 1 0</float_array><technique_common><accessor source=\"#pa\" count=\"3\" stride=\"3\">"
+      "<param name=\"X\" type=\"float\"/><param name=\"Y\" type=\"float\"/><param name=\"Z\" type=\"float\"/>"
+      "</accessor></technique_common></source><vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/>"
+      "</vertices><triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/><p>0 1 2</p>"
+      "</triangles></mesh></geometry></library_geometries><library_nodes>"
+      "<node id=\"loop\"><node id=\"inner\"><instance_node url=\"#loop\"/></node></node></library_nodes>"
+      "<library_visual_scenes><visual_scene id=\"s\"><node id=\"a\"><instance_geometry url=\"#g\"/>"
+      "NODE</node></visual_scene></library_visual_scenes><scene><instance_visual_scene url=\"#s\"/></scene>"
+      "</COLLADA>";
+  const auto parse = [](const std::string& text) {
+    return parseTriangleMesh(text.data(), text.size(), "dae", "bomb.dae");
+  };
+  const std::string plain = std::string(dae).replace(dae.find("NODE"), 4, "").replace(
+      dae.find("<library_nodes>"), dae.find("</library_nodes>") + 16 - dae.find("<library_nodes>"), "");
+  EXPECT_EQ(parse(plain).triangles.size(), 1u) << "the same file without instanced nodes loads";
+  // A <p> holding anything but integers: assimp appended indices for ever
+  // (found by fuzz_mesh); entities and CDATA are refused with it.
+  for (const std::string bad : {"0 1 \xcd\xdf2", "0 1 &#50;", "<![CDATA[0 1 2]]>", "0 1 x"}) {
+    const std::string text = std::string(plain).replace(plain.find("0 1 2</p>"), 5, bad);
+    const InputError e = errorOf([&] { parse(text); });
+    EXPECT_NE(std::string(e.what()).find("<p> holds more than integers"), std::string::npos) << e.what();
+  }
+  const std::string looped = dae.replace(dae.find("NODE"), 4, "<instance_node url=\"#loop\"/>");
+  const InputError e = errorOf([&] { parse(looped); });
+  EXPECT_EQ(e.field(), "mesh_resource");
+  EXPECT_NE(std::string(e.what()).find("<instance_node>"), std::string::npos) << e.what();
 }
 
 TEST(MeshGenerators, TheTwoRealWorldMeshesVoxeliseSolid) {
