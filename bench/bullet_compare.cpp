@@ -747,6 +747,7 @@ int main(int argc, char** argv) {
         rows += runRow(c, side[k]);
         phases_md += phaseRow(c, side[k]);
         side_md += sideBySideRow(c, side[k], opt.side_by_side[k]);
+        std::printf("side by side: %s", sideBySideRow(c, side[k], opt.side_by_side[k]).c_str());
       }
       std::printf("%s", rows.c_str());
       ours = side.front();
