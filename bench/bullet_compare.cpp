@@ -29,7 +29,7 @@
 // ratio of the two p50s.
 //
 // Usage: bench_bullet_compare [--seconds S] [--settle S] [--scenes LIST] [--variants LIST] [--iterations N]
-//                             [--reuse T] [--markdown FILE]
+//                             [--reuse T[,T...]] [--markdown FILE]
 //   --seconds   simulated time per run (default 10)
 //   --settle    simulated time run first, untimed (default 0): with it the timed
 //               ticks are those of a settling scene, where both engines put
@@ -46,7 +46,12 @@
 //               at the same solver effort. The SUMMARY lines say which was used.
 //   --reuse T   this package carries a resting pair's contacts over while its bodies
 //               drift less than T of a leaf radius (ResponseOptions::reuse_tolerance;
-//               default: the World's, 0 = off). The SUMMARY lines say so.
+//               default: the World's). The SUMMARY lines say so. A list (--reuse 0,0.05)
+//               runs one World per value side by side, in turns of 10 ticks (so a
+//               loaded machine weighs on each alike), with their phases timed in
+//               thread-CPU (World::setClock), and prints them in one more table: the
+//               whole tick, narrow phase, contact building and solve, and the share
+//               of colliding pairs whose contacts were carried over.
 // Where the response's time goes (instruction counts, stable on a loaded machine;
 // docs/response.md, "Cost of the response"):
 //   valgrind --tool=callgrind --toggle-collect='stc::Physics::buildContacts*' --toggle-collect='stc::Physics::solve*'
@@ -99,6 +104,8 @@ struct Run {
   // (integration, islands, activation).
   std::vector<double> integrate, broad, sweep, narrow, building, detection, solve, rest;
   std::vector<double> contacts;                           // per tick (this package)
+  std::vector<double> reused;  // per tick (this package): share of the colliding pairs carried over
+  bool cpu_phases = false;     // this package's phases in thread-CPU s (side by side), else wall
   double stored_speed = 0.0;  // mean over ticks and movers of |v|
   double moved_speed = 0.0;   // mean over ticks and movers of |dx| / dt
   double final_speed = 0.0;   // mean |v| after the last tick
@@ -187,43 +194,80 @@ void timeTick(Run& run, double wall0, double cpu0) {
   run.cpu.push_back(stc_bench::threadCpuSeconds() - cpu0);
 }
 
-Run runPackage(const Case& c, int ticks, int settle_ticks, const PackageOptions& package) {
-  SceneWorld scene = sceneWorld(c, package);
-  World& world = scene.world;
-  const SceneSpec& spec = scene.spec;
-  for (int t = 0; t < settle_ticks; ++t) world.step(spec.dt, Budget::unlimited());
-  std::vector<std::size_t> dense;
-  for (EntityId id : spec.movers) dense.push_back(*world.indexOf(id));
-  std::vector<Vec3> positions(dense.size()), velocities(dense.size());
-  auto read = [&] {
-    for (std::size_t i = 0; i < dense.size(); ++i) {
-      positions[i] = world.bodies()[dense[i]].pose.position;
-      velocities[i] = world.bodies()[dense[i]].linear_velocity;
-    }
-  };
-  Run run;
-  run.engine = package.label();
-  MotionCheck check(spec.bounds, spec.dt);
-  read();
-  check.start(positions);
-  for (int t = 0; t < ticks; ++t) {
-    const double wall0 = stc_bench::wallSeconds(), cpu0 = stc_bench::threadCpuSeconds();
-    const TickReport r = world.step(spec.dt, Budget::unlimited());
-    timeTick(run, wall0, cpu0);
-    run.integrate.push_back(r.integrate_s);
-    run.broad.push_back(r.broad_s);
-    run.sweep.push_back(r.sweep_s);
-    run.narrow.push_back(r.narrow_s);
-    run.building.push_back(r.contacts_s);
-    run.detection.push_back(r.broad_s + r.sweep_s + r.narrow_s + r.contacts_s);
-    run.solve.push_back(r.response_s - r.contacts_s);
-    run.contacts.push_back(static_cast<double>(r.contacts));
-    run.sleeping = static_cast<int>(r.sleeping);
+// One World of a scene, ticked and timed a tick at a time (so that several
+// can take turns).
+class PackageRun {
+ public:
+  PackageRun(const Case& c, int settle_ticks, const PackageOptions& package, bool cpu_phases)
+      : scene_(sceneWorld(c, package)), check_(scene_.spec.bounds, scene_.spec.dt) {
+    World& world = scene_.world;
+    if (cpu_phases) world.setClock(stc_bench::threadCpuSeconds);
+    for (int t = 0; t < settle_ticks; ++t) world.step(scene_.spec.dt, Budget::unlimited());
+    for (EntityId id : scene_.spec.movers) dense_.push_back(*world.indexOf(id));
+    positions_.resize(dense_.size());
+    velocities_.resize(dense_.size());
+    run_.engine = package.label();
+    run_.cpu_phases = cpu_phases;
     read();
-    check.tick(positions, velocities);
+    check_.start(positions_);
   }
-  check.finish(run);
-  return run;
+  void tick() {
+    World& world = scene_.world;
+    const double wall0 = stc_bench::wallSeconds(), cpu0 = stc_bench::threadCpuSeconds();
+    const TickReport r = world.step(scene_.spec.dt, Budget::unlimited());
+    timeTick(run_, wall0, cpu0);
+    run_.integrate.push_back(r.integrate_s);
+    run_.broad.push_back(r.broad_s);
+    run_.sweep.push_back(r.sweep_s);
+    run_.narrow.push_back(r.narrow_s);
+    run_.building.push_back(r.contacts_s);
+    run_.detection.push_back(r.broad_s + r.sweep_s + r.narrow_s + r.contacts_s);
+    run_.solve.push_back(r.response_s - r.contacts_s);
+    run_.contacts.push_back(static_cast<double>(r.contacts));
+    run_.reused.push_back(r.colliding > 0 ? static_cast<double>(r.reused) / static_cast<double>(r.colliding) : 0.0);
+    run_.sleeping = static_cast<int>(r.sleeping);
+    read();
+    check_.tick(positions_, velocities_);
+  }
+  Run finish() {
+    check_.finish(run_);
+    return run_;
+  }
+
+ private:
+  void read() {
+    for (std::size_t i = 0; i < dense_.size(); ++i) {
+      positions_[i] = scene_.world.bodies()[dense_[i]].pose.position;
+      velocities_[i] = scene_.world.bodies()[dense_[i]].linear_velocity;
+    }
+  }
+  SceneWorld scene_;
+  MotionCheck check_;
+  std::vector<std::size_t> dense_;
+  std::vector<Vec3> positions_, velocities_;
+  Run run_;
+};
+
+Run runPackage(const Case& c, int ticks, int settle_ticks, const PackageOptions& package) {
+  PackageRun run(c, settle_ticks, package, false);
+  for (int t = 0; t < ticks; ++t) run.tick();
+  return run.finish();
+}
+
+// One World per package option, ticked in turns of kTurnTicks ticks.
+constexpr int kTurnTicks = 10;
+std::vector<Run> runPackagesSideBySide(const Case& c, int ticks, int settle_ticks,
+                                       const std::vector<PackageOptions>& packages) {
+  std::vector<std::unique_ptr<PackageRun>> runs;
+  for (const PackageOptions& p : packages) runs.push_back(std::make_unique<PackageRun>(c, settle_ticks, p, true));
+  for (int done = 0; done < ticks; done += kTurnTicks) {
+    for (auto& run : runs) {
+      for (int t = done; t < std::min(ticks, done + kTurnTicks); ++t) run->tick();
+    }
+  }
+  std::vector<Run> out;
+  for (auto& run : runs) out.push_back(run->finish());
+  return out;
 }
 
 // ---------------------------------------------------------------------------
@@ -555,10 +599,19 @@ std::string phaseCell(const std::vector<double>& v) {
 
 std::string phaseRow(const Case& c, const Run& r) {
   char buf[512];
-  std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %s | %s | %.0f |\n", label(c).c_str(),
+  const std::string scene = r.cpu_phases ? label(c) + ", " + r.engine : label(c);
+  std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %s | %s | %.0f |\n", scene.c_str(),
                 phaseCell(r.integrate).c_str(), phaseCell(r.broad).c_str(), phaseCell(r.sweep).c_str(),
                 phaseCell(r.narrow).c_str(), phaseCell(r.building).c_str(), phaseCell(r.solve).c_str(),
-                phaseCell(r.wall).c_str(), percentile(r.contacts, 0.5));
+                phaseCell(r.cpu_phases ? r.cpu : r.wall).c_str(), percentile(r.contacts, 0.5));
+  return buf;
+}
+
+std::string sideBySideRow(const Case& c, const Run& r, double reuse) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "| %s | %g | %s | %s | %s | %s | %.0f %% | %.0f |\n", label(c).c_str(), reuse,
+                phaseCell(r.cpu).c_str(), phaseCell(r.narrow).c_str(), phaseCell(r.building).c_str(),
+                phaseCell(r.solve).c_str(), 100.0 * meanOf(r.reused), percentile(r.contacts, 0.5));
   return buf;
 }
 
@@ -579,6 +632,7 @@ struct Options {
   double settle = 0.0;
   bool bullet_only = false;
   PackageOptions package;
+  std::vector<double> side_by_side;  // --reuse with several values: one World each, in turns
   std::vector<Case> cases;
   std::vector<BulletShape> variants{BulletShape::Compound, BulletShape::Hull, BulletShape::Lean};
   std::string markdown;
@@ -625,8 +679,15 @@ Options parse(int argc, char** argv) {
       o.package.iterations = std::stoi(args.required());
       if (o.package.iterations < 1) throw InputError("--iterations", "must be >= 1");
     } else if (a == "--reuse") {
-      o.package.reuse = std::stod(args.required());
-      if (!(o.package.reuse >= 0.0 && o.package.reuse <= 1.0)) throw InputError("--reuse", "must be in [0, 1]");
+      o.side_by_side.clear();
+      for (const std::string& v : splitList(args.required())) {
+        const double reuse = std::stod(v);
+        if (!(reuse >= 0.0 && reuse <= 1.0)) throw InputError("--reuse", "must be in [0, 1]");
+        o.side_by_side.push_back(reuse);
+      }
+      if (o.side_by_side.empty()) throw InputError("--reuse", "names no value");
+      o.package.reuse = o.side_by_side.front();
+      if (o.side_by_side.size() == 1) o.side_by_side.clear();
     } else if (a == "--markdown") {
       o.markdown = args.required();
     } else {
@@ -665,11 +726,35 @@ int main(int argc, char** argv) {
               "surface-voxel corners, faces moved in by Bullet's default margin; lean = full voxel boxes as "
               "btBoxShape, other shapes as optimizeConvexHull() hulls of the surface-voxel corners, margin %.3f m\n",
               kLeanMargin);
+  std::string side_md =
+      "| scene | reuse tolerance | whole tick | narrow phase | contacts | solve | colliding pairs carried over "
+      "| contacts a tick |\n"
+      "|---|---|---|---|---|---|---|---|\n";
   for (const Case& c : opt.cases) {
     std::printf("## %s (load %.2f)\n", label(c).c_str(), loadAverage());
     std::fflush(stdout);
-    const Run ours = opt.bullet_only ? Run{} : runPackage(c, ticks, settle_ticks, opt.package);
-    std::string rows = opt.bullet_only ? std::string() : runRow(c, ours);
+    std::string rows;
+    Run ours;
+    if (!opt.bullet_only && !opt.side_by_side.empty()) {
+      std::vector<PackageOptions> packages;
+      for (const double reuse : opt.side_by_side) {
+        PackageOptions p = opt.package;
+        p.reuse = reuse;
+        packages.push_back(p);
+      }
+      const std::vector<Run> side = runPackagesSideBySide(c, ticks, settle_ticks, packages);
+      for (std::size_t k = 0; k < side.size(); ++k) {
+        rows += runRow(c, side[k]);
+        phases_md += phaseRow(c, side[k]);
+        side_md += sideBySideRow(c, side[k], opt.side_by_side[k]);
+        std::printf("side by side: %s", sideBySideRow(c, side[k], opt.side_by_side[k]).c_str());
+      }
+      std::printf("%s", rows.c_str());
+      ours = side.front();
+    } else if (!opt.bullet_only) {
+      ours = runPackage(c, ticks, settle_ticks, opt.package);
+      rows = runRow(c, ours);
+    }
     std::printf("%s", rows.c_str());
     std::fflush(stdout);
     double best = NAN;
@@ -688,7 +773,7 @@ int main(int argc, char** argv) {
       }
     }
     runs_md += rows;
-    if (!opt.bullet_only) {
+    if (!opt.bullet_only && opt.side_by_side.empty()) {
       phases_md += phaseRow(c, ours);
       std::printf("phases p50 / mean ms: %s", phaseRow(c, ours).c_str());
     }
@@ -708,8 +793,15 @@ int main(int argc, char** argv) {
                 "tick; speeds in m/s, means over movers and ticks.\n\n",
                 opt.seconds, ticks, opt.settle);
   md = std::string(head) + runs_md +
-       "\nThis package's phases, ms per tick (p50 / mean, wall time):\n\n" + phases_md +
+       (opt.side_by_side.empty() ? "\nThis package's phases, ms per tick (p50 / mean, wall time):\n\n"
+                                  : "\nThis package's phases, ms per tick (p50 / mean, thread-CPU):\n\n") +
+       phases_md +
        "\nBullet's phases (its profile zones), ms per tick (p50 / mean, wall time):\n\n" + bullet_phases_md;
+  if (!opt.side_by_side.empty()) {
+    md += "\nContacts carried over, side by side (one World per tolerance, in turns of " + std::to_string(kTurnTicks) +
+          " ticks): thread-CPU ms per tick, p50 / mean; the share of colliding pairs carried over, mean over the "
+          "ticks:\n\n" + side_md;
+  }
   std::printf("\n%s\nload at the end %.2f\n%s", md.c_str(), loadAverage(), summary.c_str());
   if (!opt.markdown.empty()) std::ofstream(opt.markdown) << md << "\n```\n" << summary << "```\n";
   return 0;

@@ -29,10 +29,12 @@
 // Usage: bench_steady_frame_rate [--scene all|NAME[:N][,NAME[:N]...]] [--entities N]
 //          [--tick-budget-ms 16.7] [--seconds 60] [--budget-off] [--no-reference] [--wall-clock]
 //          [--trace-escape] [--sphere-tests N] [--solver-iterations N]
-//          [--position-correction F] [--markdown FILE] [--smoke]
+//          [--position-correction F] [--reuse-tolerance T] [--markdown FILE] [--smoke]
 //   --scene: a bare NAME picks that scene's default cases (rockfall: 1,000 and 5,000)
 //   --entities N: every chosen scene at N movers instead
 //   --budget-off: the unbudgeted run alone; --no-reference: the budgeted run alone
+//   --reuse-tolerance T: ResponseOptions::reuse_tolerance in [0, 1] (0: every pair built
+//     every tick; default: the World's), to measure contact recycling off and on
 //   --smoke: every scene at 100 entities for 0.05 s: that the bench runs, scripts/bench_smoke.sh
 #include "bench_args.hpp"
 #include "plausibility.hpp"
@@ -103,11 +105,12 @@ struct Run {
 
 constexpr double kMovedMetres = 0.02;
 
-Run simulate(const Case& c, double seconds, const Budget& budget, bool budgeted, double position_correction, bool wall_clock,
-             bool trace_escape) {
+Run simulate(const Case& c, double seconds, const Budget& budget, bool budgeted, double position_correction,
+             double reuse_tolerance, bool wall_clock, bool trace_escape) {
   WorldConfig config;
   config.scheduler.kind = SchedulerKind::PriorityQueues;
   if (std::isfinite(position_correction)) config.response.position_correction = position_correction;
+  if (std::isfinite(reuse_tolerance)) config.response.reuse_tolerance = reuse_tolerance;
   SceneParams params;
   params.entities = c.bodies;
   SceneWorld scene = makeSceneWorld(c.kind, params, config);
@@ -250,6 +253,8 @@ int main(int argc, char** argv) {
   std::int64_t sphere_tests = std::numeric_limits<std::int64_t>::max();
   int solver_iterations = std::numeric_limits<int>::max();
   double position_correction = NAN;  // the World's default
+  double reuse_tolerance = NAN;      // the World's default
+  bool reuse_set = false;
   std::string markdown;
   std::vector<Case> cases;
   try {
@@ -264,6 +269,10 @@ int main(int argc, char** argv) {
       else if (a == "--sphere-tests") sphere_tests = std::stoll(args.required());
       else if (a == "--solver-iterations") solver_iterations = std::stoi(args.required());
       else if (a == "--position-correction") position_correction = std::stod(args.required());
+      else if (a == "--reuse-tolerance") {
+        reuse_tolerance = std::stod(args.required());
+        reuse_set = true;
+      }
       else if (a == "--wall-clock") wall_clock = true;
       else if (a == "--trace-escape") trace_escape = true;
       else if (a == "--markdown") markdown = args.required();
@@ -271,6 +280,9 @@ int main(int argc, char** argv) {
       else return args.unknown();
     }
     if (entities < 0) throw InputError("--entities", "must be >= 0 (0: each scene's default cases)");
+    if (reuse_set && !(reuse_tolerance >= 0.0 && reuse_tolerance <= 1.0)) {
+      throw InputError("--reuse-tolerance", "must be in [0, 1]");
+    }
     if (budget_off && !reference) throw InputError("--no-reference", "with --budget-off nothing would run");
     cases = scene == "all" ? kDefaultCases : stc_bench::parseSceneCases(scene, kDefaultCases);
     if (cases.empty()) throw InputError("--scene", "names no scene");
@@ -297,11 +309,12 @@ int main(int argc, char** argv) {
   for (const Case& c : cases) {
     if (!budget_off) {
       std::fprintf(stderr, "%s %d under the budget: %.0f s simulated ...\n", toString(c.kind), c.bodies, seconds);
-      runs.push_back(simulate(c, seconds, budget, true, position_correction, wall_clock, trace_escape));
+      runs.push_back(simulate(c, seconds, budget, true, position_correction, reuse_tolerance, wall_clock, trace_escape));
     }
     if (reference) {
       std::fprintf(stderr, "%s %d unbudgeted: %.0f s simulated ...\n", toString(c.kind), c.bodies, seconds);
-      runs.push_back(simulate(c, seconds, Budget::unlimited(), false, position_correction, wall_clock, trace_escape));
+      runs.push_back(simulate(c, seconds, Budget::unlimited(), false, position_correction, reuse_tolerance,
+                              wall_clock, trace_escape));
     }
   }
 
@@ -321,6 +334,10 @@ int main(int argc, char** argv) {
   }
   if (std::isfinite(position_correction)) {
     std::snprintf(buf, sizeof buf, " Position correction: %.2f.", position_correction);
+    md += buf;
+  }
+  if (std::isfinite(reuse_tolerance)) {
+    std::snprintf(buf, sizeof buf, " Reuse tolerance: %.3g.", reuse_tolerance);
     md += buf;
   }
   md += "\n\n";

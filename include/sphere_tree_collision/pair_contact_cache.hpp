@@ -31,13 +31,17 @@ class PairContactCache {
  public:
   static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 
-  // The contact points of one entry: each body's surface point in its own
-  // frame and the normal in A's frame, as built.
+  // The contact points of one entry, as built: each body's surface point in
+  // its own frame (the anchors), and the normal in the frame of the body it
+  // turns with.
   struct Point {
-    Vec3 on_a, on_b, normal_in_a;
+    Vec3 on_a, on_b, normal;
     double depth = 0.0, separation = 0.0, sphere_bound = 0.0;
     std::int32_t node_a = 0, node_b = 0;
     int level = 0;
+    // The normal is a face axis of B's voxel boxes and not of A's: it turns
+    // with B. Else with A (A's face, or a line of centres as built).
+    bool normal_of_b = false;
     bool resolved = true;  // found at the leaves (an unresolved pair's frontier: false)
   };
   // A pair's contacts as built, and the pose of B in A's frame then.
@@ -61,6 +65,8 @@ class PairContactCache {
       entries.clear();
       points.clear();
     }
+    // Room for `entries` entries and `points` points.
+    void reserve(std::size_t entries, std::size_t points);
   };
 
   PairContactCache();
@@ -86,11 +92,16 @@ class PairContactCache {
   std::uint32_t find(const ReuseBody& a, const ReuseBody& b, double dt) const;
   const Entry& entry(std::uint32_t index) const { return entries_[index]; }
 
-  // The entry's contacts at the bodies' poses now, appended to `out`: each
-  // point on A and on B where it was on its body, the normal turned with
-  // A, the separation measured again between the two points along it (at
-  // least 0 for a point of an unresolved pair, as when it was built).
-  // `base` gives the ids, dense indices and priority.
+  // The entry's contacts at the bodies' poses now, appended to `out`, each
+  // measured again from its anchors (as Box2D v3 measures its substeps'
+  // separations): the surface points on A and on B where they are on their
+  // bodies now, the normal turned with the body whose face it is (with A
+  // when it is neither's nor B's alone), the separation between
+  // the two points along it and the point halfway between them. So a
+  // carried contact's separation is the bodies' now, to first order in
+  // their drift, not the one it was built with (at least 0 for a point of
+  // an unresolved pair, as when it was built). `base` gives the ids, dense
+  // indices and priority.
   void place(std::uint32_t index, const Contact& base, const Pose& pose_a, const Pose& pose_b,
              std::vector<Contact>& out) const;
 

@@ -55,10 +55,11 @@ struct ResponseOptions {
   // body moves relative to the other by more than this fraction of the
   // smaller leaf radius of the two since they were built
   // (pair_contact_cache.hpp). 0: every pair is tested and built every tick.
-  // In [0, 1]; only with the response enabled. Off by default: the carried
-  // contacts lag the bodies by up to the drift, which changes how piles
-  // creep and settle (docs/response.md: reusing a pair's contacts).
-  double reuse_tolerance = 0.0;
+  // In [0, 1]; only with the response enabled. A carried contact is measured
+  // again from anchors fixed in each body at this tick's poses, so its
+  // separation follows the bodies; piles settle as with every contact built
+  // (docs/response.md: reusing a pair's contacts, where 0.05 is measured).
+  double reuse_tolerance = 0.05;
   // With threads > 1: a solver stage (contact_partition.hpp) of fewer
   // manifolds than this runs on the calling thread, a bigger one's blocks on
   // the workers (each hand-off may wake a worker; docs/parallel.md). >= 1.

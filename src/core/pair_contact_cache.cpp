@@ -16,6 +16,13 @@ Vec3 originIn(const Pose& frame, const Pose& other) {
   return frame.orientation.conjugate() * (other.position - frame.position);
 }
 
+// Whether a unit vector (a body frame's) is one of that frame's axes: a
+// face normal of its voxel boxes (ContactBuilder's face_normals).
+bool alongAnAxis(const Vec3& unit) {
+  constexpr double kAxis = 1.0 - 1e-9;
+  return unit.cwiseAbs().maxCoeff() >= kAxis;
+}
+
 }  // namespace
 
 PairContactCache::PairContactCache()
@@ -63,7 +70,7 @@ void PairContactCache::place(std::uint32_t index, const Contact& base, const Pos
     Contact c = base;
     const Vec3 on_a = pose_a.apply(p.on_a);
     const Vec3 on_b = pose_b.apply(p.on_b);
-    c.normal = (pose_a.orientation * p.normal_in_a).normalized();
+    c.normal = ((p.normal_of_b ? pose_b.orientation : pose_a.orientation) * p.normal).normalized();
     c.separation = (on_b - on_a).dot(c.normal);
     c.point = 0.5 * (on_a + on_b);
     c.depth = std::max(p.depth - (c.separation - p.separation), 0.0);
@@ -99,7 +106,10 @@ void PairContactCache::record(const PairTest& test, const ReuseBody& a, const Re
     Point p;
     p.on_a = to_a * (c->point - half - pa.position);
     p.on_b = to_b * (c->point + half - pb.position);
-    p.normal_in_a = to_a * c->normal;
+    const Vec3 normal_in_a = to_a * c->normal;
+    const Vec3 normal_in_b = to_b * c->normal;
+    p.normal_of_b = !alongAnAxis(normal_in_a) && alongAnAxis(normal_in_b);
+    p.normal = p.normal_of_b ? normal_in_b : normal_in_a;
     p.depth = c->depth;
     p.separation = c->separation;
     p.sphere_bound = c->sphere_bound;
@@ -136,6 +146,11 @@ void PairContactCache::commit(const Pending* const* pending, std::size_t count) 
   entries_.swap(next_entries_);
   points_.swap(next_points_);
   index_.swap(next_index_);
+}
+
+void PairContactCache::Pending::reserve(std::size_t entry_count, std::size_t point_count) {
+  growCapacity(entries, entry_count);
+  growCapacity(points, point_count);
 }
 
 void PairContactCache::reserve(std::size_t entries, std::size_t points) {

@@ -269,18 +269,21 @@ void Physics::buildContacts(const StepContext& step) {
   const std::size_t chunks = threads > 1 && count >= kPairsPerTask ? kChunksPerThread * threads : 1;
   if (builders_.size() < chunks) builders_.resize(chunks);
   if (chunk_contacts_.size() < chunks) chunk_contacts_.resize(chunks);
-  // Sized by the pairs: each pair keeps its deepest contacts, so the count
-  // creeps up as the gaze passes over a pile; a tick with more entries or
-  // contacts than any before then allocates nothing.
-  if (step.steady_frontier) {
+  // The caches sized by the pairs: each pair keeps its deepest contacts (or
+  // its carried ones), so the count creeps up as the gaze passes over a pile
+  // (or as a pile's pairs go from built to carried and back); a tick with no
+  // more pairs than any before then allocates nothing, and a forming pile's
+  // buffers grow in the same few ticks.
+  if (step.steady_frontier || step.reused != nullptr) {
     const std::size_t points_per_pair = static_cast<std::size_t>(std::max(1, step.options->max_contacts_per_pair));
     for (std::size_t k = 0; k < chunks; ++k) {
       const auto [first, last] = chunkRange(count, k, chunks);
-      growCapacity(chunk_contacts_[k].frontier.entries, last - first);
-      growCapacity(chunk_contacts_[k].frontier.points, (last - first) * points_per_pair);
+      if (step.steady_frontier) chunk_contacts_[k].frontier.reserve(last - first, (last - first) * points_per_pair);
+      if (step.reused != nullptr) chunk_contacts_[k].reuse.reserve(last - first, (last - first) * points_per_pair);
       if (chunks > 1) growCapacity(chunk_contacts_[k].contacts, (last - first) * points_per_pair);
     }
-    frontier_cache_.reserve(count, count * points_per_pair);
+    if (step.steady_frontier) frontier_cache_.reserve(count, count * points_per_pair);
+    if (step.reused != nullptr) pair_cache_.reserve(count, count * points_per_pair);
     growCapacity(contacts, count * points_per_pair);
   }
   if (chunks == 1) {
