@@ -32,6 +32,7 @@
 //          [--snapshots N] [--repeats R] [--scene packed_box|rockfall]
 //          [--gaze entity|screen] [--queues K] [--ratio R] [--cost-exponent A]
 //          [--smoke]  (--quick with 1 snapshot, 1 repeat and no CSV: that the bench runs, scripts/bench_smoke.sh)
+#include "sphere_tree_collision/gaze_model.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 

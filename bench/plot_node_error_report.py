@@ -35,9 +35,9 @@ def load(path):
     return {
         "t": [float(r["stamp"]) - t0 for r in rows],
         "accepted": [int(r["unresolved_accepted"]) for r in rows],
-        "bound": [float(r["bound_sum_m"]) for r in rows],
-        "nabla": [float(r["nabla_m"]) for r in rows],
-        "p": [float(r["perceived"]) for r in rows],
+        "bound": [float(r["geometric_bound"]) for r in rows],
+        "nabla": [float(r["geometric_inaccuracy"]) for r in rows],
+        "p": [float(r["perceived_inaccuracy"]) for r in rows],
         "narrow_ms": [float(r["narrow_ms"]) for r in rows],
         "label": f"{os.path.basename(path)}: {rows[0]['scheduler']}, "
                  + (f"{float(rows[0]['budget_ms']):g} ms" if float(rows[0]["budget_ms"]) >= 0 else "no ms budget")

@@ -35,6 +35,7 @@
 //
 // Usage: bench_scheduler_order_bound [--scene packed_box|rockfall] [--snapshots N] [--smoke]
 //   --smoke: 1 snapshot, that the bench runs, scripts/bench_smoke.sh
+#include "sphere_tree_collision/gaze_model.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 

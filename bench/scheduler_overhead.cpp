@@ -22,6 +22,7 @@
 // Usage: bench_scheduler_overhead [--scene packed_box|rockfall] [--scheduler NAME|all] [--ticks N]
 //          [--no-retry] [--queues K --ratio R --cost-exponent A] [--smoke]
 //   --smoke: 3 ticks, no retry: that the bench runs, scripts/bench_smoke.sh
+#include "sphere_tree_collision/gaze_model.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 

@@ -37,6 +37,7 @@
 #include "bench_args.hpp"
 #include "plausibility.hpp"
 #include "scene_cases.hpp"
+#include "sphere_tree_collision/gaze_model.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
@@ -87,7 +88,18 @@ struct Run {
   // (level 0). Per tick they swing with what the narrow phase got.
   double contacts = 0.0, unresolved_contacts = 0.0, root_contacts = 0.0;
   double frontier_kept = 0.0;  // pairs a tick (mean) that kept a deeper frontier's contacts
+  // Island levels (TickReport::levels), means a tick: islands stepped fully
+  // and held, of those held the ones a moving body joined to the tick, bodies
+  // held; the longest wait (ticks); summed over the run, the held body-ticks
+  // (each one tick of simulated time a body lags behind) and the held
+  // islands' gaze priority (the perceived cost: ticks held weighted by how
+  // noticeable each island was).
+  double islands_full = 0.0, islands_held = 0.0, islands_joined = 0.0, bodies_held = 0.0;
+  int most_ticks_held = 0;
+  std::vector<double> largest_island;  // bodies, a tick
+  double held_body_ticks = 0.0, held_priority = 0.0;
 };
+
 
 constexpr double kMovedMetres = 0.02;
 
@@ -139,6 +151,14 @@ Run simulate(const Case& c, double seconds, const Budget& budget, bool budgeted,
     run.unresolved_share.push_back(r.broad_pairs ? double(r.unresolved) / double(r.broad_pairs) : 0.0);
     run.interrupted += r.interrupted ? 1 : 0;
     run.frontier_kept += static_cast<double>(r.frontier_kept);
+    run.islands_full += static_cast<double>(r.levels.islands_full);
+    run.islands_held += static_cast<double>(r.levels.islands_held);
+    run.islands_joined += static_cast<double>(r.levels.islands_joined);
+    run.bodies_held += static_cast<double>(r.levels.bodies_held);
+    run.held_body_ticks += static_cast<double>(r.levels.bodies_held);
+    run.held_priority += r.levels.held_priority;
+    run.most_ticks_held = std::max(run.most_ticks_held, r.levels.most_ticks_held);
+    if (r.levels.used) run.largest_island.push_back(static_cast<double>(r.levels.largest_island));
     for (const Contact& contact : world.contacts()) {
       run.contacts += 1.0;
       if (contact.resolved) continue;
@@ -163,6 +183,10 @@ Run simulate(const Case& c, double seconds, const Budget& budget, bool budgeted,
     run.unresolved_contacts /= ticks;
     run.root_contacts /= ticks;
     run.frontier_kept /= ticks;
+    run.islands_full /= ticks;
+    run.islands_held /= ticks;
+    run.islands_joined /= ticks;
+    run.bodies_held /= ticks;
   }
   run.plausibility = check.finish(world);
   // Whether the movers went anywhere in the last second (a NaN pose counts as
@@ -342,6 +366,23 @@ int main(int argc, char** argv) {
       ref = &runs[i + 1];
     }
     md += plausibilityRow(runs[i], ref);
+  }
+  md += "\nIsland levels of the budgeted runs (TickReport::levels, island_levels.hpp): islands a tick stepped "
+        "fully / held still (mean), of the held ones joined to the tick by a moving body, bodies held a tick; "
+        "the longest wait, ticks; the lag: simulated time a mover lost by the end, mean over the movers, s; "
+        "the perceived cost: held island-ticks weighted by their gaze priority (exp(-e / 100)), a tick; "
+        "the largest island's bodies, p50 / max.\n\n"
+        "| scene | bodies | islands full / held | joined | bodies held | longest wait | mean lag | perceived cost "
+        "| largest island |\n"
+        "|---|---|---|---|---|---|---|---|---|\n";
+  for (const Run& r : runs) {
+    if (!r.budgeted) continue;
+    const double ticks = static_cast<double>(std::max<std::size_t>(r.cpu.size(), 1));
+    std::snprintf(buf, sizeof buf, "| %s | %d | %.1f / %.1f | %.1f | %.0f | %d | %.3f | %.3f | %.0f / %.0f |\n",
+                  r.scene.c_str(), r.bodies, r.islands_full, r.islands_held, r.islands_joined, r.bodies_held,
+                  r.most_ticks_held, r.held_body_ticks / std::max(r.bodies, 1) / 60.0, r.held_priority / ticks,
+                  percentile(r.largest_island, 0.5), maxOf(r.largest_island));
+    md += buf;
   }
   std::printf("%s", md.c_str());
   if (!markdown.empty()) std::ofstream(markdown) << md;

@@ -56,6 +56,10 @@ struct StepContext {
   const std::vector<std::uint8_t>* held_asleep = nullptr;
   // Static bodies' covered faces, kept out of contact normals (buildContacts; nullptr: none).
   const StaticCover* static_cover = nullptr;
+  // integrate: only the bodies flagged non-zero, the others left as they are
+  // (held islands joined to the tick after the broad phase, island_levels.hpp;
+  // nullptr: every body).
+  const std::vector<std::uint8_t>* integrate_only = nullptr;
 };
 
 struct PhysicsReport {

@@ -7,6 +7,7 @@
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
 #include "sphere_tree_collision/fracture.hpp"
+#include "sphere_tree_collision/island_levels.hpp"
 #include "sphere_tree_collision/islands.hpp"
 #include "sphere_tree_collision/limits.hpp"
 #include "sphere_tree_collision/narrow_chunks.hpp"
@@ -136,6 +137,10 @@ struct TickReport {
   std::size_t piece_trees = 0;  // new pieces' sphere-trees built this tick
   double piece_tree_s = 0.0;    // of fracture_s: building them
   std::size_t sleeping = 0;  // bodies asleep after the tick (islands.hpp)
+  // Under a limited response (a tick budget or Budget::response_contacts):
+  // which awake islands were stepped fully and which were held still
+  // (island_levels.hpp; World::responseLevel names each body's).
+  IslandLevelReport levels;
 };
 
 // One entity removed at the end of a tick, and why.
@@ -222,6 +227,10 @@ class World {
   // Awake and failing the rest test at the last step (it moved out of its
   // rest balls, rest_test.hpp): what keeps its island awake. False when asleep.
   bool isRestless(EntityId id) const;
+  // The response level the last step gave the entity's island
+  // (island_levels.hpp): Full, Held (still, waiting for its turn), Asleep or
+  // Static. Full for an unknown id.
+  ResponseLevel responseLevel(EntityId id) const;
 
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.
@@ -255,7 +264,7 @@ class World {
  private:
   // Phases, in tick order.
   void integrate(double dt, TickReport& report);
-  void broadPhase(TickReport& report);   // also sets up the pair tests of its pairs
+  void broadPhase(double dt, TickReport& report);   // also sets up the pair tests of its pairs
   void continuousCollision(TickReport& report);
   // Returns the clock when the scheduler stopped (what follows is not interruptible).
   double narrowPhase(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
@@ -288,6 +297,17 @@ class World {
   Aabb boxOf(std::size_t index) const;
   Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
+  // Island levels (world_levels.cpp). Whether the response is limited this
+  // tick; the islands ranked and the ones beyond the allowance held
+  // (before integrate); held islands a moving body reaches joined to the tick
+  // and integrated (after the broad phase's pairs); after the tick, what a
+  // unit of cost took and what the phases that must run took, for the next.
+  static bool responseLimited(const Budget& budget);
+  void chooseLevels(const Budget& budget, TickReport& report);
+  void joinHeldIslands(double dt, TickReport& report);
+  void learnLevelCosts(double must_run_s, double response_mandatory_s, const TickReport& report);
+  // The solver's "held" bodies: asleep or held by their level (for its warm-start store).
+  const std::vector<std::uint8_t>& outOfStep();
   bool setUpPairTests();  // bodies of the broad phase's pairs; true when a sleeping island woke
 
   WorldConfig config_;
@@ -337,6 +357,12 @@ class World {
   std::vector<Contact> contacts_;
   Physics physics_;  // integration and response (response.hpp), warm-start state
   Islands islands_;  // which bodies sleep, indexed like bodies_
+  IslandLevels levels_;  // which awake islands are held this tick, indexed like bodies_
+  // Learnt from timed ticks (world_levels.cpp): seconds of the response's
+  // mandatory part per unit of island cost, and of the phases that must run.
+  double cost_unit_s_ = 0.0;
+  double must_run_s_ = 0.0;
+  std::vector<std::uint8_t> out_of_step_;  // outOfStep (pooled)
   SecondsClock clock_ = steadySeconds;
   std::int64_t clock_check_every_ = BudgetTracker::kDefaultCheckEvery;  // of clock_ (setClock)
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick

@@ -1,5 +1,5 @@
 // GazeModel: where the viewer looks at time t (fixed, saccades, follow).
-#include "sphere_tree_collision/scenes.hpp"
+#include "sphere_tree_collision/gaze_model.hpp"
 
 #include <algorithm>
 #include <array>

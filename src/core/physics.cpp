@@ -49,6 +49,7 @@ void Physics::integrate(const StepContext& step) {
   // gives the same result.
   forEachIndex(step.workers, bodies.size(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
+      if (step.integrate_only != nullptr && (*step.integrate_only)[i] == 0) continue;
       start_[i] = bodies[i].pose;
       integratePosition(bodies[i], integration, step.dt);
       integrateVelocity(bodies[i], integration, step.dt);

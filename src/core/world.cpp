@@ -190,6 +190,7 @@ EntityId World::addEntity(const EntitySpec& spec) {
   if (!spec.name.empty()) id_by_name_.emplace(spec.name, id);
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
   islands_.add(info.bounding_radius);
+  levels_.add();
   ++next_id_;
   if (spec.is_static) physics_.forgetReuse();  // its neighbours' covered faces change
   invalidateLastTick();
@@ -208,6 +209,7 @@ bool World::removeEntity(EntityId id) {
   }
   if (bodies_[index].is_static) physics_.forgetReuse();  // its neighbours' covered faces change
   islands_.remove(index, last);
+  levels_.remove(index, last);
   static_cover_.remove(index, last);
   broad_phase_.remove(id);
   if (!names_[index].empty()) id_by_name_.erase(names_[index]);
@@ -253,6 +255,7 @@ void World::clear() {
   id_by_name_.clear();
   broad_phase_ = SweepAndPrune();
   islands_.clear();
+  levels_.clear();
   static_cover_.clear();
   physics_.forgetReuse();
   invalidateLastTick();
@@ -324,6 +327,7 @@ TickReport World::step(double dt, const Budget& budget) {
   islands_.beginTick(bodies_, sleeping);  // sleepers held as static until endTick
   const double t0 = clock_();
   const bool timed_tick = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
+  const bool levelled = responseLimited(budget);
   const Deadline tick_end = timed_tick ? Deadline(&clock_, t0 + std::max(budget.tick_seconds, 0.0)) : Deadline();
   if (timed_tick) report.tick_budget_s = std::max(budget.tick_seconds, 0.0);
   double t0i = 0.0, t1 = 0.0, t2 = 0.0, t2s = 0.0, t3 = 0.0, t4 = 0.0, t5 = 0.0, scheduled = 0.0;
@@ -332,9 +336,10 @@ TickReport World::step(double dt, const Budget& budget) {
   const LoopTimes loops_before = workers_.loopTimes();
   workers_.withTeam([&](Team&) {
     t0i = breakPending(t0, tick_end, report);  // splits the last tick had no time for
+    if (levelled) chooseLevels(budget, report);  // held islands are static until released
     integrate(dt, report);
     t1 = clock_();
-    broadPhase(report);
+    broadPhase(dt, report);
     t2 = clock_();
     continuousCollision(report);
     t2s = clock_();
@@ -361,7 +366,13 @@ TickReport World::step(double dt, const Budget& budget) {
   // Held through the tick, a sleeper was neither moved nor solved: its state
   // passed the first check unchanged (endTick releases the holds).
   held_through_tick_ = islands_.held();
-  islands_.endTick(bodies_, contacts_, dt, sleeping);
+  islands_.endTick(bodies_, contacts_, dt, sleeping);  // held islands are not movable: no rest, no sleep
+  if (levelled) {
+    levels_.release(bodies_, report.levels);
+    if (timed_tick) learnLevelCosts((t2s - t0) + (t5 - t4), t4 - scheduled - report.response_refinement_s, report);
+  } else {
+    levels_.unused();
+  }
   quarantine(report, &held_through_tick_);
   report.sleeping = islands_.sleepingCount();
   return report;
@@ -436,16 +447,22 @@ Aabb World::sweptBoxOf(std::size_t index) const {
   return box;
 }
 
-void World::broadPhase(TickReport& report) {
-  // The boxes in parallel (each body alone), then handed over in order.
+void World::broadPhase(double dt, TickReport& report) {
+  // The boxes in parallel (each body alone), then handed over in order. A
+  // body held by its island's level gets the box of where it would go.
+  const bool held = levels_.anyHeld();
   boxes_.resize(ids_.size());
   workers_.forEach(ids_.size(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      if (!bodies_[i].is_static) boxes_[i] = physics_.isFast(i) ? sweptBoxOf(i) : boxOf(i);
+      if (!bodies_[i].is_static) {
+        boxes_[i] = physics_.isFast(i) ? sweptBoxOf(i) : boxOf(i);
+      } else if (held && levels_.isHeld(i)) {
+        boxes_[i] = IslandLevels::heldBox(bodies_[i], shapes_[body_shapes_[i]].bounding_radius, dt);
+      }
     }
   });
   for (std::size_t i = 0; i < ids_.size(); ++i) {
-    if (!bodies_[i].is_static) broad_phase_.setBox(ids_[i], boxes_[i]);
+    if (!bodies_[i].is_static || (held && levels_.isHeld(i))) broad_phase_.setBox(ids_[i], boxes_[i]);
   }
   broad_phase_.update();
   report.broad_pairs = broad_phase_.pairs().size();
@@ -459,6 +476,7 @@ void World::broadPhase(TickReport& report) {
   }
   // A moving body reached a sleeping island: it woke, its pairs are tested too.
   if (setUpPairTests()) setUpPairTests();
+  if (held) joinHeldIslands(dt, report);
 }
 
 // The pairs' bodies; the tests themselves are reset by their chunk of the
@@ -600,6 +618,7 @@ void World::response(double dt, const Budget& budget, const Deadline& tick_end, 
   step.budget.max_iterations = budget.solver_iterations;
   step.budget.deadline = tick_end;
   step.steady_frontier = narrowPhaseLimited(budget, tick_end);
+  if (levels_.anyHeld()) step.held_asleep = &outOfStep();  // held pairs keep their warm start as sleepers'
   physics_.buildContacts(step);
   report.contacts_s = clock_() - start;
   report.frontier_kept = physics_.lastReport().frontier_kept;

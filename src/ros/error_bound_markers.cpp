@@ -14,6 +14,7 @@ namespace {
 using visualization_msgs::Marker;
 
 const std::string kBoundsNs = "error_bounds", kTextNs = "error_text";
+constexpr double kTextTowardCamera = 0.6;  // share of the way from the gaze point to the camera
 constexpr float kBoundAlpha = 0.4f;  // see-through: the rocks and the contact dot inside stay visible
 
 // Amber for a bound nobody looks at, red for the one the viewer would notice
@@ -82,9 +83,11 @@ void ErrorBoundMarkers::build(const stc::World& world, const stc::TickReport& re
   text.color = toColorMsg(1.0f, 1.0f, 1.0f, 0.95f);
   const stc::Perception& perception = world.perception();
   const stc::Pose& camera = perception.camera().camera_to_world;
-  // A quarter of the way from the gaze point to the camera: in front of the
-  // surface the gaze rests on, so no wall cuts into the text.
-  const stc::Vec3 at = text_anchor_ + 0.25 * (camera.position - text_anchor_);
+  // Most of the way from the gaze point to the camera (its size on screen does
+  // not depend on it): in front of the rocks around the gaze and above the
+  // walls beside it. A quarter of the way, the demo's ravine walls and the
+  // rocks in front of the gaze cut into the text.
+  const stc::Vec3 at = text_anchor_ + kTextTowardCamera * (camera.position - text_anchor_);
   const double height = std::max(options.text_height_per_metre * (camera.position - at).norm(), 1e-3);
   text.scale.z = height;
   stc::Vec3 local = camera.orientation.conjugate() * (at - camera.position);

@@ -1,40 +1,58 @@
 #include "sphere_tree_collision/ros/error_report.hpp"
 
+#include "sphere_tree_collision/ros/tick_fields.hpp"
 #include "sphere_tree_collision/types.hpp"
 
 #include <cerrno>
-#include <cmath>
 #include <cstring>
-#include <limits>
+#include <type_traits>
 
 namespace stc_ros {
+namespace {
 
-const char* const ErrorReport::kHeader =
-    "stamp,tick,budget_ms,budget_sphere_tests,scheduler,broad_pairs,unresolved,unresolved_accepted,"
-    "nabla_m,bound_sum_m,perceived,narrow_ms,sphere_tests,gaze_x,gaze_y";
+// One cell and its comma. %.17g: every double reads back exactly (a test
+// compares rows with tick_stats); a flag (uint8 in a message) as 0 or 1.
+template <typename T>
+void writeCell(std::FILE* file, const T& value) {
+  if constexpr (std::is_floating_point_v<T>) {
+    std::fprintf(file, "%.17g,", static_cast<double>(value));
+  } else if constexpr (std::is_signed_v<T>) {
+    std::fprintf(file, "%lld,", static_cast<long long>(value));
+  } else {
+    std::fprintf(file, "%llu,", static_cast<unsigned long long>(value));
+  }
+}
+
+}  // namespace
+
+std::string ErrorReport::header() {
+  std::string columns = "stamp,tick,budget_ms,budget_sphere_tests,scheduler,";
+  forEachReportField(sphere_tree_collision::TickStats{}, [&](const char* name, const auto&) {
+    columns += name;
+    columns += ',';
+  });
+  return columns + "gaze_x,gaze_y";
+}
 
 ErrorReport::ErrorReport(const std::string& path) {
   if (path.empty()) throw stc::InputError("error_report", "is empty (leave it unset for no report)");
   file_ = std::fopen(path.c_str(), "w");
   if (!file_) throw stc::InputError("error_report", "cannot write '" + path + "': " + std::strerror(errno));
   std::setvbuf(file_, nullptr, _IOLBF, 0);
-  std::fprintf(file_, "%s\n", kHeader);
+  std::fprintf(file_, "%s\n", header().c_str());
 }
 
 ErrorReport::~ErrorReport() {
   if (file_) std::fclose(file_);
 }
 
-void ErrorReport::write(const ros::Time& stamp, std::uint64_t tick, const stc::TickReport& r, const stc::Budget& budget,
-                        const char* scheduler, const std::optional<stc::Vec2>& gaze) {
-  const double budget_ms = std::isfinite(budget.seconds) ? budget.seconds * 1e3 : -1.0;
-  const long long sphere_tests =
-      budget.sphere_tests == std::numeric_limits<std::int64_t>::max() ? -1 : static_cast<long long>(budget.sphere_tests);
-  // %.17g: every double reads back exactly (a test compares rows with tick_stats).
-  std::fprintf(file_, "%u.%09u,%llu,%.17g,%lld,%s,%zu,%zu,%zu,%.17g,%.17g,%.17g,%.17g,%lld,", stamp.sec, stamp.nsec,
-               static_cast<unsigned long long>(tick), budget_ms, sphere_tests, scheduler, r.broad_pairs, r.unresolved,
-               r.unresolved_accepted, r.geometric_inaccuracy, r.geometric_bound, r.perceived_inaccuracy,
-               r.narrow_s * 1e3, static_cast<long long>(r.sphere_tests));
+void ErrorReport::write(const sphere_tree_collision::TickStats& s, const std::optional<stc::Vec2>& gaze) {
+  std::fprintf(file_, "%u.%09u,", s.header.stamp.sec, s.header.stamp.nsec);
+  writeCell(file_, s.tick);
+  writeCell(file_, s.budget_ms);
+  writeCell(file_, s.budget_sphere_tests);
+  std::fprintf(file_, "%s,", s.scheduler.c_str());
+  forEachReportField(s, [&](const char*, const auto& value) { writeCell(file_, value); });
   if (gaze) {
     std::fprintf(file_, "%.17g,%.17g\n", gaze->x(), gaze->y());
   } else {

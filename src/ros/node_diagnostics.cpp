@@ -1,5 +1,7 @@
 #include "sphere_tree_collision/ros/node_diagnostics.hpp"
 
+#include "sphere_tree_collision/ros/tick_fields.hpp"
+
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
 #include <cmath>
@@ -39,6 +41,7 @@ NodeDiagnostics::NodeDiagnostics(const ros::NodeHandle& nh, const ros::NodeHandl
   updater_.add("rejected inputs", this, &NodeDiagnostics::rejectedInputs);
   updater_.add("entities", this, &NodeDiagnostics::entities);
   updater_.add("quarantined bodies", this, &NodeDiagnostics::quarantined);
+  updater_.add("tick report", this, &NodeDiagnostics::tickReport);
 }
 
 // What "over budget" means for a tick: the budget its step was given, else 1/~rate.
@@ -120,6 +123,12 @@ void NodeDiagnostics::quarantined(Status& status) {
   status.add("last removal", last_.last_quarantine);
   summariseSinceLastReport(status, recent, "bodies quarantined", last_.last_quarantine);
   reported_quarantined_ = last_.quarantined_total;
+}
+
+void NodeDiagnostics::tickReport(Status& status) {
+  // uint8 flags as numbers, not characters.
+  forEachReportField(last_, [&](const char* name, const auto& value) { status.add(name, +value); });
+  status.summaryf(DiagnosticStatus::OK, "tick %llu", static_cast<unsigned long long>(last_.tick));
 }
 
 }  // namespace stc_ros

@@ -2,6 +2,7 @@
 
 #include "sphere_tree_collision/ros/conversions.hpp"
 #include "sphere_tree_collision/ros/scene_file.hpp"
+#include "sphere_tree_collision/ros/tick_fields.hpp"
 #include "sphere_tree_collision/perception_ray.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 
@@ -254,8 +255,7 @@ void WorldNode::runTick() {
   for (const stc::QuarantinedEntity& q : world_.quarantined()) onQuarantined(q, now);
   publishStats(report, now);
   if (error_report_) {
-    error_report_->write(now, tick_, report, budget_, stc::toString(params_.world.scheduler.kind),
-                         world_.perception().fixation());
+    error_report_->write(stats_msg_, world_.perception().fixation());
   }
   publishContacts(now);
   publishTf(now);
@@ -343,40 +343,12 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.header.stamp = stamp;
   s.header.frame_id = params_.world_frame;
   s.tick = tick_;
-  s.integrate_ms = (r.integrate_s + r.sweep_s) * 1e3;  // includes the swept test (run after the broad phase)
-  s.sweep_ms = r.sweep_s * 1e3;
-  s.broad_ms = r.broad_s * 1e3;
-  s.narrow_ms = r.narrow_s * 1e3;
-  s.response_ms = r.response_s * 1e3;
-  s.contacts_ms = r.contacts_s * 1e3;
-  s.total_ms = r.total_s * 1e3;
-  s.scheduling_overhead_ms = r.scheduling_overhead_s * 1e3;
+  fillFromReport(r, s);
   s.budget_ms = std::isfinite(budget_.seconds) ? budget_.seconds * 1e3 : -1.0;  // nothing non-finite is published
   s.budget_sphere_tests = params_.sphere_test_budget;
   s.scheduler = stc::toString(params_.world.scheduler.kind);
-  s.perception_used = r.perception_used;
-  s.entities = static_cast<std::uint32_t>(r.entities);
-  s.broad_pairs = static_cast<std::uint32_t>(r.broad_pairs);
-  s.colliding = static_cast<std::uint32_t>(r.colliding);
-  s.reused = static_cast<std::uint32_t>(r.reused);
-  s.separate = static_cast<std::uint32_t>(r.separate);
-  s.unresolved = static_cast<std::uint32_t>(r.unresolved);
-  s.unresolved_accepted = static_cast<std::uint32_t>(r.unresolved_accepted);
-  s.frontier_kept = static_cast<std::uint32_t>(r.frontier_kept);
-  s.sphere_tests = r.sphere_tests;
-  s.interrupted = r.interrupted;
-  s.geometric_inaccuracy = r.geometric_inaccuracy;
-  s.geometric_bound = r.geometric_bound;
-  s.perceived_inaccuracy = r.perceived_inaccuracy;
-  s.contacts = static_cast<std::uint32_t>(r.contacts);
-  s.tick_budget_ms = r.tick_budget_s * 1e3;
   s.period_ms = dt_ * 1e3;
   s.publish_ms = publish_cost_.seconds() * 1e3;  // not yet this tick's: the figure its budget came from
-  s.narrow_budget_ms = r.narrow_budget_s * 1e3;
-  s.response_budget_ms = r.response_budget_s * 1e3;
-  s.reserve_ms = r.reserve_s * 1e3;
-  s.velocity_passes = static_cast<std::uint32_t>(r.velocity_passes);
-  s.position_passes = static_cast<std::uint32_t>(r.position_passes);
   s.rejected_spawn = rejected_[0];
   s.rejected_despawn = rejected_[1];
   s.rejected_gaze = rejected_[2];
@@ -384,8 +356,6 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.rejected_inputs = rejected_[0] + rejected_[1] + rejected_[2] + rejected_[3];
   s.last_rejection = last_rejection_;
   s.gaze_active = world_.perception().hasFixation();
-  s.quarantined = static_cast<std::uint32_t>(r.quarantined);
-  s.left_world = static_cast<std::uint32_t>(r.left_world);
   s.quarantined_total = quarantined_total_;
   s.left_world_total = left_world_total_;
   s.last_quarantine = last_quarantine_;
@@ -393,11 +363,6 @@ void WorldNode::publishStats(const stc::TickReport& r, const ros::Time& stamp) {
   s.physics_time = clock_.physicsSeconds();
   s.real_time_factor = clock_.realTimeFactor();
   s.paused = paused_;
-  s.sleeping = static_cast<std::uint32_t>(r.sleeping);
-  s.fractures = static_cast<std::uint32_t>(r.fractures);
-  s.fractures_waiting = static_cast<std::uint32_t>(r.fractures_deferred);
-  s.piece_trees = static_cast<std::uint32_t>(r.piece_trees);
-  s.fracture_ms = r.fracture_s * 1e3;
   diagnostics_->onTick(s);
   if (stats_pub_.getNumSubscribers() > 0) stats_pub_.publish(s);
 }

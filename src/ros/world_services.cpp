@@ -1,7 +1,7 @@
 #include "sphere_tree_collision/ros/world_services.hpp"
 
 #include "sphere_tree_collision/ros/conversions.hpp"
-#include "sphere_tree_collision/ros/world_node.hpp"
+#include "sphere_tree_collision/ros/tick_clock.hpp"
 
 #include <boost/make_shared.hpp>
 
@@ -59,7 +59,7 @@ class TickThreadCall final : public ros::CallbackInterface {
 
 }  // namespace
 
-WorldServices::WorldServices(ros::NodeHandle& pnh, WorldNode& node)
+WorldServices::WorldServices(ros::NodeHandle& pnh, WorldControl& node)
     : node_(node), world_frame_(node.worldFrame()), spawn_spinner_(1, &spawn_queue_) {
   ros::AdvertiseServiceOptions spawn_options;
   spawn_options.init<sphere_tree_collision::Spawn::Request, sphere_tree_collision::Spawn::Response>(

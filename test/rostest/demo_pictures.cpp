@@ -92,7 +92,9 @@ TEST(DemoPictures, MovingEntitiesInViewAt10sAnd60sAndThePileAtRest) {
   // --fullscreen cannot resize the window, and demo.rviz's 1920x1080 fills it.
   const std::string display = stc_rviz::startXvfb(xvfb, *xvfb_exe, dir + "/xvfb.log");
   ASSERT_FALSE(display.empty()) << "Xvfb did not start (log: " << dir << "/xvfb.log)";
-  ASSERT_TRUE(rviz.start({*rviz_exe, "-d", rviz_config, "--fullscreen"}, display, dir + "/rviz.log"));
+  // The flags of demo.launch's rviz.
+  ASSERT_TRUE(rviz.start({*rviz_exe, "-d", rviz_config, "--fullscreen", "--disable-anti-aliasing"}, display,
+                         dir + "/rviz.log"));
 
   for (const Picture& picture : kPictures) {
     const double seconds = picture.seconds;

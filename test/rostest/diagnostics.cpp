@@ -3,6 +3,8 @@
 // topic and turns the next "rejected inputs" report into a warning.
 #include "rostest_util.hpp"
 
+#include <sphere_tree_collision/ros/tick_fields.hpp>
+
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <sphere_tree_collision/GazePoint.h>
@@ -55,6 +57,17 @@ TEST(Diagnostics, EveryConcernReportedWithItsKeysAndRejectionsCounted) {
     const auto values = valuesOf(*status);
     for (const std::string& key : names) EXPECT_EQ(values.count(key), 1u) << concern << ": no key '" << key << "'";
   }
+  // The tick report: every field of the one list tick_stats is filled from,
+  // by its tick_stats name; flags as numbers.
+  const auto report = valuesOf(*statusOf(diagnostics.last, "tick report"));
+  std::size_t fields = 0;
+  stc_ros::forEachReportField(sphere_tree_collision::TickStats{}, [&](const char* name, const auto&) {
+    ++fields;
+    EXPECT_EQ(report.count(name), 1u) << "tick report: no key '" << name << "'";
+  });
+  EXPECT_EQ(report.size(), fields);
+  EXPECT_EQ(report.at("entities"), "6");
+  EXPECT_TRUE(report.at("interrupted") == "0" || report.at("interrupted") == "1") << report.at("interrupted");
   const auto entities = valuesOf(*statusOf(diagnostics.last, "entities"));
   EXPECT_EQ(entities.at("entities"), "6");  // the default scene
   EXPECT_EQ(entities.at("~max_entities"), "50");

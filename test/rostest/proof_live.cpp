@@ -191,8 +191,21 @@ TEST_F(ProofLive, ErrorReportHasARowPerTickWithTheTicksFigures) {
   ASSERT_TRUE(in) << "no report at " << path;
   std::string line;
   ASSERT_TRUE(std::getline(in, line));
-  EXPECT_EQ(line, stc_ros::ErrorReport::kHeader);
-  const std::size_t columns = split(line).size();
+  EXPECT_EQ(line, stc_ros::ErrorReport::header());
+  const std::vector<std::string> names = split(line);
+  const std::size_t columns = names.size();
+  const auto column = [&](const char* name) {
+    const auto at = std::find(names.begin(), names.end(), name);
+    EXPECT_NE(at, names.end()) << "no column " << name;
+    return static_cast<std::size_t>(at - names.begin());
+  };
+  const std::size_t budget_ms = column("budget_ms"), budget_tests = column("budget_sphere_tests"),
+                    scheduler = column("scheduler"), broad_pairs = column("broad_pairs"),
+                    unresolved = column("unresolved"), accepted = column("unresolved_accepted"),
+                    nabla = column("geometric_inaccuracy"), bound = column("geometric_bound"),
+                    perceived = column("perceived_inaccuracy"), narrow_ms = column("narrow_ms"),
+                    sphere_tests = column("sphere_tests"), gaze_x = column("gaze_x"), gaze_y = column("gaze_y");
+  ASSERT_EQ(gaze_y, columns - 1);
   std::size_t rows = 0, matched = 0, with_gaze = 0;
   unsigned long long previous_tick = 0;
   while (std::getline(in, line)) {
@@ -212,22 +225,22 @@ TEST_F(ProofLive, ErrorReportHasARowPerTickWithTheTicksFigures) {
     ++matched;
     SCOPED_TRACE(line);
     EXPECT_EQ(tick, s->tick);
-    EXPECT_EQ(std::stod(c[2]), s->budget_ms);
-    EXPECT_EQ(std::stoll(c[3]), s->budget_sphere_tests);
-    EXPECT_EQ(c[4], s->scheduler);
-    EXPECT_EQ(std::stoul(c[5]), s->broad_pairs);
-    EXPECT_EQ(std::stoul(c[6]), s->unresolved);
-    EXPECT_EQ(std::stoul(c[7]), s->unresolved_accepted);
-    EXPECT_EQ(std::stod(c[8]), s->geometric_inaccuracy);  // %.17g reads back exactly
-    EXPECT_EQ(std::stod(c[9]), s->geometric_bound);
-    EXPECT_EQ(std::stod(c[10]), s->perceived_inaccuracy);
-    EXPECT_EQ(std::stod(c[11]), s->narrow_ms);
-    EXPECT_EQ(std::stoll(c[12]), s->sphere_tests);
-    EXPECT_EQ(c[13].empty(), !s->gaze_active) << "gaze x, y empty exactly when no gaze is set";
+    EXPECT_EQ(std::stod(c[budget_ms]), s->budget_ms);
+    EXPECT_EQ(std::stoll(c[budget_tests]), s->budget_sphere_tests);
+    EXPECT_EQ(c[scheduler], s->scheduler);
+    EXPECT_EQ(std::stoul(c[broad_pairs]), s->broad_pairs);
+    EXPECT_EQ(std::stoul(c[unresolved]), s->unresolved);
+    EXPECT_EQ(std::stoul(c[accepted]), s->unresolved_accepted);
+    EXPECT_EQ(std::stod(c[nabla]), s->geometric_inaccuracy);  // %.17g reads back exactly
+    EXPECT_EQ(std::stod(c[bound]), s->geometric_bound);
+    EXPECT_EQ(std::stod(c[perceived]), s->perceived_inaccuracy);
+    EXPECT_EQ(std::stod(c[narrow_ms]), s->narrow_ms);
+    EXPECT_EQ(std::stoll(c[sphere_tests]), s->sphere_tests);
+    EXPECT_EQ(c[gaze_x].empty(), !s->gaze_active) << "gaze x, y empty exactly when no gaze is set";
     if (s->gaze_active) {
       ++with_gaze;
-      EXPECT_EQ(std::stod(c[13]), 640.0);
-      EXPECT_EQ(std::stod(c[14]), 360.0);
+      EXPECT_EQ(std::stod(c[gaze_x]), 640.0);
+      EXPECT_EQ(std::stod(c[gaze_y]), 360.0);
     }
   }
   std::printf("[proof_live] %zu report rows, %zu matched with tick_stats (%zu with gaze)\n", rows, matched, with_gaze);

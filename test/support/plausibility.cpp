@@ -61,27 +61,32 @@ PlausibilityCheck::PlausibilityCheck(const World& world, const SceneSpec& spec)
 }
 
 void PlausibilityCheck::tick(const World& world, double dt) {
-  ++ticks_;
-  const bool window_ends = ticks_ % kPlausibilityWindow == 0;
   for (EntityId id : movers_) {
     const auto index = world.indexOf(id);
     if (!index) continue;  // removed: counted outside at the end
     const BodyState& b = world.bodies()[*index];
     Track& k = track_[id];
-    k.stored += k.velocity.norm();  // the velocity this tick moved it with
-    k.real += (b.pose.position - k.position).norm() / dt;
+    // Held still by its island's level (island_levels.hpp), its time did not
+    // pass this tick: its windows are of the ticks it was stepped (of every
+    // tick, for a mover never held).
+    if (world.responseLevel(id) != ResponseLevel::Held) {
+      k.stored += k.velocity.norm();  // the velocity this tick moved it with
+      k.real += (b.pose.position - k.position).norm() / dt;
+      ++k.ticks;
+    }
     k.position = b.pose.position;
     k.velocity = b.linear_velocity;
     const double speed = b.linear_velocity.norm();
     f_.max_speed = std::max(f_.max_speed, speed);
     k.too_fast = k.too_fast || !(speed <= f_.fall_speed);
-    if (!window_ends) continue;
+    if (k.ticks < kPlausibilityWindow) continue;
     const double stored = k.stored / kPlausibilityWindow, real = k.real / kPlausibilityWindow;
     const double excess = std::abs(stored - real) - (0.1 * real + 0.05);
     f_.worst_window_excess = std::max(f_.worst_window_excess, excess);
     ++f_.windows;
     if (!(excess <= 0.0)) ++f_.bad_windows;
     k.stored = k.real = 0.0;
+    k.ticks = 0;
   }
 }
 

@@ -24,7 +24,9 @@ struct Plausibility {
   // to its first contact moves part of one tick, and a pile's position
   // correction moves a resting body a little; neither is a stored speed
   // without motion). A window's excess is |stored - real| - (10 % real +
-  // 0.05 m/s); it is off when that is > 0.
+  // 0.05 m/s); it is off when that is > 0. Ticks a mover was held still by
+  // its island's level (World::responseLevel) are left out: its time stood,
+  // and its windows are of kPlausibilityWindow ticks it was stepped.
   double worst_window_excess = -1.0;
   std::size_t windows = 0, bad_windows = 0;
   double max_speed = 0.0;   // m/s, the fastest mover at any tick
@@ -59,14 +61,14 @@ class PlausibilityCheck {
  private:
   struct Track {
     Vec3 position, velocity;
-    double stored = 0.0, real = 0.0;  // sums over the window
+    double stored = 0.0, real = 0.0;  // sums over the window's ticks it was stepped (not held)
+    int ticks = 0;                    // those ticks
     bool too_fast = false;
   };
   Aabb bounds_;
   std::vector<EntityId> movers_;
   std::unordered_map<EntityId, Track> track_;
   Plausibility f_;
-  int ticks_ = 0;
 };
 
 // One line: "NaN 0, outside 0, fastest 3.10 m/s (a fall allows 17.50), 0 too fast, ..."

@@ -2,6 +2,7 @@
 // checks, determinism, and where the gaze lands over time.
 #include "thrown_field.hpp"
 
+#include "sphere_tree_collision/gaze_model.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 
 #include <gtest/gtest.h>

@@ -3,6 +3,7 @@
 // a change of gravity, an edit and World::wake wake it; with sleeping off
 // nothing changes; bad thresholds are rejected naming the field.
 #include "sphere_tree_collision/dynamics.hpp"
+#include "sphere_tree_collision/gaze_model.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 

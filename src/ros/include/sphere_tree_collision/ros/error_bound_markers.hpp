@@ -30,7 +30,7 @@ class ErrorBoundMarkers {
  public:
   // One array for one tick: a sphere per accepted unresolved pair in
   // world.contacts(), DELETEs for the spheres of the previous array beyond
-  // them, and the text above `gaze_point`, a quarter of the way to the
+  // them, and the text above `gaze_point`, most of the way to the
   // camera (without a gaze: the bounds' centroid, else where it was).
   void build(const stc::World& world, const stc::TickReport& report, const std::optional<stc::Vec3>& gaze_point,
              const ros::Time& stamp, const ErrorBoundOptions& options, visualization_msgs::MarkerArray& out);

@@ -17,7 +17,7 @@
 #pragma once
 
 #include "sphere_tree_collision/perception.hpp"
-#include "sphere_tree_collision/scenes.hpp"
+#include "sphere_tree_collision/gaze_model.hpp"
 
 #include <image_geometry/pinhole_camera_model.h>
 #include <ros/ros.h>

@@ -36,6 +36,8 @@ class NodeDiagnostics {
   void rejectedInputs(diagnostic_updater::DiagnosticStatusWrapper& status);
   void entities(diagnostic_updater::DiagnosticStatusWrapper& status);
   void quarantined(diagnostic_updater::DiagnosticStatusWrapper& status);
+  // Every figure of the latest tick's report, by its tick_stats name (tick_fields.hpp).
+  void tickReport(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   double rate_hz_;
   double tick_budget_param_ms_;  // ~tick_budget: > 0, 0 (1/~rate less publishing) or -1 (none)

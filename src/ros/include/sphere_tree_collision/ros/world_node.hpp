@@ -16,6 +16,7 @@
 #include "sphere_tree_collision/ros/perception_camera_info.hpp"
 #include "sphere_tree_collision/ros/tick_budget_rule.hpp"
 #include "sphere_tree_collision/ros/tick_clock.hpp"
+#include "sphere_tree_collision/ros/world_control.hpp"
 #include "sphere_tree_collision/ros/world_services.hpp"
 #include "sphere_tree_collision/world.hpp"
 
@@ -40,7 +41,7 @@
 
 namespace stc_ros {
 
-class WorldNode {
+class WorldNode final : public WorldControl {
  public:
   // Throws stc::InputError naming the parameter or scene field: the caller
   // reports it and exits non-zero rather than run on a guess.
@@ -51,21 +52,21 @@ class WorldNode {
   void tick();
 
   const stc::World& world() const { return world_; }
-  std::uint64_t tickCount() const { return tick_; }
+  std::uint64_t tickCount() const override { return tick_; }
 
-  // What the services (world_services.hpp) and the input topics do. The throwing
+  // What the services (WorldControl) and the input topics do. The throwing
   // ones throw stc::InputError naming the message field and change nothing.
-  stc::EntityId spawnEntity(const sphere_tree_collision::SpawnEntity& msg);  // pose in ~world_frame
-  void despawnEntity(stc::EntityId id, const std::string& name);              // by name unless empty
-  void clearWorld();
-  void resetWorld();  // the start scene again (~scene); ticks and physics time go on
-  void setPaused(bool paused);
-  bool paused() const { return paused_; }
+  stc::EntityId spawnEntity(const sphere_tree_collision::SpawnEntity& msg) override;  // pose in ~world_frame
+  void despawnEntity(stc::EntityId id, const std::string& name) override;              // by name unless empty
+  void clearWorld() override;
+  void resetWorld() override;  // the start scene again (~scene); ticks and physics time go on
+  void setPaused(bool paused) override;
+  bool paused() const override { return paused_; }
   // Paused: n more ticks; returns the tick number reached after them.
-  std::uint64_t queueSteps(std::uint32_t n);
-  const std::string& frameOf(stc::EntityId id) const { return frames_.at(id); }
-  const std::string& worldFrame() const { return params_.world_frame; }
-  void publishEntityList() { entity_states_.publishListIfChanged(world_, frames_, clock_.now(), beats_); }
+  std::uint64_t queueSteps(std::uint32_t n) override;
+  const std::string& frameOf(stc::EntityId id) const override { return frames_.at(id); }
+  const std::string& worldFrame() const override { return params_.world_frame; }
+  void publishEntityList() override { entity_states_.publishListIfChanged(world_, frames_, clock_.now(), beats_); }
 
  private:
   enum class Input { Spawn, Despawn, Gaze, ClickedPoint };

@@ -10,6 +10,8 @@
 //     number tick_stats reaches when they are done.
 #pragma once
 
+#include "sphere_tree_collision/ros/world_control.hpp"
+
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <ros/spinner.h>
@@ -28,13 +30,12 @@
 
 namespace stc_ros {
 
-class WorldNode;
 
 class WorldServices {
  public:
   // Advertises the services; ~spawn's thread is started by start(), once the
   // node is whole (a call must not wait on a node that never spins).
-  WorldServices(ros::NodeHandle& private_nh, WorldNode& node);
+  WorldServices(ros::NodeHandle& private_nh, WorldControl& node);
   ~WorldServices();
   void start() { spawn_spinner_.start(); }
 
@@ -53,7 +54,7 @@ class WorldServices {
   // on their own thread.
   void onTickThread(std::function<void()> work) const;
 
-  WorldNode& node_;
+  WorldControl& node_;
   const std::string world_frame_;  // the node's, copied: read on ~spawn's thread
   std::atomic<bool> stopping_{false};
   // Created at the first spawn in another frame: the node's own /tf is not read otherwise.
