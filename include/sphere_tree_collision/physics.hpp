@@ -145,9 +145,10 @@ class Physics {
   void holdOnStatic(const StepContext& step, std::uint32_t ia, std::uint32_t ib, std::size_t before,
                     std::vector<Contact>& out) const;
   // The sweep's hit of pair i (tests[i] of bodies ia, ib) appended to `out`
-  // when the sweep held a body back there, beside the pair's own contacts.
+  // when the sweep held a body back there and none of the pair's contacts
+  // out[before..] was proven at the leaves.
   void appendSweepHit(const PairTest& test, std::uint32_t ia, std::uint32_t ib, std::size_t i, double priority,
-                      std::vector<Contact>& out) const;
+                      std::size_t before, std::vector<Contact>& out) const;
 
   std::vector<ChunkContacts> chunk_contacts_;
   std::size_t builder_turn_ = 0;

@@ -260,7 +260,6 @@ struct SweepInput {
   double threshold;
   bool prune_by_boxes;
   const std::uint8_t* moved = nullptr;  // after the first round: only pairs with a body put back in the last
-  const SweepHit* held = nullptr;       // after the first round: per body, the instant it stopped (1: not put back)
 };
 
 // A hit of pair k at fraction t of `body`'s path holds it back, when it is
@@ -345,16 +344,7 @@ void sweepAgainstHeld(const SweepInput& in, std::size_t k, std::uint32_t mover, 
 
 // Sweeps pairs [begin, end) in order into the lane's hits: in the first
 // round every pair with a fast body, later only the pairs of a body put back
-// in the last round, the other body against it when that one is fast and
-// stopped later than it (a body never put back stopped at the tick's end).
-// A body put back stands where it stopped from that instant on: one that
-// stopped earlier never meets it there. Swept against bodies that stopped
-// after it, touching cubes landing together held each other back in turns,
-// round after round, each time further (the fractions multiply), until a
-// whole cluster of a landing pile stood near its start with its velocities
-// untouched; no contact of the tick turned them, so the next tick held them
-// back again while gravity's gain piled up (cube_box 10,000: 43 m/s stored
-// on cubes moving mm/s).
+// in the last round, the other body (when fast) against it.
 void sweepPairs(const SweepInput& in, std::size_t begin, std::size_t end, SweepLane& lane) {
   const std::vector<std::uint8_t>& fast = in.fast;
   for (std::size_t k = begin; k < end; ++k) {
@@ -364,8 +354,8 @@ void sweepPairs(const SweepInput& in, std::size_t begin, std::size_t end, SweepL
       if (fast[a] || fast[b]) sweepBoth(in, k, lane);
       continue;
     }
-    if (in.moved[b] != 0 && fast[a] != 0 && in.held[b].t < in.held[a].t) sweepAgainstHeld(in, k, a, b, lane);
-    if (in.moved[a] != 0 && fast[b] != 0 && in.held[a].t < in.held[b].t) sweepAgainstHeld(in, k, b, a, lane);
+    if (in.moved[b] != 0 && fast[a] != 0) sweepAgainstHeld(in, k, a, b, lane);
+    if (in.moved[a] != 0 && fast[b] != 0) sweepAgainstHeld(in, k, b, a, lane);
   }
 }
 
@@ -455,7 +445,6 @@ SweepStats sweepFastBodies(std::vector<BodyState>& bodies, const std::vector<Pos
     }
     if (!held) break;
     in.moved = scratch.moved.data();
-    in.held = scratch.hits.data();
   }
   return stats;
 }

@@ -132,7 +132,7 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
         frontier_cache_.carry(kept, frontier);
         ++chunk.frontier_kept;
         holdOnStatic(step, ia, ib, before, out);
-        appendSweepHit(tests[i], ia, ib, i, priorities[i], out);
+        appendSweepHit(tests[i], ia, ib, i, priorities[i], before, out);
         continue;
       }
     }
@@ -152,7 +152,7 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
                                out.data() + before, out.data() + out.size(), frontier);
     }
     holdOnStatic(step, ia, ib, before, out);
-    appendSweepHit(tests[i], ia, ib, i, priorities[i], out);
+    appendSweepHit(tests[i], ia, ib, i, priorities[i], before, out);
   }
 }
 
@@ -220,19 +220,19 @@ void Physics::holdOnStatic(const StepContext& step, std::uint32_t ia, std::uint3
   }
 }
 
-// The sweep held a body back at pair i's first touch: the hit is a contact
-// too, so the response turns the approach the sweep stopped, beside the
-// pair's own contacts. Without it the body was held back tick after tick
-// while its velocity kept gravity's gain (stored m/s, real mm/s): under a
-// budget when the test gave no contact proven at the leaves (interrupted:
-// none, or its frontier's, whose separations are at least 0 and whose
-// normals run along the line of centres of spheres that may be the roots);
-// and unbudgeted when the leaves' contacts lay elsewhere, where the bodies
-// already touched and separate (a spinning cube on its neighbour, whose far
-// corner the sweep saw coming down on it).
+// The sweep held a body back at pair i's first touch, but the test gave no
+// contact proven at the leaves (interrupted: none, or its frontier's, whose
+// separations are at least 0 and whose normals run along the line of centres
+// of spheres that may be the roots): the hit is a contact too, so the
+// response turns the approach the sweep stopped. Without it a budgeted tick
+// held the body back tick after tick while its velocity kept gravity's gain
+// (stored m/s, real mm/s), until the pair resolved and released it.
 void Physics::appendSweepHit(const PairTest& test, std::uint32_t ia, std::uint32_t ib, std::size_t i,
-                             double priority, std::vector<Contact>& out) const {
+                             double priority, std::size_t before, std::vector<Contact>& out) const {
   if (sweep_hit_of_pair_[i] < 0) return;
+  for (std::size_t k = before; k < out.size(); ++k) {
+    if (out[k].resolved) return;  // the leaves' contacts turn it
+  }
   const SweepHit& hit = sweep_scratch_.hits[static_cast<std::size_t>(sweep_hit_of_pair_[i])];
   Contact c;
   c.a = test.bodyA().id;
