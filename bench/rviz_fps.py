@@ -13,7 +13,7 @@ round, and the table gives each one's median and range. A screenshot of each
 variant's first trial (rviz_fps_<variant>.png in --shots) shows what it draws.
 
 Usage (after `source <build>/devel/setup.bash`):
-  bench/rviz_fps.py [--rounds 4] [--variants demo,aa,...] [--markdown FILE] [--shots DIR] [--smoke]
+  python3 bench/rviz_fps.py [--rounds 4] [--variants demo,aa,...] [--markdown FILE] [--shots DIR] [--smoke]
 """
 import argparse
 import os

@@ -213,9 +213,10 @@ TEST(WorldAllocations, AFormingPileAllocatesInFewTicks) {
   EXPECT_LE(allocating, new_highs / 2);
 }
 
-// Contacts carried over (ResponseOptions::reuse_tolerance): a settling pile
-// (sleeping off, so its pairs stay in the tick) whose pairs go from built to
-// reused and back; the cache's entries, points and index keep their capacity.
+// Contacts carried over (ResponseOptions::reuse_tolerance): a pile at rest
+// (sleeping off, so its pairs stay in the tick) whose top cube is set
+// spinning now and then, so its pairs go from reused to built and back; the
+// cache's entries, points and index keep their capacity.
 TEST(WorldAllocations, ReusedContactsDoNotAllocate) {
   for (const int threads : {1, 2}) {
     SceneParams params;
@@ -226,10 +227,17 @@ TEST(WorldAllocations, ReusedContactsDoNotAllocate) {
     config.response.reuse_tolerance = 0.05;
     SceneWorld scene = makeSceneWorld(SceneKind::CubeBox, params, config);
     for (int t = 0; t < 300; ++t) scene.world.step(scene.spec.dt, Budget::unlimited());
+    // The pile is at rest by now, every pair carried over: the topmost cube
+    // is set spinning now and then, so its pairs are built again.
+    std::size_t top = 0;
+    for (std::size_t i = 0; i < scene.world.bodies().size(); ++i) {
+      if (scene.world.bodies()[i].pose.position.z() > scene.world.bodies()[top].pose.position.z()) top = i;
+    }
     std::size_t reused = 0, colliding = 0;
     g_allocations = 0;
     g_counting = true;
     for (int t = 0; t < 60; ++t) {
+      if (t % 10 == 0) scene.world.bodies()[top].angular_velocity = Vec3(0.0, 0.0, 2.0);
       const TickReport r = scene.world.step(scene.spec.dt, Budget::unlimited());
       reused += r.reused;
       colliding += r.colliding;
