@@ -2,6 +2,8 @@
 // priority and their wait, the ones beyond the allowance held still.
 #include "sphere_tree_collision/island_levels.hpp"
 
+#include "union_find.hpp"
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -36,18 +38,9 @@ void IslandLevels::clear() {
   held_count_ = 0;
 }
 
-std::uint32_t IslandLevels::find(std::uint32_t i) {
-  while (parent_[i] != i) {
-    parent_[i] = parent_[parent_[i]];  // path halving
-    i = parent_[i];
-  }
-  return i;
-}
+std::uint32_t IslandLevels::find(std::uint32_t i) { return findRoot(parent_, i); }
 
-void IslandLevels::unite(std::uint32_t a, std::uint32_t b) {
-  const std::uint32_t ra = find(a), rb = find(b);
-  if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
-}
+void IslandLevels::unite(std::uint32_t a, std::uint32_t b) { uniteRoots(parent_, a, b); }
 
 Aabb IslandLevels::heldBox(const BodyState& body, double reach, double dt) {
   const Vec3 start = body.pose.position;

@@ -2,6 +2,8 @@
 // timers per body, whole islands put to sleep and woken.
 #include "sphere_tree_collision/islands.hpp"
 
+#include "union_find.hpp"
+
 #include "sphere_tree_collision/types.hpp"
 
 #include <algorithm>
@@ -148,13 +150,7 @@ void Islands::beginTick(std::vector<BodyState>& bodies, const SleepOptions& opti
 
 void Islands::releaseWoken(std::vector<BodyState>& bodies) { applyWakes(&bodies); }
 
-std::uint32_t Islands::find(std::uint32_t i) {
-  while (parent_[i] != i) {
-    parent_[i] = parent_[parent_[i]];  // path halving
-    i = parent_[i];
-  }
-  return i;
-}
+std::uint32_t Islands::find(std::uint32_t i) { return findRoot(parent_, i); }
 
 void Islands::endTick(std::vector<BodyState>& bodies, const std::vector<Contact>& contacts, double dt,
                       const SleepOptions& options) {
@@ -185,8 +181,7 @@ void Islands::endTick(std::vector<BodyState>& bodies, const std::vector<Contact>
   std::iota(parent_.begin(), parent_.end(), 0u);
   for (const Contact& c : contacts) {
     if (!movable(c.index_a) || !movable(c.index_b)) continue;
-    const std::uint32_t ra = find(c.index_a), rb = find(c.index_b);
-    if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
+    uniteRoots(parent_, c.index_a, c.index_b);
   }
   island_rest_.assign(n, std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < n; ++i) {
