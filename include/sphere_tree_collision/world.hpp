@@ -192,6 +192,9 @@ class World {
   // "material.restitution", "material.friction", "name", "max_entities") and,
   // for a value beyond config().limits, the limit; on throw nothing changes.
   EntityId addEntity(const EntitySpec& spec);
+  // What addEntity checks but the shape id, for a request whose shape is not
+  // built yet: the same errors, in the same order.
+  void validateEntity(const EntitySpec& spec) const;
   bool removeEntity(EntityId id);
   std::optional<EntityId> findByName(const std::string& name) const;
   void clear();  // removes every entity, keeps shapes
