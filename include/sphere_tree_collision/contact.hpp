@@ -7,6 +7,11 @@
 
 namespace stc {
 
+// Contact::node_a/node_b of the swept test's hit (Physics::appendSweepHit):
+// an impact at one instant, not a load the pair carries, so the solver's warm
+// start neither gives it an impulse nor takes one from it.
+constexpr std::int32_t kSweepHitNode = -1;
+
 struct Contact {
   EntityId a = kInvalidEntity;
   EntityId b = kInvalidEntity;
@@ -29,8 +34,8 @@ struct Contact {
   // (ShapeBounds::support in response.hpp): what the solver acts on. At
   // least 0 for an accepted unresolved pair, whose overlap is not proven.
   double separation = 0.0;
-  std::int32_t node_a = 0;      // sphere pair the contact was built from (tree node indices)
-  std::int32_t node_b = 0;
+  std::int32_t node_a = 0;      // sphere pair the contact was built from (tree node indices;
+  std::int32_t node_b = 0;      // kSweepHitNode: the swept test's hit, of no sphere pair)
   // Filled in by the solver: impulses applied at the point this tick (N s, world).
   double normal_impulse = 0.0;
   Vec3 friction_impulse = Vec3::Zero();

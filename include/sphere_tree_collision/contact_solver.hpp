@@ -70,7 +70,8 @@ struct SolveBudget {
 // keeps each pair's manifold from tick to tick: a point takes the impulse of
 // last tick's point with the same feature id (Contact::node_a/node_b, the
 // leaf sphere pair it was built from), else of the nearest one in body A's
-// frame within half the gap bound; each old point is used once. Stopped early by the
+// frame within half the gap bound; each old point is used once (the swept
+// test's hit, kSweepHitNode, neither takes nor lends one). Stopped early by the
 // budget, the state is as consistent as after a full solve: normal impulses
 // >= 0, friction clamped to the cone as each pass goes, and velocities what
 // the impulses sum to (shock propagation aside: it holds supports still).

@@ -32,6 +32,7 @@ struct SweepHit {
   std::uint32_t pair = 0;      // index into the candidate pairs
   Vec3 point = Vec3::Zero();   // halfway between the two leaf boxes' faces, below the held body's box centre
   Vec3 normal = Vec3::UnitZ(); // face axis the boxes met on, from pairs[pair][0] towards [1]
+  double separation = 0.0;     // the two boxes' along the normal at the hit (< 0: they overlap)
 };
 
 // One task's run of the pairs: its own node stack and earliest hits, merged

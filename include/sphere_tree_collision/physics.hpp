@@ -144,10 +144,10 @@ class Physics {
   // voxels along the normal (physics.cpp).
   void holdOnStatic(const StepContext& step, std::uint32_t ia, std::uint32_t ib, std::size_t before,
                     std::vector<Contact>& out) const;
-  // The sweep's hit of pair i (tests[i] of bodies ia, ib) appended to `out`
-  // when the sweep held a body back there and none of the pair's contacts
-  // out[before..] was proven at the leaves.
-  void appendSweepHit(const PairTest& test, std::uint32_t ia, std::uint32_t ib, std::size_t i, double priority,
+  // The sweep's hit of pair i (bodies ia, ib) merged into the pair's contacts
+  // out[before..] when the sweep held a body back there and none of them
+  // stops that approach already; at most max_contacts_per_pair.
+  void appendSweepHit(const StepContext& step, std::uint32_t ia, std::uint32_t ib, std::size_t i,
                       std::size_t before, std::vector<Contact>& out) const;
 
   std::vector<ChunkContacts> chunk_contacts_;

@@ -468,6 +468,7 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
       const Quat to_a = ba.pose.orientation.conjugate();
       for (std::uint32_t r = first; r < last; ++r) {
         const Contact& c = contacts[info_[r].contact];
+        if (c.node_a == kSweepHitNode) continue;  // an impact: starts cold
         int best = -1;
         for (std::uint32_t j = 0; j < old_count && best < 0; ++j) {
           if (!(used >> j & 1u) && old[j].node_a == c.node_a && old[j].node_b == c.node_b) best = static_cast<int>(j);
@@ -479,7 +480,7 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
           const double tolerance = std::max(0.5 * c.sphere_bound, 1e-12);
           double best_d = tolerance * tolerance;
           for (std::uint32_t j = 0; j < old_count; ++j) {
-            if (used >> j & 1u) continue;
+            if ((used >> j & 1u) || old[j].node_a == kSweepHitNode) continue;  // nor lends an impact's impulse
             const double d = (old[j].local_a - local).squaredNorm();
             if (d <= best_d) {
               best_d = d;

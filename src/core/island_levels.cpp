@@ -69,6 +69,7 @@ void IslandLevels::choose(const Inputs& in, IslandLevelReport& report) {
   island_wait_.resize(n);
   island_bodies_.resize(n);
   root_held_.resize(n);
+  ranked_.reserve(n);  // at most an island a body: grown as the islands passed their high, a tick allocated
   for (std::size_t i = 0; i < n; ++i) {
     parent_[i] = static_cast<std::uint32_t>(i);
     candidate_[i] = bodies[i].is_static ? 0 : 1;  // sleepers are held static already

@@ -17,6 +17,9 @@ constexpr double kRestingFallTicks = 4.0;
 // Below this many pairs the contacts are built on the calling thread.
 constexpr std::size_t kPairsPerTask = 64;
 constexpr std::size_t kChunksPerThread = 4;  // contact building
+// A contact whose normal is within about 25 degrees of the sweep's hit, near
+// it, stops the approach the hit stopped (Physics::appendSweepHit).
+constexpr double kHitCoveredCosine = 0.9;
 
 // What a cache's placed contacts of the pair of `test` take from the pair now.
 Contact placedBase(const PairTest& test, std::uint32_t ia, std::uint32_t ib, double priority) {
@@ -110,6 +113,7 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
       pair_cache_.place(entry, placedBase(tests[i], ia, ib, priorities[i]), *tests[i].bodyA().pose,
                         *tests[i].bodyB().pose, out);
       pair_cache_.carry(entry, reuse);
+      appendSweepHit(step, ia, ib, i, before, out);
       continue;
     }
     const PairStatus status = tests[i].status();
@@ -132,7 +136,7 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
         frontier_cache_.carry(kept, frontier);
         ++chunk.frontier_kept;
         holdOnStatic(step, ia, ib, before, out);
-        appendSweepHit(tests[i], ia, ib, i, priorities[i], before, out);
+        appendSweepHit(step, ia, ib, i, before, out);
         continue;
       }
     }
@@ -152,7 +156,7 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
                                out.data() + before, out.data() + out.size(), frontier);
     }
     holdOnStatic(step, ia, ib, before, out);
-    appendSweepHit(tests[i], ia, ib, i, priorities[i], before, out);
+    appendSweepHit(step, ia, ib, i, before, out);
   }
 }
 
@@ -220,20 +224,40 @@ void Physics::holdOnStatic(const StepContext& step, std::uint32_t ia, std::uint3
   }
 }
 
-// The sweep held a body back at pair i's first touch, but the test gave no
-// contact proven at the leaves (interrupted: none, or its frontier's, whose
-// separations are at least 0 and whose normals run along the line of centres
-// of spheres that may be the roots): the hit is a contact too, so the
-// response turns the approach the sweep stopped. Without it a budgeted tick
-// held the body back tick after tick while its velocity kept gravity's gain
-// (stored m/s, real mm/s), until the pair resolved and released it.
-void Physics::appendSweepHit(const PairTest& test, std::uint32_t ia, std::uint32_t ib, std::size_t i,
-                             double priority, std::size_t before, std::vector<Contact>& out) const {
+// The sweep held a body back at pair i's first touch: the response must turn
+// that approach, or the body is held back again next tick while its velocity
+// keeps gravity's gain (stored m/s, real mm/s). A contact of the pair turns
+// it when it is proven at the leaves (resolved), faces the way the hit does
+// and lies within a leaf diameter of it. Otherwise the hit (point between the
+// two boxes, normal along the face they met on, separation minus their overlap
+// there, as a leaf contact's says) becomes a contact: under a
+// budget the test may give none proven (interrupted: none, or its frontier's,
+// whose separations are at least 0 and whose normals run along the line of
+// centres of spheres that may be the roots); and unbudgeted the leaves'
+// contacts may lie elsewhere, where the bodies already touch and separate (a
+// spinning cube on its neighbour, whose far corner the sweep saw coming down
+// on it). A leaf contact beside the hit already stops it: the hit added as
+// well was a fifth point of a rock pair. A full manifold gives up its
+// shallowest point for the hit, the one doing least. The hit's contact is
+// warm-started from nothing and warm-starts nothing (kSweepHitNode).
+void Physics::appendSweepHit(const StepContext& step, std::uint32_t ia, std::uint32_t ib, std::size_t i,
+                             std::size_t before, std::vector<Contact>& out) const {
   if (sweep_hit_of_pair_[i] < 0) return;
-  for (std::size_t k = before; k < out.size(); ++k) {
-    if (out[k].resolved) return;  // the leaves' contacts turn it
-  }
   const SweepHit& hit = sweep_scratch_.hits[static_cast<std::size_t>(sweep_hit_of_pair_[i])];
+  const std::deque<ShapeBounds>& shape_bounds = *step.shape_bounds;
+  const std::vector<std::uint32_t>& body_shapes = *step.body_shapes;
+  const double leaf_diameter = 2.0 * std::min(shape_bounds[body_shapes[ia]].min_leaf_radius,
+                                              shape_bounds[body_shapes[ib]].min_leaf_radius);
+  std::size_t shallowest = before;
+  for (std::size_t k = before; k < out.size(); ++k) {
+    const Contact& c = out[k];
+    if (c.resolved && c.normal.dot(hit.normal) >= kHitCoveredCosine &&
+        (c.point - hit.point).squaredNorm() <= leaf_diameter * leaf_diameter) {
+      return;
+    }
+    if (c.separation > out[shallowest].separation) shallowest = k;
+  }
+  const PairTest& test = (*step.tests)[i];
   Contact c;
   c.a = test.bodyA().id;
   c.b = test.bodyB().id;
@@ -241,9 +265,17 @@ void Physics::appendSweepHit(const PairTest& test, std::uint32_t ia, std::uint32
   c.index_b = ib;
   c.point = hit.point;
   c.normal = hit.normal;
+  c.separation = hit.separation;
   c.resolved = true;
-  c.priority = priority;
-  out.push_back(c);
+  c.priority = (*step.priorities)[i];
+  c.node_a = kSweepHitNode;
+  c.node_b = kSweepHitNode;
+  const std::size_t most = static_cast<std::size_t>(std::max(1, step.options->max_contacts_per_pair));
+  if (out.size() - before >= most) {
+    out[shallowest] = c;
+  } else {
+    out.push_back(c);
+  }
 }
 
 void Physics::buildContacts(const StepContext& step) {

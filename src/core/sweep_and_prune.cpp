@@ -300,7 +300,16 @@ struct SweepAndPrune::Impl {
       lists[a].bands.resize(static_cast<std::size_t>(q.top) + 1);
       lists[a].band_lost.assign(lists[a].bands.size(), 0);
       lists[a].band_dirty.assign(lists[a].bands.size(), 0);
-      for (std::vector<Endpoint>& band : lists[a].bands) band.clear();
+      // Room in each band for twice its even share of the endpoints (two a
+      // box, a box in at most two bands): grown only as a band first passed
+      // its high, a steady scene whose boxes drift between bands allocated in
+      // a tick long after its start (the swept allocation test, once its
+      // trajectory changed).
+      const std::size_t share = 2 * 2 * in_use / lists[a].bands.size() + 16;
+      for (std::vector<Endpoint>& band : lists[a].bands) {
+        band.clear();
+        band.reserve(2 * share);
+      }
     }
     pairs.clear();
     pair_keys.clear();
