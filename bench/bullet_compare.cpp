@@ -29,7 +29,7 @@
 // ratio of the two p50s.
 //
 // Usage: bench_bullet_compare [--seconds S] [--settle S] [--scenes LIST] [--variants LIST] [--iterations N]
-//                             [--reuse T[,T...]] [--markdown FILE]
+//                             [--reuse T[,T...]] [--solver NAME] [--markdown FILE]
 //   --seconds   simulated time per run (default 10)
 //   --settle    simulated time run first, untimed (default 0): with it the timed
 //               ticks are those of a settling scene, where both engines put
@@ -44,6 +44,8 @@
 //               (ResponseOptions::iterations; default: the World's, 20). Bullet
 //               runs its default 10 always: --iterations 10 compares the two
 //               at the same solver effort. The SUMMARY lines say which was used.
+//   --solver NAME  this package's solver (ResponseOptions::solver: sequential, jacobi,
+//               soft; default: the World's, sequential). The SUMMARY lines say so.
 //   --reuse T   this package carries a resting pair's contacts over while its bodies
 //               drift less than T of a leaf radius (ResponseOptions::reuse_tolerance;
 //               default: the World's). The SUMMARY lines say so. A list (--reuse 0,0.05)
@@ -161,14 +163,17 @@ class MotionCheck {
 struct PackageOptions {
   int iterations = 0;      // > 0: solver iterations instead of the default
   double reuse = -1.0;     // >= 0: ResponseOptions::reuse_tolerance
+  std::string solver;      // non-empty: ResponseOptions::solver by name
   std::string label() const {
     std::string out = "this package";
+    if (!solver.empty()) out += ", " + solver + " solver";
     if (iterations > 0) out += ", " + std::to_string(iterations) + " iterations";
     if (reuse >= 0.0) out += ", reuse " + shortNumber(reuse);
     return out;
   }
   std::string summary() const {
     std::string out;
+    if (!solver.empty()) out += " solver=" + solver;
     if (iterations > 0) out += " iterations=" + std::to_string(iterations);
     if (reuse >= 0.0) out += " reuse=" + shortNumber(reuse);
     return out;
@@ -186,6 +191,7 @@ SceneWorld sceneWorld(const Case& c, const PackageOptions& package = PackageOpti
   WorldConfig config;
   if (package.iterations > 0) config.response.iterations = package.iterations;
   if (package.reuse >= 0.0) config.response.reuse_tolerance = package.reuse;
+  if (!package.solver.empty()) config.response.solver = parseSolverKind(package.solver);
   return makeSceneWorld(c.kind, params, config);
 }
 
@@ -678,6 +684,9 @@ Options parse(int argc, char** argv) {
     } else if (a == "--iterations") {
       o.package.iterations = std::stoi(args.required());
       if (o.package.iterations < 1) throw InputError("--iterations", "must be >= 1");
+    } else if (a == "--solver") {
+      o.package.solver = args.required();
+      parseSolverKind(o.package.solver);  // throws InputError("solver") on an unknown name
     } else if (a == "--reuse") {
       o.side_by_side.clear();
       for (const std::string& v : splitList(args.required())) {
