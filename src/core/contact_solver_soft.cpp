@@ -54,7 +54,12 @@ STC_HOT_INLINE void softRow(ContactSolver::Row& row, double s, const SoftPass& p
   const double vn = relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n);
   double bias = 0.0, mass_scale = 1.0, impulse_scale = 0.0;
   if (s > 0.0) {
-    bias = s * pass.inv_h;  // speculative: close the gap at most to contact this substep
+    // Speculative: close the gap at most to contact this substep. The
+    // relaxing pass comes after the move and leaves an open contact to the
+    // next substep's biased pass: so the velocity a tick stores is the one
+    // its last substep moved with.
+    if (!pass.bias) return;
+    bias = s * pass.inv_h;
   } else if (pass.bias) {
     const Softness& soft = (row.inv_ma == 0.0 || row.inv_mb == 0.0) ? pass.immovable : pass.moving;
     bias = std::max(soft.bias_rate * std::min(0.0, s + row.slop), -pass.max_push);
