@@ -226,6 +226,7 @@ class ContactSolver {
     // its bounce, which bounds friction in the first substep only.
     double soft_total[3] = {0.0, 0.0, 0.0};
     double soft_bounce = 0.0;
+    double soft_kept[3] = {0.0, 0.0, 0.0};  // its impulses before a substep's shock sweep
   };
   // Last tick's manifold of a body pair: its points' impulses, by feature id
   // (the leaf sphere pair a point was built from) and position in A's frame.
@@ -328,6 +329,8 @@ class ContactSolver {
   double separationNow(const Row& row) const;
   // Rows' separations at the tick's start, the restitution's wave 0 from them.
   void prepareSoft(const std::vector<Contact>& contacts, const ResponseOptions& options, double dt);
+  // A substep's shock sweep (contact_solver_soft.cpp), substep length h.
+  void holdSupports(const ResponseOptions& options, double h);
   // The substeps after the restitution and the warm start.
   void substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt);
   std::vector<SoftMove> soft_move_;

@@ -164,6 +164,7 @@ void ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptio
     }
     pass.bias = true;
     if (!rows_.empty()) pass_over(softStep);
+    if (options.shock_propagation && !rows_.empty() && shockLevels() > 0) holdSupports(options, h);
     forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         BodyState& body = bodies[i];
@@ -186,6 +187,32 @@ void ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptio
       });
     }
   }
+}
+
+// Shock propagation inside the substep, before the move: one sweep up the
+// levels from the ground with each row's supporting body held, so that no
+// body moves into what supports it however heavy its load. Its impulses move
+// the upper bodies only and are not kept: the impulses so far (the next
+// substep's warm start) stay the passes', which reach both bodies, so a
+// support still learns its load.
+void ContactSolver::holdSupports(const ResponseOptions& options, double h) {
+  forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      Row& row = rows_[r];
+      RowInfo& info = info_[r];
+      const double s = separationNow(row);
+      row.speculative = s > 0.0 ? s / h : 0.0;  // shock propagation's gap: this substep's
+      for (int k = 0; k < 3; ++k) info.soft_kept[k] = row.lambda[k];
+    }
+  });
+  ResponseOptions once = options;
+  once.iterations = 2;  // max(2, iterations / 2) passes a level: two
+  propagateShock(once);
+  forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      for (int k = 0; k < 3; ++k) rows_[r].lambda[k] = info_[r].soft_kept[k];
+    }
+  });
 }
 
 SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
