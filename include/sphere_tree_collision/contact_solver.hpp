@@ -331,8 +331,13 @@ class ContactSolver {
   void prepareSoft(const std::vector<Contact>& contacts, const ResponseOptions& options, double dt);
   // A substep's shock sweep (contact_solver_soft.cpp), substep length h.
   void holdSupports(const ResponseOptions& options, double h);
-  // The substeps after the restitution and the warm start.
-  void substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt);
+  // The substeps after the restitution and the warm start; `hold`: with a
+  // shock sweep in each (holdSupports).
+  void substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt, bool hold);
+  // The soft step sweeps shock propagation in each substep only when some
+  // body rests on one at least this much lighter than itself (10:1 holds
+  // without it; a pile of like bodies does not pay for it).
+  static constexpr double kHeavyOnLight = 10.0;
   std::vector<SoftMove> soft_move_;
   std::vector<Pose> soft_found_;   // per body: the poses its contacts were found at
   std::vector<Motion> soft_gain_;  // per body: what the integration added to v and w this tick

@@ -7,6 +7,7 @@
 #include "contact_rows.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 
@@ -101,7 +102,7 @@ void ContactSolver::prepareSoft(const std::vector<Contact>& contacts, const Resp
   });
 }
 
-void ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt) {
+void ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt, bool hold) {
   const int count = options.substeps;
   const double h = dt / count;
   SoftPass pass;
@@ -164,7 +165,7 @@ void ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptio
     }
     pass.bias = true;
     if (!rows_.empty()) pass_over(softStep);
-    if (options.shock_propagation && !rows_.empty() && shockLevels() > 0) holdSupports(options, h);
+    if (hold) holdSupports(options, h);
     forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         BodyState& body = bodies[i];
@@ -257,12 +258,27 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
     }
   });
   if (!rows_.empty()) prepareSoft(contacts, options, dt);
+  // A heavy body on a much lighter support (the support nearer the ground).
+  std::atomic<bool> heavy_on_light{false};
+  if (options.shock_propagation && !rows_.empty() && shockLevels() > 0) {
+    forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+      bool found = false;
+      for (std::size_t r = begin; r < end && !found; ++r) {
+        const Row& row = rows_[r];
+        const RowInfo& info = info_[r];
+        found = (!info.move_a && row.inv_mb > 0.0 && row.inv_ma >= kHeavyOnLight * row.inv_mb) ||
+                (!info.move_b && row.inv_ma > 0.0 && row.inv_mb >= kHeavyOnLight * row.inv_ma);
+      }
+      if (found) heavy_on_light.store(true, std::memory_order_relaxed);
+    });
+  }
+  const bool hold = heavy_on_light.load();
   const auto run = [&] {
     if (!rows_.empty()) {
       collide(sequential, stats);
       if (options.warm_starting) warmStart(contacts, bodies, stats);
     }
-    substeps(bodies, options, dt);
+    substeps(bodies, options, dt, hold);
   };
   if (workers_ != nullptr) {
     workers_->withTeam([&](Team& team) {
