@@ -83,8 +83,8 @@ class ContactSolver {
   // from `start_poses` (the tick's start) with velocities `start_v`, `start_w`.
   // The bodies go back to the start and move again by `options.substeps`
   // substeps of h = dt / substeps, what the integration added to their
-  // velocities (gravity, the gyroscopic turn) spread evenly over them; each
-  // substep: that share, the impulses so far (warm start), one pass with
+  // velocities (gravity) spread evenly over them, each turning torque-free
+  // by h (rotateFreely); each substep: that share, the impulses so far (warm start), one pass with
   // soft contacts (a penetration beyond the slop pushed out as a damped
   // spring, at most max_push_speed; a gap closed at most to contact),
   // positions moved by h, one pass without the push (relax). Each contact's

@@ -46,20 +46,19 @@ struct SoftPass {
   bool bias = true;  // false: the relaxing pass (a gap still closes at most to contact)
 };
 
-// One soft step of a row at separation `s` now: friction (bounded by the
-// normal impulse so far), then the normal impulse.
+// One soft step of a row at separation `s` now: the normal impulse, then
+// friction bounded by it (the order of Box2D v3's passes: a soft pass lowers
+// the normal impulse before it pushes, and friction bounded by that lower
+// one let a sliding cube run on).
 STC_HOT_INLINE void softRow(ContactSolver::Row& row, double s, const SoftPass& pass, ContactSolver::Motion& a,
                             ContactSolver::Motion& b) {
-  const Eigen::Vector2d d = frictionStep(row, relativeVelocity(row, a.v, a.w, b.v, b.w), row.mass[1], row.mass[2]);
-  applyFriction(row, d.x(), d.y(), a, b);
-  const double vn = relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n);
   double bias = 0.0, mass_scale = 1.0, impulse_scale = 0.0;
+  // Speculative: close the gap at most to contact this substep. The
+  // relaxing pass comes after the move and leaves an open contact's normal
+  // to the next substep's biased pass: so the velocity a tick stores is the
+  // one its last substep moved with.
+  const bool normal_step = s <= 0.0 || pass.bias;
   if (s > 0.0) {
-    // Speculative: close the gap at most to contact this substep. The
-    // relaxing pass comes after the move and leaves an open contact to the
-    // next substep's biased pass: so the velocity a tick stores is the one
-    // its last substep moved with.
-    if (!pass.bias) return;
     bias = s * pass.inv_h;
   } else if (pass.bias) {
     const Softness& soft = (row.inv_ma == 0.0 || row.inv_mb == 0.0) ? pass.immovable : pass.moving;
@@ -67,10 +66,15 @@ STC_HOT_INLINE void softRow(ContactSolver::Row& row, double s, const SoftPass& p
     mass_scale = soft.mass_scale;
     impulse_scale = soft.impulse_scale;
   }
-  const double impulse = -row.mass[0] * mass_scale * (vn + bias) - impulse_scale * row.lambda[0];
-  const double normal = std::max(0.0, row.lambda[0] + impulse);
-  applyNormal(row, normal - row.lambda[0], a, b);
-  row.lambda[0] = normal;
+  if (normal_step) {
+    const double vn = relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n);
+    const double impulse = -row.mass[0] * mass_scale * (vn + bias) - impulse_scale * row.lambda[0];
+    const double normal = std::max(0.0, row.lambda[0] + impulse);
+    applyNormal(row, normal - row.lambda[0], a, b);
+    row.lambda[0] = normal;
+  }
+  const Eigen::Vector2d d = frictionStep(row, relativeVelocity(row, a.v, a.w, b.v, b.w), row.mass[1], row.mass[2]);
+  applyFriction(row, d.x(), d.y(), a, b);
 }
 
 }  // namespace
@@ -171,7 +175,12 @@ void ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptio
         BodyState& body = bodies[i];
         if (body.is_static) continue;
         body.pose.position += motion_[i].v * h;
-        if (!motion_[i].w.isZero(0.0)) body.pose.orientation = integrateOrientation(body.pose.orientation, motion_[i].w, h);
+        if (!motion_[i].w.isZero(0.0)) {  // the torque-free turn of h (the gyroscopic term's, energy kept)
+          body.angular_velocity = motion_[i].w;
+          const FreeRotation turned = rotateFreely(body, h, options.gyroscopic);
+          body.pose.orientation = turned.orientation;
+          motion_[i].w = turned.angular_velocity;
+        }
         soft_move_[i].p = body.pose.position - soft_found_[i].position;
         soft_move_[i].q = body.pose.orientation * soft_found_[i].orientation.conjugate();
       }
@@ -239,7 +248,7 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
       soft_found_[i] = body.pose;
       if (body.is_static) continue;
       soft_gain_[i].v = body.linear_velocity - start_v[i];
-      soft_gain_[i].w = body.angular_velocity - start_w[i];
+      soft_gain_[i].w = Vec3::Zero();  // the gyroscopic turn comes substep by substep (substeps())
       body.linear_velocity = start_v[i];
       body.angular_velocity = start_w[i];
     }
