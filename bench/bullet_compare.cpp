@@ -29,7 +29,7 @@
 // ratio of the two p50s.
 //
 // Usage: bench_bullet_compare [--seconds S] [--settle S] [--scenes LIST] [--variants LIST] [--iterations N]
-//                             [--reuse T[,T...]] [--markdown FILE]
+//                             [--reuse T[,T...]] [--solver NAME[,NAME...]] [--markdown FILE]
 //   --seconds   simulated time per run (default 10)
 //   --settle    simulated time run first, untimed (default 0): with it the timed
 //               ticks are those of a settling scene, where both engines put
@@ -44,6 +44,9 @@
 //               (ResponseOptions::iterations; default: the World's, 20). Bullet
 //               runs its default 10 always: --iterations 10 compares the two
 //               at the same solver effort. The SUMMARY lines say which was used.
+//   --solver NAME  this package's solver (ResponseOptions::solver: sequential, jacobi,
+//               soft; default: the World's, sequential). The SUMMARY lines say so. A list
+//               (--solver sequential,soft) runs one World per solver side by side, as --reuse's list.
 //   --reuse T   this package carries a resting pair's contacts over while its bodies
 //               drift less than T of a leaf radius (ResponseOptions::reuse_tolerance;
 //               default: the World's). The SUMMARY lines say so. A list (--reuse 0,0.05)
@@ -161,14 +164,17 @@ class MotionCheck {
 struct PackageOptions {
   int iterations = 0;      // > 0: solver iterations instead of the default
   double reuse = -1.0;     // >= 0: ResponseOptions::reuse_tolerance
+  std::string solver;      // non-empty: ResponseOptions::solver by name
   std::string label() const {
     std::string out = "this package";
+    if (!solver.empty()) out += ", " + solver + " solver";
     if (iterations > 0) out += ", " + std::to_string(iterations) + " iterations";
     if (reuse >= 0.0) out += ", reuse " + shortNumber(reuse);
     return out;
   }
   std::string summary() const {
     std::string out;
+    if (!solver.empty()) out += " solver=" + solver;
     if (iterations > 0) out += " iterations=" + std::to_string(iterations);
     if (reuse >= 0.0) out += " reuse=" + shortNumber(reuse);
     return out;
@@ -186,6 +192,7 @@ SceneWorld sceneWorld(const Case& c, const PackageOptions& package = PackageOpti
   WorldConfig config;
   if (package.iterations > 0) config.response.iterations = package.iterations;
   if (package.reuse >= 0.0) config.response.reuse_tolerance = package.reuse;
+  if (!package.solver.empty()) config.response.solver = parseSolverKind(package.solver);
   return makeSceneWorld(c.kind, params, config);
 }
 
@@ -607,9 +614,10 @@ std::string phaseRow(const Case& c, const Run& r) {
   return buf;
 }
 
-std::string sideBySideRow(const Case& c, const Run& r, double reuse) {
+std::string sideBySideRow(const Case& c, const Run& r, const PackageOptions& package) {
   char buf[512];
-  std::snprintf(buf, sizeof buf, "| %s | %g | %s | %s | %s | %s | %.0f %% | %.0f |\n", label(c).c_str(), reuse,
+  std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %.0f %% | %.0f |\n", label(c).c_str(),
+                package.label().c_str(),
                 phaseCell(r.cpu).c_str(), phaseCell(r.narrow).c_str(), phaseCell(r.building).c_str(),
                 phaseCell(r.solve).c_str(), 100.0 * meanOf(r.reused), percentile(r.contacts, 0.5));
   return buf;
@@ -632,7 +640,8 @@ struct Options {
   double settle = 0.0;
   bool bullet_only = false;
   PackageOptions package;
-  std::vector<double> side_by_side;  // --reuse with several values: one World each, in turns
+  // --reuse or --solver with several values: one World each (every pair of them), in turns
+  std::vector<PackageOptions> side_by_side;
   std::vector<Case> cases;
   std::vector<BulletShape> variants{BulletShape::Compound, BulletShape::Hull, BulletShape::Lean};
   std::string markdown;
@@ -651,6 +660,8 @@ Options parse(int argc, char** argv) {
   Options o;
   std::string scenes;
   bool smoke = false;
+  std::vector<double> reuses;
+  std::vector<std::string> solvers;
   for (stc_bench::Args args(argc, argv); args.more();) {
     const std::string a = args.flag();
     if (a == "--seconds") {
@@ -678,20 +689,36 @@ Options parse(int argc, char** argv) {
     } else if (a == "--iterations") {
       o.package.iterations = std::stoi(args.required());
       if (o.package.iterations < 1) throw InputError("--iterations", "must be >= 1");
+    } else if (a == "--solver") {
+      solvers = splitList(args.required());
+      for (const std::string& v : solvers) parseSolverKind(v);  // throws InputError("solver") on an unknown name
+      if (solvers.empty()) throw InputError("--solver", "names no value");
     } else if (a == "--reuse") {
-      o.side_by_side.clear();
+      reuses.clear();
       for (const std::string& v : splitList(args.required())) {
         const double reuse = std::stod(v);
         if (!(reuse >= 0.0 && reuse <= 1.0)) throw InputError("--reuse", "must be in [0, 1]");
-        o.side_by_side.push_back(reuse);
+        reuses.push_back(reuse);
       }
-      if (o.side_by_side.empty()) throw InputError("--reuse", "names no value");
-      o.package.reuse = o.side_by_side.front();
-      if (o.side_by_side.size() == 1) o.side_by_side.clear();
+      if (reuses.empty()) throw InputError("--reuse", "names no value");
     } else if (a == "--markdown") {
       o.markdown = args.required();
     } else {
       throw InputError(a, "unknown argument");
+    }
+  }
+  if (!reuses.empty()) o.package.reuse = reuses.front();
+  if (!solvers.empty()) o.package.solver = solvers.front();
+  if (reuses.size() > 1 || solvers.size() > 1) {
+    if (reuses.empty()) reuses.push_back(o.package.reuse);
+    if (solvers.empty()) solvers.push_back(o.package.solver);
+    for (const double reuse : reuses) {
+      for (const std::string& solver : solvers) {
+        PackageOptions p = o.package;
+        p.reuse = reuse;
+        p.solver = solver;
+        o.side_by_side.push_back(p);
+      }
     }
   }
   o.cases = scenes.empty() ? kDefaultCases : stc_bench::parseSceneCases(scenes, kDefaultCases);
@@ -727,7 +754,7 @@ int main(int argc, char** argv) {
               "btBoxShape, other shapes as optimizeConvexHull() hulls of the surface-voxel corners, margin %.3f m\n",
               kLeanMargin);
   std::string side_md =
-      "| scene | reuse tolerance | whole tick | narrow phase | contacts | solve | colliding pairs carried over "
+      "| scene | this package | whole tick | narrow phase | contacts | solve | colliding pairs carried over "
       "| contacts a tick |\n"
       "|---|---|---|---|---|---|---|---|\n";
   for (const Case& c : opt.cases) {
@@ -736,20 +763,13 @@ int main(int argc, char** argv) {
     std::string rows;
     Run ours;
     if (!opt.bullet_only && !opt.side_by_side.empty()) {
-      std::vector<PackageOptions> packages;
-      for (const double reuse : opt.side_by_side) {
-        PackageOptions p = opt.package;
-        p.reuse = reuse;
-        packages.push_back(p);
-      }
-      const std::vector<Run> side = runPackagesSideBySide(c, ticks, settle_ticks, packages);
+      const std::vector<Run> side = runPackagesSideBySide(c, ticks, settle_ticks, opt.side_by_side);
       for (std::size_t k = 0; k < side.size(); ++k) {
         rows += runRow(c, side[k]);
         phases_md += phaseRow(c, side[k]);
         side_md += sideBySideRow(c, side[k], opt.side_by_side[k]);
         std::printf("side by side: %s", sideBySideRow(c, side[k], opt.side_by_side[k]).c_str());
       }
-      std::printf("%s", rows.c_str());
       ours = side.front();
     } else if (!opt.bullet_only) {
       ours = runPackage(c, ticks, settle_ticks, opt.package);
@@ -798,7 +818,7 @@ int main(int argc, char** argv) {
        phases_md +
        "\nBullet's phases (its profile zones), ms per tick (p50 / mean, wall time):\n\n" + bullet_phases_md;
   if (!opt.side_by_side.empty()) {
-    md += "\nContacts carried over, side by side (one World per tolerance, in turns of " + std::to_string(kTurnTicks) +
+    md += "\nSide by side (one World per setting, in turns of " + std::to_string(kTurnTicks) +
           " ticks): thread-CPU ms per tick, p50 / mean; the share of colliding pairs carried over, mean over the "
           "ticks:\n\n" + side_md;
   }

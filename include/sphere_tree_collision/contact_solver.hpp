@@ -79,6 +79,23 @@ class ContactSolver {
  public:
   SolveStats solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
                    const ResponseOptions& options, double dt, const SolveBudget& budget = SolveBudget{});
+  // The soft step (SolverKind::Soft; contact_solver_soft.cpp). The contacts
+  // were found at the bodies' poses now, which the integration predicted
+  // from `start_poses` (the tick's start) with velocities `start_v`, `start_w`.
+  // The bodies go back to the start and move again by `options.substeps`
+  // substeps of h = dt / substeps, what the integration added to their
+  // velocities (gravity) spread evenly over them, each turning torque-free
+  // by h (rotateFreely); each substep: that share, the impulses so far (warm start), one pass with
+  // soft contacts (a penetration beyond the slop pushed out as a damped
+  // spring, at most max_push_speed; a gap closed at most to contact),
+  // positions moved by h, one pass without the push (relax). Each contact's
+  // separation is measured again each pass from its bodies' moves since its
+  // poses (anchors fixed in the bodies). Restitution comes first, as the
+  // default's waves. Stores the velocities and the poses; the contacts get
+  // the tick's impulses; the warm start keeps the last substep's.
+  SolveStats solveSoft(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
+                       const ResponseOptions& options, double dt, const std::vector<Pose>& start_poses,
+                       const std::vector<Vec3>& start_v, const std::vector<Vec3>& start_w);
   void forget() {  // drop warm-start impulses
     cache_.clear();
     cache_manifolds_.clear();
@@ -128,6 +145,11 @@ class ContactSolver {
     double speculative = 0.0;          // closing speed allowed by a gap: max(s, 0) / dt
     double lambda[3] = {0.0, 0.0, 0.0};
     double bounce_impulse = 0.0;       // of all its restitution waves (before the solve)
+    // The soft step only: the contact's separation at the poses it was
+    // found at (measured again from the bodies' moves each substep), and
+    // the penetration it keeps as slop.
+    double separation = 0.0;
+    double slop = 0.0;
   };
   // Rolling resistance of one body pair (Material::rolling_resistance): an
   // angular impulse on the two bodies' relative spin, held within
@@ -201,6 +223,11 @@ class ContactSolver {
     double lambda_wave = 0.0;  // impulse of the current restitution wave
     int wave = -1;             // restitution wave it bounced in (-1: none)
     bool bounced = false;      // took a restitution impulse this tick
+    // The soft step: the impulses of all its substeps (normal, t1, t2), and
+    // its bounce, which bounds friction in the first substep only.
+    double soft_total[3] = {0.0, 0.0, 0.0};
+    double soft_bounce = 0.0;
+    double soft_kept[3] = {0.0, 0.0, 0.0};  // its impulses before a substep's shock sweep
   };
   // Last tick's manifold of a body pair: its points' impulses, by feature id
   // (the leaf sphere pair a point was built from) and position in A's frame.
@@ -292,6 +319,29 @@ class ContactSolver {
   // body of each row held: what they left of a pile's overlap goes upward.
   void propagatePositionShock(const ResponseOptions& options);
   void store(std::vector<BodyState>& bodies, std::vector<Contact>& contacts, double dt);
+
+  // The soft step (contact_solver_soft.cpp). A body's move since the poses
+  // its contacts were found at: translation, and rotation (world frame).
+  struct SoftMove {
+    Vec3 p = Vec3::Zero();
+    Quat q = Quat::Identity();
+  };
+  // A row's separation at the poses now (soft_move_).
+  double separationNow(const Row& row) const;
+  // Rows' separations at the tick's start, the restitution's wave 0 from them.
+  void prepareSoft(const std::vector<Contact>& contacts, const ResponseOptions& options, double dt);
+  // A substep's shock sweep (contact_solver_soft.cpp), substep length h.
+  void holdSupports(const ResponseOptions& options, double h);
+  // The substeps after the restitution and the warm start; `hold`: with a
+  // shock sweep in each (holdSupports).
+  void substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt, bool hold);
+  // The soft step sweeps shock propagation in each substep only when some
+  // body rests on one at least this much lighter than itself (10:1 holds
+  // without it; a pile of like bodies does not pay for it).
+  static constexpr double kHeavyOnLight = 10.0;
+  std::vector<SoftMove> soft_move_;
+  std::vector<Pose> soft_found_;   // per body: the poses its contacts were found at
+  std::vector<Motion> soft_gain_;  // per body: what the integration added to v and w this tick
 
   // The sequential passes (velocity, shock, position, position shock),
   // kLanes manifolds side by side (contact_solver_wide.cpp): a block's manifolds in batches that share no

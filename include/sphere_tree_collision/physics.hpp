@@ -158,6 +158,7 @@ class Physics {
   std::vector<const PairContactCache::Pending*> reuse_pending_;  // the chunks' entries, for commit
   double gravity_speed_ = 0.0;  // |g| dt of the last integrate
   std::vector<Pose> start_;
+  std::vector<Vec3> start_v_, start_w_;  // the soft step's: velocities at the tick's start
   std::vector<const ShapeBounds*> body_bounds_;
   SweepScratch sweep_scratch_;
   std::vector<std::int32_t> sweep_hit_of_pair_;  // body whose sweep hit that pair, or -1

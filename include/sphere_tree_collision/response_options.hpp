@@ -12,8 +12,11 @@ enum class SolverKind : std::uint8_t {
   Sequential,  // projected Gauss-Seidel (sequential impulses): each contact sees the last one's impulse
   Jacobi,      // the paper's simultaneous scheme: every iteration computes all impulses from
                // one state, then applies them together (mass splitting keeps it convergent)
+  Soft,        // soft step (after Box2D v3): `substeps` substeps inside the tick, each one
+               // biased pass with soft contacts, positions moved, one relaxing pass
+               // (contact_solver_soft.cpp; docs/response.md: the soft step)
 };
-// "sequential" | "jacobi"; throws InputError("solver") otherwise.
+// "sequential" | "jacobi" | "soft"; throws InputError("solver") otherwise.
 SolverKind parseSolverKind(const std::string& name);
 const char* toString(SolverKind kind);
 
@@ -32,6 +35,15 @@ struct ResponseOptions {
   bool position_turns = false;
   double allowed_penetration = 0.0;     // metres kept as slop (0: 2% of the contact's gap bound h_a + h_b)
   SolverKind solver = SolverKind::Sequential;
+  // The soft step (solver = Soft) only: substeps a tick (>= 1; `iterations`,
+  // position_correction and shock_propagation are not used), and its soft
+  // contacts: a penetration is pushed out as a spring of `contact_hertz`
+  // (Hz, > 0; twice that against an immovable body, at most a quarter of the
+  // substep rate) with `contact_damping_ratio` (> 0), at most `max_push_speed` m/s (> 0).
+  int substeps = 4;
+  double contact_hertz = 30.0;
+  double contact_damping_ratio = 10.0;
+  double max_push_speed = 3.0;
   // Sequential passes take four manifolds that share no movable body at a
   // time, side by side in vector registers (contact_solver_wide.cpp): the
   // same result bit for bit as one at a time (false), in less time. A

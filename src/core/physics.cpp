@@ -40,6 +40,13 @@ void Physics::integrate(const StepContext& step) {
   report_.sweep = SweepStats{};
   gravity_speed_ = step.gravity.norm() * step.dt;
   start_.resize(bodies.size());
+  // The soft step moves the bodies again from the tick's start, with the
+  // velocities they started it with (ContactSolver::solveSoft).
+  const bool soft = options.solver == SolverKind::Soft && options.enabled;
+  if (soft) {
+    start_v_.resize(bodies.size());
+    start_w_.resize(bodies.size());
+  }
   IntegrationOptions integration;
   integration.gravity = step.gravity;
   integration.gyroscopic = options.gyroscopic;
@@ -54,6 +61,10 @@ void Physics::integrate(const StepContext& step) {
     for (std::size_t i = begin; i < end; ++i) {
       if (step.integrate_only != nullptr && (*step.integrate_only)[i] == 0) continue;
       start_[i] = bodies[i].pose;
+      if (soft) {
+        start_v_[i] = bodies[i].linear_velocity;
+        start_w_[i] = bodies[i].angular_velocity;
+      }
       integratePosition(bodies[i], integration, step.dt);
       integrateVelocity(bodies[i], integration, step.dt);
       fast[i] = 0;
@@ -365,7 +376,11 @@ void Physics::solve(const StepContext& step) {
   run.restitution_threshold = std::max(options.restitution_threshold, kRestingFallTicks * gravity_speed_);
   solver_.setWorkers(step.workers, static_cast<std::size_t>(options.solver_task_manifolds));
   solver_.keepWhileHeld(step.ids, step.held_asleep);
-  report_.solve = solver_.solve(*step.bodies, contacts, run, step.dt, step.budget);
+  if (options.solver == SolverKind::Soft) {
+    report_.solve = solver_.solveSoft(*step.bodies, contacts, run, step.dt, start_, start_v_, start_w_);
+  } else {
+    report_.solve = solver_.solve(*step.bodies, contacts, run, step.dt, step.budget);
+  }
 }
 
 }  // namespace stc

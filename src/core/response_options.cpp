@@ -10,11 +10,17 @@ namespace stc {
 SolverKind parseSolverKind(const std::string& name) {
   if (name == "sequential") return SolverKind::Sequential;
   if (name == "jacobi") return SolverKind::Jacobi;
-  throw InputError("solver", "unknown solver '" + name + "' (sequential | jacobi)");
+  if (name == "soft") return SolverKind::Soft;
+  throw InputError("solver", "unknown solver '" + name + "' (sequential | jacobi | soft)");
 }
 
 const char* toString(SolverKind kind) {
-  return kind == SolverKind::Jacobi ? "jacobi" : "sequential";
+  switch (kind) {
+    case SolverKind::Jacobi: return "jacobi";
+    case SolverKind::Soft: return "soft";
+    case SolverKind::Sequential: break;
+  }
+  return "sequential";
 }
 
 void validateResponseOptions(const ResponseOptions& o) {
@@ -38,6 +44,18 @@ void validateResponseOptions(const ResponseOptions& o) {
   }
   if (!(o.sweep_threshold > 0.0 && std::isfinite(o.sweep_threshold))) {
     throw InputError("response.sweep_threshold", "must be finite and > 0");
+  }
+  if (o.substeps < 1 || o.substeps > 64) {
+    throw InputError("response.substeps", "must be in [1, 64]");
+  }
+  if (!(o.contact_hertz > 0.0 && std::isfinite(o.contact_hertz))) {
+    throw InputError("response.contact_hertz", "must be finite and > 0");
+  }
+  if (!(o.contact_damping_ratio > 0.0 && std::isfinite(o.contact_damping_ratio))) {
+    throw InputError("response.contact_damping_ratio", "must be finite and > 0");
+  }
+  if (!(o.max_push_speed > 0.0 && std::isfinite(o.max_push_speed))) {
+    throw InputError("response.max_push_speed", "must be finite and > 0");
   }
   if (!(o.reuse_tolerance >= 0.0 && o.reuse_tolerance <= 1.0)) {
     throw InputError("response.reuse_tolerance", "must be in [0, 1]");

@@ -276,6 +276,7 @@ void World::setScheduler(const SchedulerOptions& options) {
 
 void World::setResponse(const ResponseOptions& options) {
   validateResponseOptions(options);
+  if (options.solver != config_.response.solver) physics_.forget();  // impulses of another kind of step
   config_.response = options;
   physics_.forgetReuse();  // contacts built under the options before
   if (!options.enabled) islands_.wakeAll();  // detection alone: every pair is tested again

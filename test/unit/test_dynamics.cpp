@@ -316,6 +316,20 @@ TEST(Response, OptionsAndSolverNamesAreValidatedByField) {
   o = ResponseOptions{};
   o.solver_task_manifolds = 0;
   EXPECT_EQ(thrownField([&] { validateResponseOptions(o); }), "response.solver_task_manifolds");
+  EXPECT_EQ(parseSolverKind("soft"), SolverKind::Soft);
+  EXPECT_STREQ(toString(SolverKind::Soft), "soft");
+  o = ResponseOptions{};
+  o.substeps = 0;
+  EXPECT_EQ(thrownField([&] { validateResponseOptions(o); }), "response.substeps");
+  o = ResponseOptions{};
+  o.contact_hertz = 0.0;
+  EXPECT_EQ(thrownField([&] { validateResponseOptions(o); }), "response.contact_hertz");
+  o = ResponseOptions{};
+  o.contact_damping_ratio = std::nan("");
+  EXPECT_EQ(thrownField([&] { validateResponseOptions(o); }), "response.contact_damping_ratio");
+  o = ResponseOptions{};
+  o.max_push_speed = -1.0;
+  EXPECT_EQ(thrownField([&] { validateResponseOptions(o); }), "response.max_push_speed");
   Vec3 t1, t2;
   for (const Vec3& n : {Vec3(Vec3::UnitX()), Vec3(Vec3::UnitZ()), Vec3(Vec3(1, 2, 3).normalized())}) {
     tangentBasis(n, t1, t2);

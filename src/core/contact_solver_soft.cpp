@@ -1,0 +1,335 @@
+// The soft step (SolverKind::Soft), after the idea of Box2D v3's solver:
+// substeps inside the tick, soft contacts, positions moved in the solve.
+// Reuses the default solver's rows, blocks, stages and restitution waves.
+#include "sphere_tree_collision/contact_solver.hpp"
+
+#include "sphere_tree_collision/dynamics.hpp"
+#include "contact_rows.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cassert>
+#include <cmath>
+
+namespace stc {
+
+using namespace contact_rows;
+
+namespace {
+
+constexpr std::size_t kRowsPerTask = 256;
+constexpr double kPi = 3.14159265358979323846;
+
+// A soft contact as a damped spring of `hertz` and `damping_ratio`, solved
+// implicitly over a substep h: the push speed per metre of penetration, and
+// how much of the rigid impulse and of the impulse so far a step applies
+// (Catto, "Solver2D" notes: the soft step's coefficients).
+struct Softness {
+  double bias_rate = 0.0;
+  double mass_scale = 1.0;
+  double impulse_scale = 0.0;
+};
+
+Softness makeSoftness(double hertz, double damping_ratio, double h) {
+  const double omega = 2.0 * kPi * hertz;
+  const double a1 = 2.0 * damping_ratio + h * omega;
+  const double a2 = h * omega * a1;
+  const double a3 = 1.0 / (1.0 + a2);
+  return Softness{omega / a1, a2 * a3, a3};
+}
+
+// What one pass of the substeps needs besides the rows.
+struct SoftPass {
+  Softness moving, immovable;  // contacts of two movable bodies, and against an immovable one
+  double inv_h = 0.0;
+  double max_push = 0.0;
+  bool bias = true;  // false: the relaxing pass (a gap still closes at most to contact)
+};
+
+// One soft step of a row at separation `s` now: friction (bounded by the
+// normal impulse so far, the default's order), then the normal impulse.
+// (Normal first let the sliding cube of test_physics stop where it should,
+// but launched rocks at 30 m/s in test_stability's zero-budget pile.)
+STC_HOT_INLINE void softRow(ContactSolver::Row& row, double s, const SoftPass& pass, ContactSolver::Motion& a,
+                            ContactSolver::Motion& b) {
+  const Eigen::Vector2d d = frictionStep(row, relativeVelocity(row, a.v, a.w, b.v, b.w), row.mass[1], row.mass[2]);
+  applyFriction(row, d.x(), d.y(), a, b);
+  double bias = 0.0, mass_scale = 1.0, impulse_scale = 0.0;
+  if (s > 0.0) {
+    // Speculative: close the gap at most to contact this substep. The
+    // relaxing pass comes after the move and leaves an open contact to the
+    // next substep's biased pass: so the velocity a tick stores is the one
+    // its last substep moved with.
+    if (!pass.bias) return;
+    bias = s * pass.inv_h;
+  } else if (pass.bias) {
+    const Softness& soft = (row.inv_ma == 0.0 || row.inv_mb == 0.0) ? pass.immovable : pass.moving;
+    bias = std::max(soft.bias_rate * std::min(0.0, s + row.slop), -pass.max_push);
+    mass_scale = soft.mass_scale;
+    impulse_scale = soft.impulse_scale;
+  }
+  const double vn = relativeVelocity(row, a.v, a.w, b.v, b.w).dot(row.n);
+  const double impulse = -row.mass[0] * mass_scale * (vn + bias) - impulse_scale * row.lambda[0];
+  const double normal = std::max(0.0, row.lambda[0] + impulse);
+  applyNormal(row, normal - row.lambda[0], a, b);
+  row.lambda[0] = normal;
+}
+
+}  // namespace
+
+double ContactSolver::separationNow(const Row& row) const {
+  const SoftMove& ma = soft_move_[row.a];
+  const SoftMove& mb = soft_move_[row.b];
+  const Vec3 d = (mb.p - ma.p) + (mb.q * row.rb - row.rb) - (ma.q * row.ra - row.ra);
+  return row.separation + row.n.dot(d);
+}
+
+void ContactSolver::prepareSoft(const std::vector<Contact>& contacts, const ResponseOptions& options, double dt) {
+  forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      Row& row = rows_[r];
+      RowInfo& info = info_[r];
+      const Contact& c = contacts[info.contact];
+      row.separation = c.separation;
+      row.slop = options.allowed_penetration > 0.0 ? options.allowed_penetration : 0.02 * c.sphere_bound;
+      // Wave 0 of the restitution as prepare() classifies it, but from the
+      // gap at the tick's start: a contact bounces when it closes that gap
+      // this tick faster than the threshold.
+      const double s = separationNow(row);
+      row.speculative = s > 0.0 ? s / dt : 0.0;
+      info.bounced = info.restitution > 0.0 && info.approach < -std::max(options.restitution_threshold, row.speculative);
+      info.wave = info.bounced ? 0 : -1;
+      wave_flag_[r] = info.bounced ? 1 : 0;
+    }
+  });
+}
+
+void ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt, bool hold) {
+  const int count = options.substeps;
+  const double h = dt / count;
+  SoftPass pass;
+  const double hertz = std::min(options.contact_hertz, 0.25 / h);
+  pass.moving = makeSoftness(hertz, options.contact_damping_ratio, h);
+  pass.immovable = makeSoftness(2.0 * hertz, options.contact_damping_ratio, h);
+  pass.inv_h = 1.0 / h;
+  pass.max_push = options.max_push_speed;
+  const double share = 1.0 / count;
+  const std::size_t body_count = bodies.size();
+  const auto softStep = [&](std::size_t r, Motion& a, Motion& b) { softRow(rows_[r], separationNow(rows_[r]), pass, a, b); };
+  const auto relaxStep = [&](std::size_t r, Motion& a, Motion& b) {
+    Row& row = rows_[r];
+    softRow(row, separationNow(row), pass, a, b);
+    RowInfo& info = info_[r];  // this substep's impulses are final
+    for (int k = 0; k < 3; ++k) info.soft_total[k] += row.lambda[k];
+  };
+  const auto roll = [&](std::size_t m, Motion& a, Motion& b) {
+    if (rolling_[m].per_normal != 0.0) resistRolling(rolling_[m], normalImpulse(m), a, b);
+  };
+  // The impulses so far again, as each substep's warm start.
+  const auto warmStep = [&](std::size_t r, Motion& a, Motion& b) {
+    const Row& row = rows_[r];
+    applyNormal(row, row.lambda[0], a, b);
+    applyFriction(row, row.lambda[1], row.lambda[2], a, b);
+  };
+  const auto warmRoll = [&](std::size_t m, Motion& a, Motion& b) {
+    const Rolling& rl = rolling_[m];
+    if (rl.per_normal == 0.0) return;
+    a.w -= rl.inv_ia * rl.lambda;
+    b.w += rl.inv_ib * rl.lambda;
+  };
+  const auto pass_over = [&](auto& step) {
+    forEachStage([&](std::size_t first, std::size_t end) {
+      if (any_rolling_) {
+        overManifolds(first, end, motion_, step, roll);
+      } else {
+        overManifolds(first, end, motion_, step);
+      }
+    });
+  };
+  for (int sub = 0; sub < count; ++sub) {
+    // Each body alone: its share of the integration's gain, then (after the
+    // biased pass) its move by h.
+    forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        if (bodies[i].is_static) continue;
+        motion_[i].v += share * soft_gain_[i].v;
+        motion_[i].w += share * soft_gain_[i].w;
+      }
+    });
+    if (sub > 0 && !rows_.empty()) {
+      forEachStage([&](std::size_t first, std::size_t end) {
+        if (any_rolling_) {
+          overManifolds(first, end, motion_, warmStep, warmRoll);
+        } else {
+          overManifolds(first, end, motion_, warmStep);
+        }
+      });
+    }
+    pass.bias = true;
+    if (!rows_.empty()) pass_over(softStep);
+    if (hold) holdSupports(options, h);
+    forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        BodyState& body = bodies[i];
+        if (body.is_static) continue;
+        body.pose.position += motion_[i].v * h;
+        if (!motion_[i].w.isZero(0.0)) {  // the torque-free turn of h (the gyroscopic term's, energy kept)
+          body.angular_velocity = motion_[i].w;
+          const FreeRotation turned = rotateFreely(body, h, options.gyroscopic);
+          body.pose.orientation = turned.orientation;
+          motion_[i].w = turned.angular_velocity;
+        }
+        soft_move_[i].p = body.pose.position - soft_found_[i].position;
+        soft_move_[i].q = body.pose.orientation * soft_found_[i].orientation.conjugate();
+      }
+    });
+    pass.bias = false;
+    if (!rows_.empty()) pass_over(relaxStep);
+    if (sub == 0 && !rows_.empty()) {
+      // The bounce bounds friction in the first substep only: it acted once.
+      forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t r = begin; r < end; ++r) {
+          info_[r].soft_bounce = rows_[r].bounce_impulse;
+          rows_[r].bounce_impulse = 0.0;
+        }
+      });
+    }
+  }
+}
+
+// Shock propagation inside the substep, before the move: one sweep up the
+// levels from the ground with each row's supporting body held, so that no
+// body moves into what supports it however heavy its load. Its impulses move
+// the upper bodies only and are not kept: the impulses so far (the next
+// substep's warm start) stay the passes', which reach both bodies, so a
+// support still learns its load.
+void ContactSolver::holdSupports(const ResponseOptions& options, double h) {
+  forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      Row& row = rows_[r];
+      RowInfo& info = info_[r];
+      const double s = separationNow(row);
+      row.speculative = s > 0.0 ? s / h : 0.0;  // shock propagation's gap: this substep's
+      for (int k = 0; k < 3; ++k) info.soft_kept[k] = row.lambda[k];
+    }
+  });
+  ResponseOptions once = options;
+  once.iterations = 2;  // max(2, iterations / 2) passes a level: two
+  propagateShock(once);
+  forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      for (int k = 0; k < 3; ++k) rows_[r].lambda[k] = info_[r].soft_kept[k];
+    }
+  });
+}
+
+SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
+                                    const ResponseOptions& options, double dt, const std::vector<Pose>& start_poses,
+                                    const std::vector<Vec3>& start_v, const std::vector<Vec3>& start_w) {
+  SolveStats stats;
+  if (!(dt > 0.0) || bodies.empty()) return stats;
+  assert(start_poses.size() >= bodies.size() && start_v.size() >= bodies.size() && start_w.size() >= bodies.size());
+  for (Contact& c : contacts) {
+    c.normal_impulse = 0.0;
+    c.friction_impulse.setZero();
+  }
+  const std::size_t body_count = bodies.size();
+  soft_gain_.resize(body_count);
+  soft_move_.resize(body_count);
+  soft_found_.resize(body_count);
+  // Velocities back to the tick's start (the rows' approach is measured from
+  // them); the poses stay where the contacts were found until prepared.
+  forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      BodyState& body = bodies[i];
+      soft_move_[i] = SoftMove{};
+      soft_found_[i] = body.pose;
+      if (body.is_static) continue;
+      soft_gain_[i].v = body.linear_velocity - start_v[i];
+      soft_gain_[i].w = Vec3::Zero();  // the gyroscopic turn comes substep by substep (substeps())
+      body.linear_velocity = start_v[i];
+      body.angular_velocity = start_w[i];
+    }
+  });
+  ResponseOptions sequential = options;
+  sequential.wide_passes = false;  // the soft passes take one manifold at a time
+  prepare(bodies, contacts, sequential, dt, stats);
+  // The poses back to the tick's start: the moves since the contacts' poses.
+  forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      BodyState& body = bodies[i];
+      if (body.is_static) continue;
+      body.pose = start_poses[i];
+      soft_move_[i].p = body.pose.position - soft_found_[i].position;
+      soft_move_[i].q = body.pose.orientation * soft_found_[i].orientation.conjugate();
+    }
+  });
+  if (!rows_.empty()) prepareSoft(contacts, options, dt);
+  // A heavy body on a much lighter support (the support nearer the ground).
+  std::atomic<bool> heavy_on_light{false};
+  if (options.shock_propagation && !rows_.empty() && shockLevels() > 0) {
+    forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+      bool found = false;
+      for (std::size_t r = begin; r < end && !found; ++r) {
+        const Row& row = rows_[r];
+        const RowInfo& info = info_[r];
+        found = (!info.move_a && row.inv_mb > 0.0 && row.inv_ma >= kHeavyOnLight * row.inv_mb) ||
+                (!info.move_b && row.inv_ma > 0.0 && row.inv_mb >= kHeavyOnLight * row.inv_ma);
+      }
+      if (found) heavy_on_light.store(true, std::memory_order_relaxed);
+    });
+  }
+  const bool hold = heavy_on_light.load();
+  const auto run = [&] {
+    if (!rows_.empty()) {
+      collide(sequential, stats);
+      if (options.warm_starting) warmStart(contacts, bodies, stats);
+    }
+    substeps(bodies, options, dt, hold);
+  };
+  if (workers_ != nullptr) {
+    workers_->withTeam([&](Team& team) {
+      team_ = &team;
+      run();
+      team_ = nullptr;
+    });
+  } else {
+    run();
+  }
+  stats.velocity_passes = rows_.empty() ? 0 : 2 * options.substeps;
+  // The warm start keeps the last substep's impulses; the contacts report the tick's.
+  forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      Row& row = rows_[r];
+      RowInfo& info = info_[r];
+      info.lambda_main = row.lambda[0];
+      info.friction_main[0] = row.lambda[1];
+      info.friction_main[1] = row.lambda[2];
+      for (int k = 0; k < 3; ++k) row.lambda[k] = info.soft_total[k];
+      row.bounce_impulse = info.soft_bounce;
+    }
+  });
+  forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!bodies[i].is_static) refreshWorldInertia(bodies[i]);
+    }
+  });
+  if (rows_.empty()) {
+    forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        if (bodies[i].is_static) continue;
+        bodies[i].linear_velocity = motion_[i].v;
+        bodies[i].angular_velocity = motion_[i].w;
+      }
+    });
+    next_cache_.clear();
+    next_manifolds_.clear();
+    keepHeldManifolds(bodies);
+    return stats;
+  }
+  store(bodies, contacts, dt);  // pseudo-velocities are zero: velocities and the cache alone
+  if (!options.warm_starting) forget();
+  return stats;
+}
+
+}  // namespace stc
