@@ -6,6 +6,7 @@
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/entity_table.hpp"
 #include "sphere_tree_collision/fracture.hpp"
 #include "sphere_tree_collision/island_levels.hpp"
 #include "sphere_tree_collision/islands.hpp"
@@ -32,19 +33,7 @@
 
 namespace stc {
 
-namespace detail {
-class FlatHashMap;  // src/core/flat_hash_map.hpp
-}  // namespace detail
-
-using ShapeId = std::uint32_t;
-
-// How an entity's broad-phase box is made (paper 3.2).
-enum class BoxMode : std::uint8_t {
-  Auto,     // chosen from the shape: Dynamic when elongated, else FixedCube
-  FixedCube,  // cube big enough for any orientation; only moves with the centre
-  Dynamic,    // tight AABB of the rotated root-level spheres, recomputed each tick
-};
-// "auto" | "fixed" | "dynamic"; throws InputError("box_mode").
+// BoxMode (entity_table.hpp): "auto" | "fixed" | "dynamic"; throws InputError("box_mode").
 BoxMode parseBoxMode(const std::string& name);
 
 struct WorldConfig {
@@ -174,7 +163,10 @@ struct ShapeInfo {
   bool elongated = false;     // Auto box mode picks Dynamic
 };
 
-class World {
+// The entities' rows are an EntityTable (entity_table.hpp), a private base:
+// what World adds to them is the validation, and the parts that follow
+// each add and remove.
+class World : private EntityTable {
  public:
   explicit World(const WorldConfig& config = WorldConfig{});
   ~World();
@@ -193,7 +185,7 @@ class World {
   // for a value beyond config().limits, the limit; on throw nothing changes.
   EntityId addEntity(const EntitySpec& spec);
   bool removeEntity(EntityId id);
-  std::optional<EntityId> findByName(const std::string& name) const;
+  using EntityTable::findByName;
   void clear();  // removes every entity, keeps shapes
 
   // Breaks a body as an impact at `point` along `normal` (world frame) would
@@ -240,13 +232,12 @@ class World {
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.
   // A sleeping body's pose or velocity edited here wakes its island at the next step.
-  std::size_t entityCount() const { return ids_.size(); }
-  const std::vector<EntityId>& entityIds() const { return ids_; }
-  const std::vector<BodyState>& bodies() const { return bodies_; }
-  std::vector<BodyState>& bodies() { return bodies_; }
-  const std::vector<ShapeId>& bodyShapes() const { return body_shapes_; }
-  const std::vector<std::string>& bodyNames() const { return names_; }
-  std::optional<std::size_t> indexOf(EntityId id) const;
+  using EntityTable::entityCount;
+  using EntityTable::entityIds;
+  using EntityTable::bodies;
+  using EntityTable::bodyShapes;
+  using EntityTable::bodyNames;
+  using EntityTable::indexOf;
 
   // Narrow-phase results of the last step: pairTests()[0..pairCount()).
   const std::vector<PairTest>& pairTests() const { return pair_tests_; }
@@ -322,19 +313,9 @@ class World {
   std::vector<CoverShape> cover_shapes_;  // by shape id: what StaticCover reads of each
   std::unordered_map<std::string, ShapeId> shape_by_key_;
 
-  // Entities: flat arrays indexed densely; ids_ maps dense -> id.
-  std::vector<EntityId> ids_;
-  std::vector<BodyState> bodies_;
-  std::vector<ShapeId> body_shapes_;
-  std::vector<BoxMode> box_modes_;
-  std::vector<std::string> names_;
+  // The entities' rows: the EntityTable base (ids_, bodies_, body_shapes_,
+  // box_modes_, names_, index_of_).
   StaticCover static_cover_;  // static bodies' faces other static bodies cover, by dense index
-  // Entity id -> dense index, open addressing on flat arrays: the pair walk
-  // of every tick looks up two per broad-phase pair (a settled pile of 5,000
-  // rocks: ~50,000 pairs; docs/sleeping.md).
-  std::unique_ptr<detail::FlatHashMap> index_of_;
-  std::unordered_map<std::string, EntityId> id_by_name_;
-  EntityId next_id_ = 0;
 
   SweepAndPrune broad_phase_;
   std::vector<Aabb> boxes_;  // this tick's box of each body, by dense index (pooled)

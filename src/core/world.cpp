@@ -81,7 +81,6 @@ World::World(const WorldConfig& config)
       narrow_chunks_(makeNarrowChunks(narrowChunkCount(static_cast<std::size_t>(workers_.threads()), false),
                                       config.scheduler)),
       narrow_chunks_used_(static_cast<std::size_t>(workers_.threads())) {
-  index_of_ = std::make_unique<detail::FlatHashMap>();
   validateLimits(config_.limits);
   validateMeshLimits(config_.mesh_limits);
   validateGravity(config_.gravity, config_.limits);
@@ -150,14 +149,14 @@ EntityId World::addEntity(const EntitySpec& spec) {
   }
   validateBodyInput(spec.pose, spec.linear_velocity, spec.angular_velocity, spec.density,
                     spec.material, config_.limits);
-  if (!spec.name.empty() && id_by_name_.count(spec.name) != 0) {
+  if (!spec.name.empty() && findByName(spec.name)) {
     throw InputError("name", "'" + spec.name + "' is already used");
   }
   if (spec.closed_faces > kAllFaces || (spec.closed_faces != 0 && !spec.is_static)) {
     throw InputError("closed_faces", "static bodies only, a mask of faceBit values (at most " +
                                          std::to_string(kAllFaces) + ")");
   }
-  if (ids_.size() >= config_.max_entities || next_id_ == kInvalidEntity) {
+  if (ids_.size() >= config_.max_entities || !idsLeft()) {
     throw InputError("max_entities", "the world holds " + std::to_string(config_.max_entities) +
                                          " entities at most");
   }
@@ -179,20 +178,13 @@ EntityId World::addEntity(const EntitySpec& spec) {
   BoxMode mode = spec.box_mode;
   if (mode == BoxMode::Auto) mode = info.elongated ? BoxMode::Dynamic : BoxMode::FixedCube;
 
-  const EntityId id = next_id_;
-  const std::size_t index = ids_.size();
-  ids_.push_back(id);
-  bodies_.push_back(body);
-  body_shapes_.push_back(spec.shape);
-  box_modes_.push_back(mode);
-  names_.push_back(spec.name);
+  // The row, then what follows it.
+  const EntityId id = addRow(body, spec.shape, mode, spec.name);
+  const std::size_t index = ids_.size() - 1;
   static_cover_.add(body, spec.closed_faces);
-  index_of_->set(id, static_cast<std::uint32_t>(index));
-  if (!spec.name.empty()) id_by_name_.emplace(spec.name, id);
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
   islands_.add(info.bounding_radius);
   levels_.add();
-  ++next_id_;
   if (spec.is_static) physics_.forgetReuse();  // its neighbours' covered faces change
   invalidateLastTick();
   return id;
@@ -213,47 +205,15 @@ bool World::removeEntity(EntityId id) {
   levels_.remove(index, last);
   static_cover_.remove(index, last);
   broad_phase_.remove(id);
-  if (!names_[index].empty()) id_by_name_.erase(names_[index]);
-  index_of_->erase(id);
-  if (index != last) {  // swap-remove keeps the arrays dense
-    ids_[index] = ids_[last];
-    bodies_[index] = bodies_[last];
-    body_shapes_[index] = body_shapes_[last];
-    box_modes_[index] = box_modes_[last];
-    names_[index] = std::move(names_[last]);
-    index_of_->set(ids_[index], static_cast<std::uint32_t>(index));
-  }
+  removeRow(index);  // swap-remove, as the three above
   pairs_seen_.clear();  // a dense index moved
-  ids_.pop_back();
-  bodies_.pop_back();
-  body_shapes_.pop_back();
-  box_modes_.pop_back();
-  names_.pop_back();
   invalidateLastTick();
   return true;
 }
 
-std::optional<EntityId> World::findByName(const std::string& name) const {
-  const auto it = id_by_name_.find(name);
-  if (it == id_by_name_.end()) return std::nullopt;
-  return it->second;
-}
-
-std::optional<std::size_t> World::indexOf(EntityId id) const {
-  const std::uint32_t found = index_of_->find(id);
-  if (found == detail::FlatHashMap::kMissing) return std::nullopt;
-  return static_cast<std::size_t>(found);
-}
-
 void World::clear() {
-  ids_.clear();
-  bodies_.clear();
-  body_shapes_.clear();
-  box_modes_.clear();
-  names_.clear();
-  *index_of_ = detail::FlatHashMap();
+  clearRows();
   pairs_seen_.clear();
-  id_by_name_.clear();
   broad_phase_ = SweepAndPrune();
   islands_.clear();
   levels_.clear();

@@ -71,7 +71,7 @@ std::vector<EntityId> World::placePieces(std::size_t index, std::vector<VoxelPie
     if (!parent_name.empty()) {
       do {
         spec.name = parent_name + "/piece" + std::to_string(next_name++);
-      } while (id_by_name_.count(spec.name) != 0);
+      } while (findByName(spec.name));
     }
     // A piece the limits would reject (its rim faster than max_speed, say)
     // keeps the body whole: nothing is removed that cannot be replaced.
