@@ -319,6 +319,7 @@ class World : private EntityTable {
 
   SweepAndPrune broad_phase_;
   std::vector<Aabb> boxes_;  // this tick's box of each body, by dense index (pooled)
+  std::vector<EntityId> partners_;  // removeEntity: the broad-phase partners of the removed body (pooled)
   // The narrow phase's chunks, as many as it ever cuts (narrow_chunks.hpp): a
   // scheduler each and the arena of its pair tests' hits; in a vector made
   // once, so the arenas keep their address when the World is moved (the pair

@@ -195,9 +195,9 @@ bool World::removeEntity(EntityId id) {
   if (found == detail::FlatHashMap::kMissing) return false;
   const std::size_t index = found;
   const std::size_t last = ids_.size() - 1;
-  for (const BroadPair& pair : broad_phase_.pairs()) {  // what it touched loses it: wakes
-    if (pair.first != id && pair.second != id) continue;
-    const std::uint32_t other = index_of_->find(pair.first == id ? pair.second : pair.first);
+  broad_phase_.partnersOf(id, &partners_);  // its own pairs, not all
+  for (const EntityId partner : partners_) {  // what it touched loses it: wakes
+    const std::uint32_t other = index_of_->find(partner);
     if (other != detail::FlatHashMap::kMissing) islands_.wake(other);  // missing: removed since the last update
   }
   if (bodies_[index].is_static) physics_.forgetReuse();  // its neighbours' covered faces change
