@@ -26,8 +26,6 @@ namespace detail {
 class FlatHashMap;  // src/core/flat_hash_map.hpp
 }  // namespace detail
 
-using ShapeId = std::uint32_t;
-
 // How an entity's broad-phase box is made (paper 3.2).
 enum class BoxMode : std::uint8_t {
   Auto,     // chosen from the shape: Dynamic when elongated, else FixedCube

@@ -1,4 +1,6 @@
-// World: owns shapes, trees, entities and the phases; step() runs one tick:
+// World: composes the shapes (ShapeLibrary), the entities' rows
+// (EntityTable), what follows them, fracture (WorldFracture) and the phases;
+// step() runs one tick:
 //   1 integrate  2 broad phase  3 narrow phase + scheduler  4 response
 // and returns a TickReport. Each phase reads what the previous one wrote.
 #pragma once
@@ -16,6 +18,7 @@
 #include "sphere_tree_collision/perception.hpp"
 #include "sphere_tree_collision/response.hpp"
 #include "sphere_tree_collision/scheduler.hpp"
+#include "sphere_tree_collision/shape_library.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/static_cover.hpp"
 #include "sphere_tree_collision/sweep_and_prune.hpp"
@@ -23,7 +26,6 @@
 #include "sphere_tree_collision/workers.hpp"
 
 #include <array>
-#include <deque>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -153,31 +155,24 @@ struct BrokenEntity {
   std::vector<EntityId> pieces;
 };
 
-struct ShapeInfo {
-  std::string key;
-  VoxelShape voxels;
-  MassProperties unit_mass;   // density 1
-  Vec3 body_origin;           // centre of mass in the grid frame
-  SphereTree tree;
-  double bounding_radius = 0; // max distance from the body origin to the shape
-  bool elongated = false;     // Auto box mode picks Dynamic
-};
+class WorldFracture;  // src/core/world_fracture.hpp
 
-// The entities' rows are an EntityTable (entity_table.hpp), a private base:
-// what World adds to them is the validation, and the parts that follow
-// each add and remove.
-class World : private EntityTable {
+// The shapes are a ShapeLibrary (shape_library.hpp) and the entities' rows
+// an EntityTable (entity_table.hpp), private bases: what World adds to them
+// is the validation, and the parts that follow each add and remove.
+class World : private ShapeLibrary, private EntityTable {
  public:
   explicit World(const WorldConfig& config = WorldConfig{});
   ~World();
   World(World&&) noexcept;
   World& operator=(World&&) noexcept;
 
-  // Shapes are shared: the same key returns the same id (the tree is built once).
+  // Shapes are shared: the same key returns the same id (the tree is built
+  // once, under config().voxel_limits and config().tree; ShapeLibrary).
   ShapeId addShape(const std::string& key, VoxelShape shape);
-  std::optional<ShapeId> findShape(const std::string& key) const;
-  const ShapeInfo& shape(ShapeId id) const;
-  std::size_t shapeCount() const { return shapes_.size(); }
+  using ShapeLibrary::findShape;
+  using ShapeLibrary::shape;
+  using ShapeLibrary::shapeCount;
 
   // Throws InputError naming the field ("shape", "pose.position",
   // "pose.orientation", "linear_velocity", "angular_velocity", "density",
@@ -207,7 +202,7 @@ class World : private EntityTable {
   // The entities the last step removed, with the reason.
   const std::vector<QuarantinedEntity>& quarantined() const { return quarantined_; }
   // The bodies the last step (and breakEntity since) broke, with their pieces.
-  const std::vector<BrokenEntity>& broken() const { return broken_; }
+  const std::vector<BrokenEntity>& broken() const;
 
   Perception& perception() { return perception_; }
   const Perception& perception() const { return perception_; }
@@ -268,25 +263,10 @@ class World : private EntityTable {
   // First and last: removes bodies beyond the limits; bodies flagged in
   // `unchanged` (held through the tick) are not looked at again.
   void quarantine(TickReport& report, const std::vector<std::uint8_t>* unchanged = nullptr);
-  // After the response: bodies hit harder than their strength are queued in
-  // pending_breaks_. A break is made once its pieces' trees exist; a tree is
-  // built only when its estimated cost (tree_cost_) fits before the tick's
-  // deadline, but for one tree at each tick's start, so the queue always
-  // moves (world_fracture.cpp). Both take the clock at their start and return
-  // it at their end, reading it only when there is something to break.
+  // Fracture after the response, and the breaks that waited, at the tick's
+  // start (WorldFracture::fracture / breakPending, world_fracture.cpp).
   double fracture(double now, const Deadline& tick_end, TickReport& report);
   double breakPending(double now, const Deadline& tick_end, TickReport& report);
-  void breakQueued(const Deadline& trees_until, bool one_tree_anyway, TickReport& report);
-  // The fracture plane of an impact at `point` along `normal` (world frame)
-  // on body `index`, in its grid frame (fracturePlane).
-  SplitPlane gridPlaneOf(std::size_t index, const Vec3& point, const Vec3& normal) const;
-  // The split of body `index` by `plane` (its grid frame): its pieces, or
-  // nothing when it stays whole.
-  std::vector<VoxelPiece> piecesOf(std::size_t index, const SplitPlane& plane) const;
-  // A piece's shape: the one with its voxels, or std::nullopt (*key: the key to add it by).
-  std::optional<ShapeId> findPieceShape(const VoxelShape& voxels, std::string* key) const;
-  // Replaces body `index` by `pieces`; their trees are built here if missing.
-  std::vector<EntityId> placePieces(std::size_t index, std::vector<VoxelPiece>& pieces);
   // What the physics phases read and write this tick (physics.hpp); each
   // phase sets what is its own (dt, the solver's budget).
   StepContext physicsStep();
@@ -308,11 +288,7 @@ class World : private EntityTable {
 
   WorldConfig config_;
   Workers workers_;  // before the phases that use it
-  std::deque<ShapeInfo> shapes_;  // deque: trees keep their address as shapes are added
-  std::deque<ShapeBounds> shape_bounds_;  // by shape id, built in addShape; they point at the trees
-  std::vector<CoverShape> cover_shapes_;  // by shape id: what StaticCover reads of each
-  std::unordered_map<std::string, ShapeId> shape_by_key_;
-
+  // The shapes: the ShapeLibrary base (shapes_, shape_bounds_, cover_shapes_).
   // The entities' rows: the EntityTable base (ids_, bodies_, body_shapes_,
   // box_modes_, names_, index_of_).
   StaticCover static_cover_;  // static bodies' faces other static bodies cover, by dense index
@@ -355,23 +331,7 @@ class World : private EntityTable {
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step
   std::vector<std::uint8_t> held_through_tick_;  // step: Islands::held() before endTick (pooled)
-  // A break waiting for its pieces' trees: the plane in the body's grid
-  // frame, so the split is the same whenever it is made.
-  struct PendingBreak {
-    EntityId id = kInvalidEntity;
-    SplitPlane plane;
-  };
-  std::vector<PendingBreak> pending_breaks_;
-  TreeCostEstimate tree_cost_;  // of the pieces' trees built so far
-  std::vector<BrokenEntity> broken_;  // since the last step began
-  // Contact impulses on each body this tick (by dense index; ticks with a
-  // breakable body in contact only), pooled.
-  struct BodyHits {
-    double impulse = 0.0;          // summed, N s
-    double hardest_impulse = 0.0;  // of the contact with the largest impulse
-    std::int32_t hardest = -1;     // that contact
-  };
-  std::vector<BodyHits> hits_;
+  std::unique_ptr<WorldFracture> fracture_;  // its queue, tree costs and what broke
 };
 
 }  // namespace stc
