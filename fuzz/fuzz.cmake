@@ -1,15 +1,14 @@
 # libFuzzer targets, built by scripts/fuzz.sh in its own build directory with
 # clang, -DSTC_FUZZ=ON and ASan + UBSan + fuzzer-no-link in CMAKE_CXX_FLAGS
 # (so stc_core is instrumented too). fuzz/fuzz_NAME.cpp -> executable fuzz_NAME.
-# The ROS-free parts of src/ros they reach (requests, scene files, message
-# conversion) are compiled in directly: no node, no ROS master.
+# Requests and scene files (stc_scene, ROS-free) and the two files of src/ros
+# they meet (message conversion, package:// resolution) are compiled in
+# directly: no node, no ROS master.
 add_library(stc_fuzz_ros STATIC
-  ${PROJECT_SOURCE_DIR}/src/ros/entity_request.cpp
-  ${PROJECT_SOURCE_DIR}/src/ros/scene_file.cpp
   ${PROJECT_SOURCE_DIR}/src/ros/conversions.cpp
   ${PROJECT_SOURCE_DIR}/src/ros/mesh_resource.cpp)
 target_include_directories(stc_fuzz_ros PUBLIC ${PROJECT_SOURCE_DIR}/include ${PROJECT_SOURCE_DIR}/src/ros/include)
-target_link_libraries(stc_fuzz_ros stc_core yaml-cpp ${catkin_LIBRARIES})
+target_link_libraries(stc_fuzz_ros stc_core stc_scene ${catkin_LIBRARIES})
 # Mesh entities: assimp loading and package:// resolution.
 target_link_libraries(stc_fuzz_ros stc_mesh ${roslib_LIBRARIES})
 target_include_directories(stc_fuzz_ros SYSTEM PRIVATE ${roslib_INCLUDE_DIRS})

@@ -3,15 +3,15 @@
 // count equal to what was added minus what was removed (despawned or
 // quarantined), and the broad phase's pairs equal to a brute-force check.
 #include "fuzz_support.hpp"
-#include "sphere_tree_collision/ros/entity_request.hpp"
+#include "sphere_tree_collision/scene/entity_request.hpp"
 
 #include <vector>
 
 namespace {
 
-stc_ros::EntityRequest pickEntity(FuzzedDataProvider& in) {
+stc::EntityRequest pickEntity(FuzzedDataProvider& in) {
   static const char* const kPresets[] = {"cube", "sphere", "rock", "rod", "plate", "L", "ring"};
-  stc_ros::EntityRequest r;
+  stc::EntityRequest r;
   r.preset = kPresets[in.ConsumeIntegralInRange<std::size_t>(0, std::size(kPresets) - 1)];
   r.preset_params.resolution = in.ConsumeIntegralInRange<int>(1, 10);
   r.preset_params.voxel_size = in.ConsumeBool() ? 0.05 : stc_fuzz::pickDouble(in, 0.01, 0.3);
@@ -45,7 +45,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 0:
       case 1:
         try {
-          stc_ros::addRequest(world, pickEntity(in));
+          stc::addRequest(world, pickEntity(in));
           ++expected;
         } catch (const stc::InputError&) {
         }

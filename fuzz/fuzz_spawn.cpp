@@ -3,6 +3,7 @@
 // stc::InputError may come out; the world must stay within its limits.
 #include "fuzz_support.hpp"
 #include "sphere_tree_collision/ros/conversions.hpp"
+#include "sphere_tree_collision/ros/mesh_resource.hpp"
 
 namespace {
 
@@ -59,7 +60,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
     const std::size_t before = world.entityCount();
     try {
-      stc_ros::addRequest(world, stc_ros::toEntityRequest(msg));
+      stc::addRequest(world, stc_ros::toEntityRequest(msg), {}, stc_ros::resolveMeshResource);
       stc_fuzz::require(world.entityCount() == before + 1, "accepted spawn did not add one entity");
     } catch (const stc::InputError&) {
       stc_fuzz::require(world.entityCount() == before, "rejected spawn changed the entity count");

@@ -49,12 +49,15 @@ struct Aabb {
 // "occupancy", "preset") so callers can report it verbatim.
 class InputError : public std::invalid_argument {
  public:
-  InputError(std::string field, const std::string& message)
-      : std::invalid_argument(field + ": " + message), field_(std::move(field)) {}
+  InputError(std::string field, std::string reason)
+      : std::invalid_argument(field + ": " + reason), field_(std::move(field)), reason_(std::move(reason)) {}
   const std::string& field() const { return field_; }
+  // What is wrong with the field, without its name (to name it otherwise).
+  const std::string& reason() const { return reason_; }
 
  private:
   std::string field_;
+  std::string reason_;
 };
 
 inline bool allFinite(const Vec3& v) { return v.allFinite(); }

@@ -179,6 +179,9 @@ class World : private ShapeLibrary, private EntityTable {
   // "material.restitution", "material.friction", "name", "max_entities") and,
   // for a value beyond config().limits, the limit; on throw nothing changes.
   EntityId addEntity(const EntitySpec& spec);
+  // What addEntity checks but the shape id, for a request whose shape is not
+  // built yet: the same errors, in the same order.
+  void validateEntity(const EntitySpec& spec) const;
   bool removeEntity(EntityId id);
   using EntityTable::findByName;
   void clear();  // removes every entity, keeps shapes

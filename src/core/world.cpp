@@ -63,11 +63,7 @@ ShapeId World::addShape(const std::string& key, VoxelShape voxels) {
 // ---------------------------------------------------------------------------------
 // Entities
 
-EntityId World::addEntity(const EntitySpec& spec) {
-  // Validate everything first: on throw nothing has changed.
-  if (spec.shape >= shapes_.size()) {
-    throw InputError("shape", "unknown shape id " + std::to_string(spec.shape));
-  }
+void World::validateEntity(const EntitySpec& spec) const {
   validateBodyInput(spec.pose, spec.linear_velocity, spec.angular_velocity, spec.density,
                     spec.material, config_.limits);
   if (!spec.name.empty() && findByName(spec.name)) {
@@ -81,6 +77,14 @@ EntityId World::addEntity(const EntitySpec& spec) {
     throw InputError("max_entities", "the world holds " + std::to_string(config_.max_entities) +
                                          " entities at most");
   }
+}
+
+EntityId World::addEntity(const EntitySpec& spec) {
+  // Validate everything first: on throw nothing has changed.
+  if (spec.shape >= shapes_.size()) {
+    throw InputError("shape", "unknown shape id " + std::to_string(spec.shape));
+  }
+  validateEntity(spec);
 
   const ShapeInfo& info = shapes_[spec.shape];
   BodyState body;

@@ -6,6 +6,7 @@
 
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <climits>
 #include <map>
 
@@ -72,44 +73,27 @@ std_msgs::ColorRGBA toColorMsg(float r, float g, float b, float a) {
   return c;
 }
 
-std::string reasonOf(const stc::InputError& error) {
-  const std::string what = error.what();
-  const std::string prefix = error.field() + ": ";
-  return what.compare(0, prefix.size(), prefix) == 0 ? what.substr(prefix.size()) : what;
-}
-
-EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg) {
-  EntityRequest r;
+stc::EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg) {
+  // Field for field; which shape source, and what belongs to it, is
+  // stc::validateRequest's to judge, as for a scene file.
+  stc::EntityRequest r;
   r.spec.name = msg.name;
-  const bool has_grid = msg.dims[0] != 0 || msg.dims[1] != 0 || msg.dims[2] != 0 || !msg.occupancy.empty();
-  if (!msg.mesh_resource.empty()) {
-    if (!msg.preset.empty() || has_grid) {
-      throw stc::InputError("mesh_resource", "give one of a mesh, a preset or dims + occupancy");
-    }
-    r.mesh_resource = msg.mesh_resource;
-    const stc::Vec3 scale = toEigen(msg.scale);
-    r.mesh_scale = scale.isZero(0.0) ? stc::Vec3::Ones() : scale;
-    r.mesh_voxel_size = msg.voxel_size;
-    r.mesh_up_axis = stc::parseColladaUpAxis(msg.up_axis);
-    if (msg.resolution > 1024) throw stc::InputError("resolution", "must be <= 1024 for a mesh");
-    r.preset_params.resolution = static_cast<int>(msg.resolution);  // 0: the default (addRequest)
-  } else if (!msg.up_axis.empty()) {
-    throw stc::InputError("up_axis", "only for a mesh_resource");
-  } else if (!msg.preset.empty()) {
-    if (has_grid) throw stc::InputError("preset", "give either a preset or dims + occupancy, not both");
-    r.preset = msg.preset;
-    if (msg.resolution > 4096) throw stc::InputError("resolution", "must be <= 4096");
-    r.preset_params.resolution = static_cast<int>(msg.resolution);  // 0: the default (addRequest)
-    r.preset_params.voxel_size = msg.voxel_size;
-    r.preset_params.seed = msg.seed;
-  } else {
-    if (!has_grid) throw stc::InputError("preset", "empty: give a preset or dims + occupancy");
+  r.preset = msg.preset;
+  r.mesh_resource = msg.mesh_resource;
+  const stc::Vec3 scale = toEigen(msg.scale);
+  if (!scale.isZero(0.0)) r.mesh_scale = scale;
+  if (!msg.up_axis.empty()) r.mesh_up_axis = stc::parseColladaUpAxis(msg.up_axis);
+  // Beyond int, any resolution is refused as the largest one would be.
+  r.preset_params.resolution = static_cast<int>(std::min<std::uint32_t>(msg.resolution, INT_MAX));
+  r.preset_params.seed = msg.seed;
+  (msg.mesh_resource.empty() ? r.preset_params.voxel_size : r.mesh_voxel_size) = msg.voxel_size;
+  if (msg.dims[0] != 0 || msg.dims[1] != 0 || msg.dims[2] != 0 || !msg.occupancy.empty()) {
     for (std::uint32_t d : msg.dims) {
       if (d == 0 || d > static_cast<std::uint32_t>(INT_MAX)) {
         throw stc::InputError("dims", "each of nx, ny, nz must be in [1, " + std::to_string(INT_MAX) + "]");
       }
     }
-    ExplicitGrid grid;
+    stc::ExplicitGrid grid;
     grid.nx = static_cast<int>(msg.dims[0]);
     grid.ny = static_cast<int>(msg.dims[1]);
     grid.nz = static_cast<int>(msg.dims[2]);
@@ -128,7 +112,7 @@ EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg) {
   r.spec.is_static = msg.is_static;
   if (!msg.closed_faces.empty()) r.spec.closed_faces = stc::parseFaces(msg.closed_faces);
   const auto& c = msg.color;
-  if (c.r != 0.0f || c.g != 0.0f || c.b != 0.0f || c.a != 0.0f) r.color = Rgba{c.r, c.g, c.b, c.a};
+  if (c.r != 0.0f || c.g != 0.0f || c.b != 0.0f || c.a != 0.0f) r.color = stc::Rgba{c.r, c.g, c.b, c.a};
   return r;
 }
 

@@ -1,7 +1,7 @@
 #include "sphere_tree_collision/ros/entity_state_publisher.hpp"
 
 #include "sphere_tree_collision/ros/conversions.hpp"
-#include "sphere_tree_collision/ros/entity_request.hpp"
+#include "sphere_tree_collision/ros/entity_display.hpp"
 
 #include <sphere_tree_collision/EntityList.h>
 

@@ -57,7 +57,7 @@ void LiveTuning::onReconfigure(WorldConfig& config, std::uint32_t /*level*/) {
     ROS_INFO("reconfigured: scheduler %s, detection budget %g ms, %d sphere tests, tick budget %g ms",
              config.scheduler.c_str(), config.detection_budget, config.sphere_test_budget, config.tick_budget);
   } catch (const stc::InputError& e) {
-    ROS_ERROR("reconfigure refused: ~%s: %s (the configuration is unchanged)", e.field().c_str(), reasonOf(e).c_str());
+    ROS_ERROR("reconfigure refused: ~%s: %s (the configuration is unchanged)", e.field().c_str(), e.reason().c_str());
     config = configOf(tunableOf(current_));  // what the server keeps and answers
   }
 }

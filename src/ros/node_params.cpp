@@ -38,7 +38,7 @@ auto parsed(const std::string& name, F&& parse) {
   try {
     return parse();
   } catch (const InputError& e) {
-    throw InputError(name, reasonOf(e));
+    throw InputError(name, e.reason());
   }
 }
 
@@ -240,7 +240,7 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   try {
     stc::validateVoxelSize(p.defaults.voxel_size, voxels);
   } catch (const InputError& e) {
-    throw InputError("default_voxel_size", reasonOf(e));
+    throw InputError("default_voxel_size", e.reason());
   }
 
   readParam(nh, "camera_frame", p.camera.frame);

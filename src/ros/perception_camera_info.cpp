@@ -64,7 +64,7 @@ stc::Camera withIntrinsicsOf(const sensor_msgs::CameraInfo& info, const stc::Cam
   try {
     stc::validateCamera(out);
   } catch (const stc::InputError& e) {
-    throw stc::InputError("K", reasonOf(e));
+    throw stc::InputError("K", e.reason());
   }
   return out;
 }
@@ -95,7 +95,7 @@ void PerceptionCameraInfo::onCameraInfo(const sensor_msgs::CameraInfo& msg) {
     publish();
   } catch (const stc::InputError& e) {
     ROS_ERROR("rejected camera_info message: %s: %s (the camera is unchanged)", e.field().c_str(),
-              reasonOf(e).c_str());
+              e.reason().c_str());
   }
 }
 

@@ -1,7 +1,9 @@
 #include "sphere_tree_collision/ros/world_node.hpp"
 
 #include "sphere_tree_collision/ros/conversions.hpp"
-#include "sphere_tree_collision/ros/scene_file.hpp"
+#include "sphere_tree_collision/ros/entity_display.hpp"
+#include "sphere_tree_collision/ros/mesh_resource.hpp"
+#include "sphere_tree_collision/scene/scene_file.hpp"
 #include "sphere_tree_collision/ros/tick_fields.hpp"
 #include "sphere_tree_collision/perception_ray.hpp"
 #include "sphere_tree_collision/scenes.hpp"
@@ -143,23 +145,23 @@ stc::Pose WorldNode::loadScene() {
   stc::WorldConfig config = params_.world;
   stc::Pose camera_pose = stc::opticalLookAt(params_.camera.position, params_.camera.look_at);
   if (params_.scene.empty() || isSceneFile(params_.scene)) {
-    Scene scene;
+    stc::Scene scene;
     try {
-      scene = params_.scene.empty() ? parseSceneYaml(defaultSceneYaml()) : loadSceneYaml(params_.scene);
+      scene = params_.scene.empty() ? stc::parseSceneYaml(stc::defaultSceneYaml()) : stc::loadSceneYaml(params_.scene);
     } catch (const stc::InputError& e) {
-      throw stc::InputError(e.field() == "scene" ? "scene" : "scene " + e.field(), reasonOf(e));
+      throw stc::InputError(e.field() == "scene" ? "scene" : "scene " + e.field(), e.reason());
     }
     config.gravity = params_.gravity ? *params_.gravity : scene.gravity;
     try {
       world_ = stc::World(config);  // checks the scene's gravity against ~max_gravity
     } catch (const stc::InputError& e) {
-      throw stc::InputError("scene " + e.field(), reasonOf(e));
+      throw stc::InputError("scene " + e.field(), e.reason());
     }
     std::vector<stc::EntityId> ids;
     try {
-      ids = addScene(world_, scene, params_.defaults);
+      ids = stc::addScene(world_, scene, params_.defaults, resolveMeshResource);
     } catch (const stc::InputError& e) {
-      throw stc::InputError("scene " + e.field(), reasonOf(e));
+      throw stc::InputError("scene " + e.field(), e.reason());
     }
     for (std::size_t i = 0; i < ids.size(); ++i) {
       remember(ids[i], scene.entities[i].request.spec.name, scene.entities[i].request.color);
@@ -172,7 +174,7 @@ stc::Pose WorldNode::loadScene() {
   try {
     kind = stc::parseScene(params_.scene);
   } catch (const stc::InputError& e) {
-    throw stc::InputError("scene", reasonOf(e) + ", or a YAML file path");
+    throw stc::InputError("scene", e.reason() + ", or a YAML file path");
   }
   config.gravity = params_.gravity ? *params_.gravity : stc::sceneGravity(kind);
   world_ = stc::World(config);
@@ -185,7 +187,7 @@ stc::Pose WorldNode::loadScene() {
     spec = stc::populateScene(world_, kind, scene_params);
   } catch (const stc::InputError& e) {
     const std::string field = e.field() == "entities" ? "scene_entities" : e.field() == "entity_size" ? "entity_size" : e.field();
-    throw stc::InputError(field, reasonOf(e) + " (scene " + params_.scene + ")");
+    throw stc::InputError(field, e.reason() + " (scene " + params_.scene + ")");
   }
   for (stc::EntityId id : spec.walls) remember(id, "", kWallColor);
   for (stc::EntityId id : spec.movers) remember(id, "", std::nullopt);
@@ -432,15 +434,15 @@ void WorldNode::rejectUnexpected(Input input) {
 stc::EntityId WorldNode::spawnEntity(const sphere_tree_collision::SpawnEntity& msg) {
   const bool is_preset = !msg.preset.empty() || !msg.mesh_resource.empty();  // sized by resolution, not dims
   try {
-    EntityRequest request = toEntityRequest(msg);
+    stc::EntityRequest request = toEntityRequest(msg);
     const std::string name = request.spec.name;
     const std::optional<Rgba> color = request.color;
-    const stc::EntityId id = addRequest(world_, std::move(request), params_.defaults);
+    const stc::EntityId id = stc::addRequest(world_, std::move(request), params_.defaults, resolveMeshResource);
     remember(id, name, color);
     ROS_DEBUG("spawned entity %u (%s)", id, frames_[id].c_str());
     return id;
   } catch (const stc::InputError& e) {
-    throw stc::InputError(spawnFieldOf(e.field(), is_preset), reasonOf(e));
+    throw stc::InputError(spawnFieldOf(e.field(), is_preset), e.reason());
   }
 }
 
@@ -448,7 +450,7 @@ void WorldNode::onSpawn(const sphere_tree_collision::SpawnEntity& msg) {
   try {
     spawnEntity(msg);
   } catch (const stc::InputError& e) {
-    reject(Input::Spawn, e.field(), reasonOf(e));
+    reject(Input::Spawn, e.field(), e.reason());
   } catch (...) {
     rejectUnexpected(Input::Spawn);
   }
@@ -492,7 +494,7 @@ void WorldNode::onDespawn(const sphere_tree_collision::Despawn& msg) {
   try {
     despawnEntity(msg.id, msg.name);
   } catch (const stc::InputError& e) {
-    reject(Input::Despawn, e.field(), reasonOf(e));
+    reject(Input::Despawn, e.field(), e.reason());
   } catch (...) {
     rejectUnexpected(Input::Despawn);
   }
@@ -540,7 +542,7 @@ void WorldNode::onGaze(const sphere_tree_collision::GazePoint& msg) {
   try {
     setFixation(msg.x, msg.y, msg.header.stamp, "x", "y");
   } catch (const stc::InputError& e) {
-    reject(Input::Gaze, e.field(), reasonOf(e));
+    reject(Input::Gaze, e.field(), e.reason());
   } catch (...) {
     rejectUnexpected(Input::Gaze);
   }
@@ -570,7 +572,7 @@ void WorldNode::onClickedPoint(const geometry_msgs::PointStamped& msg) {
     if (!pixel) throw stc::InputError("point", "behind the camera");
     setFixation(pixel->x(), pixel->y(), ros::Time(0), "point", "point");
   } catch (const stc::InputError& e) {
-    reject(Input::ClickedPoint, e.field(), reasonOf(e));
+    reject(Input::ClickedPoint, e.field(), e.reason());
   } catch (...) {
     rejectUnexpected(Input::ClickedPoint);
   }

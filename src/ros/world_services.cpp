@@ -29,7 +29,7 @@ void answer(Response& res, const char* service, F&& action) {
     res.message = "";
   } catch (const stc::InputError& e) {
     res.success = false;
-    res.message = e.field() + ": " + reasonOf(e);
+    res.message = e.field() + ": " + e.reason();
   } catch (const std::exception& e) {
     res.success = false;
     res.message = std::string("message: ") + e.what();
@@ -119,7 +119,7 @@ sphere_tree_collision::SpawnEntity WorldServices::inWorldFrame(const sphere_tree
   const stc::Vec3 translation = toEigen(t.transform.translation);
   sphere_tree_collision::SpawnEntity m = req.entity;
   // A unit rotation keeps the quaternion's norm: a bad orientation stays bad for the topic's check.
-  const stc::Quat q = orientationOrIdentity(toEigen(m.pose.orientation));  // left out: the frame's own
+  const stc::Quat q = stc::orientationOrIdentity(toEigen(m.pose.orientation));  // left out: the frame's own
   m.pose.position = toPointMsg(rotation * toEigen(m.pose.position) + translation);
   m.pose.orientation = toQuaternionMsg(rotation * q);
   m.twist.linear = toVector3Msg(rotation * toEigen(m.twist.linear));  // the frame is taken as not moving
@@ -142,7 +142,7 @@ bool WorldServices::spawn(sphere_tree_collision::Spawn::Request& req, sphere_tre
       try {
         made->id = node_.spawnEntity(entity);
       } catch (const stc::InputError& e) {  // named as fields of the request's `entity`
-        throw stc::InputError(e.field() == "max_entities" ? e.field() : "entity." + e.field(), reasonOf(e));
+        throw stc::InputError(e.field() == "max_entities" ? e.field() : "entity." + e.field(), e.reason());
       }
       made->frame_id = node_.frameOf(made->id);
       node_.publishEntityList();

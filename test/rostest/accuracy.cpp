@@ -4,7 +4,7 @@
 // "unlimited" (no budget) and "tight" (a few sphere tests per tick, unresolved
 // pairs accepted). This node owns the scene: it spawns the same entities into
 // both through `spawn`, learns each one's id from the tf frame that appears
-// (entity_<id>), and builds the same shape locally (stc_ros::addRequest, the
+// (entity_<id>), and builds the same shape locally (stc::addRequest, the
 // node's own path) as an FCL mesh. It then records `contacts` and `tf` and,
 // for every tick whose contacts and tf share a stamp, checks with FCL at those
 // poses:
@@ -20,7 +20,8 @@
 #include "rostest_util.hpp"
 
 #include "sphere_tree_collision/ros/conversions.hpp"
-#include "sphere_tree_collision/ros/entity_request.hpp"
+#include "sphere_tree_collision/ros/mesh_resource.hpp"
+#include "sphere_tree_collision/scene/entity_request.hpp"
 
 #include <gtest/gtest.h>
 #include <sphere_tree_collision/ContactArray.h>
@@ -137,7 +138,7 @@ class TruthShapes {
  public:
   // Adds the entity of `msg` to a local World exactly as the node does.
   Truth add(const SpawnEntity& msg) {
-    const stc::EntityId local_id = stc_ros::addRequest(world_, stc_ros::toEntityRequest(msg));
+    const stc::EntityId local_id = stc::addRequest(world_, stc_ros::toEntityRequest(msg), {}, stc_ros::resolveMeshResource);
     const stc::ShapeId shape_id = world_.bodyShapes()[*world_.indexOf(local_id)];
     Truth t;
     t.shape = &world_.shape(shape_id);  // World keeps shapes in a deque: stable address

@@ -9,8 +9,8 @@
 #include "thrown_field.hpp"
 
 #include "sphere_tree_collision/ros/conversions.hpp"
-#include "sphere_tree_collision/ros/entity_request.hpp"
-#include "sphere_tree_collision/ros/scene_file.hpp"
+#include "sphere_tree_collision/scene/entity_request.hpp"
+#include "sphere_tree_collision/scene/scene_file.hpp"
 #include "sphere_tree_collision/ros/tick_clock.hpp"
 
 #include <gtest/gtest.h>
@@ -21,6 +21,8 @@
 
 namespace stc_ros {
 namespace {
+
+using namespace stc;  // the request path (scene/) is ROS-free
 
 using sphere_tree_collision::SpawnEntity;
 using stc::thrownField;

@@ -7,9 +7,9 @@
 #include "temp_dir.hpp"
 
 #include "sphere_tree_collision/ros/conversions.hpp"
-#include "sphere_tree_collision/ros/entity_request.hpp"
+#include "sphere_tree_collision/scene/entity_request.hpp"
 #include "sphere_tree_collision/ros/mesh_resource.hpp"
-#include "sphere_tree_collision/ros/scene_file.hpp"
+#include "sphere_tree_collision/scene/scene_file.hpp"
 
 #include <gtest/gtest.h>
 #include <ros/package.h>
@@ -21,6 +21,8 @@
 
 namespace stc_ros {
 namespace {
+
+using namespace stc;  // the request path (scene/) is ROS-free
 
 class MeshSpawn : public ::testing::Test {
  protected:
@@ -61,7 +63,7 @@ TEST(ShippedMeshScene, LoadsByPackageResourceAndTheLinkComesToRestOnTheScan) {
   stc::WorldConfig config;
   config.gravity = scene.gravity;
   stc::World world(config);
-  const std::vector<stc::EntityId> ids = addScene(world, scene);
+  const std::vector<stc::EntityId> ids = addScene(world, scene, {}, resolveMeshResource);
   ASSERT_EQ(ids.size(), 3u);
   const auto link = world.findByName("link"), scan = world.findByName("scan");
   ASSERT_TRUE(link && scan);
@@ -80,18 +82,21 @@ TEST(ShippedMeshScene, LoadsByPackageResourceAndTheLinkComesToRestOnTheScan) {
 }
 
 TEST_F(MeshSpawn, SceneFileRejectsAMeshWithAPresetOrAScaleWithoutAMesh) {
+  // Judged where every request is (stc::validateRequest), when the scene is added.
+  stc::World world(config());
   try {
-    parseSceneYaml("entities:\n  - {preset: cube, mesh_resource: '" + path_ + "'}\n");
+    addScene(world, parseSceneYaml("entities:\n  - {preset: cube, mesh_resource: '" + path_ + "'}\n"));
     FAIL() << "accepted";
   } catch (const stc::InputError& e) {
     EXPECT_EQ(e.field(), "entities[0].mesh_resource");
   }
   try {
-    parseSceneYaml("entities:\n  - {preset: cube, scale: [1, 1, 1]}\n");
+    addScene(world, parseSceneYaml("entities:\n  - {preset: cube, scale: [1, 1, 1]}\n"));
     FAIL() << "accepted";
   } catch (const stc::InputError& e) {
     EXPECT_EQ(e.field(), "entities[0].scale");
   }
+  EXPECT_EQ(world.entityCount(), 0u);
 }
 
 // Not a mesh feature, but a scene file's: a one-sided static floor
@@ -164,7 +169,7 @@ TEST_F(MeshSpawn, SpawnMessageWithAMeshAddsItScaled) {
 
   msg.preset = "cube";
   try {
-    toEntityRequest(msg);
+    addRequest(world, toEntityRequest(msg));
     FAIL() << "accepted a mesh and a preset";
   } catch (const stc::InputError& e) {
     EXPECT_EQ(e.field(), "mesh_resource");
@@ -208,14 +213,16 @@ TEST_F(MeshSpawn, ADaeUpAxisIsAsWrittenUnlessZUpIsAsked) {
   };
   EXPECT_EQ(field_of([&] { parseSceneYaml("entities:\n  - {mesh_resource: '" + dae + "', up_axis: sideways}\n"); }),
             "entities[0].up_axis");
-  EXPECT_EQ(field_of([&] { parseSceneYaml("entities:\n  - {preset: cube, up_axis: z_up}\n"); }),
+  const std::size_t entities = world.entityCount();
+  EXPECT_EQ(field_of([&] { addScene(world, parseSceneYaml("entities:\n  - {preset: cube, up_axis: z_up}\n")); }),
             "entities[0].up_axis");
   msg.up_axis = "sideways";
   EXPECT_EQ(field_of([&] { toEntityRequest(msg); }), "up_axis");
   msg.mesh_resource.clear();
   msg.preset = "cube";
   msg.up_axis = "z_up";
-  EXPECT_EQ(field_of([&] { toEntityRequest(msg); }), "up_axis");
+  EXPECT_EQ(field_of([&] { addRequest(world, toEntityRequest(msg)); }), "up_axis");
+  EXPECT_EQ(world.entityCount(), entities);
 }
 
 TEST_F(MeshSpawn, PackageResourcesOfUnknownPackagesAreRejected) {

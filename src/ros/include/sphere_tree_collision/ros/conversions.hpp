@@ -2,7 +2,7 @@
 #pragma once
 
 #include "sphere_tree_collision/body.hpp"
-#include "sphere_tree_collision/ros/entity_request.hpp"
+#include "sphere_tree_collision/scene/entity_request.hpp"
 #include "sphere_tree_collision/types.hpp"
 
 #include <sphere_tree_collision/SpawnEntity.h>
@@ -36,16 +36,11 @@ std_msgs::ColorRGBA toColorMsg(float r, float g, float b, float a);
 // so com is 0); all 0 for a static body.
 geometry_msgs::Inertia toInertiaMsg(const stc::BodyState& body);
 
-// The message of an InputError without its "field: " prefix, for re-raising
-// the error under another field name.
-std::string reasonOf(const stc::InputError& error);
-
-// A SpawnEntity message as an EntityRequest. Checks what only the message can
-// get wrong (preset and grid both or neither, dims beyond int) and throws
-// InputError named after the message field; the rest is checked by addRequest,
-// which also gives fields left at 0 their defaults (applyDefaults). An
-// all-zero colour means "none".
-EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg);
+// A SpawnEntity message as an EntityRequest, field for field. Throws
+// InputError only for what the request type cannot hold (dims beyond int, an
+// unknown up_axis); everything else is checked by stc::addRequest, which also
+// gives fields left at 0 their defaults. An all-zero colour or scale means "none".
+stc::EntityRequest toEntityRequest(const sphere_tree_collision::SpawnEntity& msg);
 
 // addRequest names fields after the core (EntitySpec, VoxelShape); this gives
 // the SpawnEntity field a user wrote (e.g. "linear_velocity" -> "twist.linear").

@@ -14,7 +14,7 @@
 // Per-shape geometry is cached; the output's storage is reused between arrays.
 #pragma once
 
-#include "sphere_tree_collision/ros/entity_request.hpp"
+#include "sphere_tree_collision/ros/entity_display.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <ros/time.h>

@@ -2,7 +2,7 @@
 // Every parameter is documented (name, default, meaning) in docs/ros_interface.md.
 #pragma once
 
-#include "sphere_tree_collision/ros/entity_request.hpp"
+#include "sphere_tree_collision/scene/entity_request.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <ros/node_handle.h>
@@ -55,7 +55,7 @@ struct NodeParams {
   double gaze_timeout = 0.5;         // s
   // ~default_resolution, ~default_density, ~default_voxel_size: what spawns and
   // scene entries left at 0 (or out) get.
-  RequestDefaults defaults;
+  stc::RequestDefaults defaults;
   std::optional<stc::Vec3> gravity;  // overrides the scene's
   std::string error_report;          // CSV file, a row per tick (ErrorReport); "" = none
   stc::WorldConfig world;            // scheduler, policy, tree, limits, response

@@ -22,7 +22,7 @@ int runNode(int argc, char** argv, const char* name) {
     node = std::make_unique<Node>(nh, pnh);
   } catch (const stc::InputError& e) {
     // Running on a guess would hide the mistake.
-    ROS_FATAL("%s: invalid ~%s: %s", name, e.field().c_str(), reasonOf(e).c_str());
+    ROS_FATAL("%s: invalid ~%s: %s", name, e.field().c_str(), e.reason().c_str());
     return 1;
   }
   ros::spin();

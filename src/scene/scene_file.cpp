@@ -1,8 +1,6 @@
-#include "sphere_tree_collision/ros/scene_file.hpp"
+#include "sphere_tree_collision/scene/scene_file.hpp"
 
 #include "sphere_tree_collision/static_cover.hpp"
-
-#include "sphere_tree_collision/ros/conversions.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -12,10 +10,8 @@
 #include <set>
 #include <sstream>
 
-namespace stc_ros {
+namespace stc {
 namespace {
-
-using stc::InputError;
 
 constexpr std::int64_t kMaxSceneEntities = 1000000;  // repeats expanded, whole file
 
@@ -73,19 +69,19 @@ std::vector<double> readNumbers(const YAML::Node& node, const std::string& field
   return out;
 }
 
-stc::Vec3 readVec3(const YAML::Node& node, const std::string& field) {
+Vec3 readVec3(const YAML::Node& node, const std::string& field) {
   const auto v = readNumbers(node, field, 3);
   return {v[0], v[1], v[2]};
 }
 
-stc::Quat fromRpy(double roll, double pitch, double yaw) {
-  return stc::Quat(Eigen::AngleAxisd(yaw, stc::Vec3::UnitZ()) *
-                   Eigen::AngleAxisd(pitch, stc::Vec3::UnitY()) *
-                   Eigen::AngleAxisd(roll, stc::Vec3::UnitX()));
+Quat fromRpy(double roll, double pitch, double yaw) {
+  return Quat(Eigen::AngleAxisd(yaw, Vec3::UnitZ()) *
+                   Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
+                   Eigen::AngleAxisd(roll, Vec3::UnitX()));
 }
 
 // {rpy: [r, p, y]} (radians, fixed axes X then Y then Z) or {quat: [x, y, z, w]}.
-stc::Quat readOrientation(const YAML::Node& node, const std::string& field) {
+Quat readOrientation(const YAML::Node& node, const std::string& field) {
   if (!node.IsMap() || node.size() != 1) {
     throw InputError(field, "expected {rpy: [roll, pitch, yaw]} or {quat: [x, y, z, w]}");
   }
@@ -95,7 +91,7 @@ stc::Quat readOrientation(const YAML::Node& node, const std::string& field) {
   }
   if (node["quat"]) {
     const auto v = readNumbers(node["quat"], field + ".quat", 4);
-    return stc::Quat(v[3], v[0], v[1], v[2]);  // validated (unit norm) by addRequest
+    return Quat(v[3], v[0], v[1], v[2]);  // validated (unit norm) by addRequest
   }
   throw InputError(field, "expected {rpy: [roll, pitch, yaw]} or {quat: [x, y, z, w]}");
 }
@@ -120,29 +116,26 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
             {"name", "preset", "resolution", "voxel_size", "seed", "position", "orientation", "velocity",
              "angular_velocity", "density", "restitution", "friction", "color", "static", "box_mode",
              "repeat", "mesh_resource", "scale", "strength", "rolling_resistance", "up_axis", "closed_faces"});
+  // Which shape source, and what belongs to it, is validateRequest's to judge
+  // when the scene is added: a file, a topic and a service refuse alike.
   EntityRequest r;
-  if (node["mesh_resource"]) {
-    r.mesh_resource = readString(node["mesh_resource"], p + "mesh_resource");
-    if (node["preset"]) throw InputError(p + "mesh_resource", "give a mesh or a preset, not both");
-    if (node["scale"]) r.mesh_scale = readVec3(node["scale"], p + "scale");
-    if (node["voxel_size"]) r.mesh_voxel_size = readDouble(node["voxel_size"], p + "voxel_size");
-    if (node["up_axis"]) {
-      const std::string up_axis = readString(node["up_axis"], p + "up_axis");
-      try {
-        r.mesh_up_axis = stc::parseColladaUpAxis(up_axis);
-      } catch (const InputError& e) {
-        throw InputError(p + "up_axis", reasonOf(e));
-      }
+  if (node["mesh_resource"]) r.mesh_resource = readString(node["mesh_resource"], p + "mesh_resource");
+  if (node["preset"]) r.preset = readString(node["preset"], p + "preset");
+  if (node["scale"]) r.mesh_scale = readVec3(node["scale"], p + "scale");
+  if (node["up_axis"]) {
+    const std::string up_axis = readString(node["up_axis"], p + "up_axis");
+    try {
+      r.mesh_up_axis = parseColladaUpAxis(up_axis);
+    } catch (const InputError& e) {
+      throw InputError(p + "up_axis", e.reason());
     }
-  } else {
-    if (!node["preset"]) throw InputError(p + "preset", "missing (or give a mesh_resource)");
-    if (node["scale"]) throw InputError(p + "scale", "only for a mesh_resource");
-    if (node["up_axis"]) throw InputError(p + "up_axis", "only for a mesh_resource");
-    r.preset = readString(node["preset"], p + "preset");
   }
   if (node["name"]) r.spec.name = readString(node["name"], p + "name");
   if (node["resolution"]) r.preset_params.resolution = static_cast<int>(readInt(node["resolution"], p + "resolution", 0, 4096));
-  if (node["voxel_size"]) r.preset_params.voxel_size = readDouble(node["voxel_size"], p + "voxel_size");
+  if (node["voxel_size"]) {
+    (node["mesh_resource"] ? r.mesh_voxel_size : r.preset_params.voxel_size) =
+        readDouble(node["voxel_size"], p + "voxel_size");
+  }
   if (node["seed"]) r.preset_params.seed = static_cast<std::uint32_t>(readInt(node["seed"], p + "seed", 0, 0xffffffffll));
   if (node["position"]) r.spec.pose.position = readVec3(node["position"], p + "position");
   if (node["orientation"]) r.spec.pose.orientation = readOrientation(node["orientation"], p + "orientation");
@@ -163,16 +156,16 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
     std::vector<std::string> names;
     for (std::size_t i = 0; i < faces.size(); ++i) names.push_back(readString(faces[i], p + "closed_faces"));
     try {
-      r.spec.closed_faces = stc::parseFaces(names);
+      r.spec.closed_faces = parseFaces(names);
     } catch (const InputError& e) {
-      throw InputError(p + "closed_faces", reasonOf(e));
+      throw InputError(p + "closed_faces", e.reason());
     }
   }
   if (node["box_mode"]) {
     try {
-      r.spec.box_mode = stc::parseBoxMode(readString(node["box_mode"], p + "box_mode"));
+      r.spec.box_mode = parseBoxMode(readString(node["box_mode"], p + "box_mode"));
     } catch (const InputError& e) {
-      throw InputError(p + "box_mode", reasonOf(e));
+      throw InputError(p + "box_mode", e.reason());
     }
   }
 
@@ -185,7 +178,7 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   checkKeys(rep, p + "repeat.", {"count", "spacing", "seed_step"});
   if (!rep["count"] || !rep["spacing"]) throw InputError(p + "repeat", "needs count and spacing");
   const auto count = readNumbers(rep["count"], p + "repeat.count", 3);
-  const stc::Vec3 spacing = readVec3(rep["spacing"], p + "repeat.spacing");
+  const Vec3 spacing = readVec3(rep["spacing"], p + "repeat.spacing");
   const std::int64_t seed_step = rep["seed_step"] ? readInt(rep["seed_step"], p + "repeat.seed_step", 0, 1 << 20) : 0;
   std::int64_t total = 1;
   for (double c : count) {
@@ -203,7 +196,7 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
     for (int j = 0; j < static_cast<int>(count[1]); ++j) {
       for (int i = 0; i < static_cast<int>(count[0]); ++i, ++index) {
         EntityRequest copy = r;
-        copy.spec.pose.position += stc::Vec3(i * spacing.x(), j * spacing.y(), k * spacing.z());
+        copy.spec.pose.position += Vec3(i * spacing.x(), j * spacing.y(), k * spacing.z());
         copy.preset_params.seed = r.preset_params.seed + static_cast<std::uint32_t>(seed_step * index);
         if (!r.spec.name.empty()) copy.spec.name = r.spec.name + "_" + std::to_string(index);
         scene.entities.push_back({path + ".repeat[" + std::to_string(index) + "]", std::move(copy)});
@@ -268,14 +261,15 @@ Scene loadSceneYaml(const std::string& path) {
   return parseSceneYaml(text.str());
 }
 
-std::vector<stc::EntityId> addScene(stc::World& world, const Scene& scene, const RequestDefaults& defaults) {
-  std::vector<stc::EntityId> ids;
+std::vector<EntityId> addScene(World& world, const Scene& scene, const RequestDefaults& defaults,
+                               MeshResolver resolve_mesh) {
+  std::vector<EntityId> ids;
   ids.reserve(scene.entities.size());
   for (const SceneEntry& entry : scene.entities) {
     try {
-      ids.push_back(addRequest(world, entry.request, defaults));
+      ids.push_back(addRequest(world, entry.request, defaults, resolve_mesh));
     } catch (const InputError& e) {
-      throw InputError(entry.path + "." + sceneKeyOf(e.field()), reasonOf(e));
+      throw InputError(entry.path + "." + sceneKeyOf(e.field()), e.reason());
     }
   }
   return ids;
@@ -303,4 +297,4 @@ entities:
   return kYaml;
 }
 
-}  // namespace stc_ros
+}  // namespace stc

@@ -25,12 +25,12 @@
 //       resolution: 32           # voxels along the mesh's longest side, unless voxel_size is given
 #pragma once
 
-#include "sphere_tree_collision/ros/entity_request.hpp"
+#include "sphere_tree_collision/scene/entity_request.hpp"
 
 #include <string>
 #include <vector>
 
-namespace stc_ros {
+namespace stc {
 
 struct SceneEntry {
   std::string path;  // "entities[3]" or "entities[3].repeat[5]", for error messages
@@ -38,11 +38,11 @@ struct SceneEntry {
 };
 
 struct Scene {
-  stc::Vec3 gravity = stc::Vec3::Zero();
+  Vec3 gravity = Vec3::Zero();
   std::vector<SceneEntry> entities;  // repeats already expanded
 };
 
-// Throws stc::InputError naming the field, e.g. "entities[2].position".
+// Throws InputError naming the field, e.g. "entities[2].position".
 Scene parseSceneYaml(const std::string& yaml_text);
 Scene loadSceneYaml(const std::string& path);
 
@@ -52,6 +52,7 @@ const std::string& defaultSceneYaml();
 // Adds every entity (addRequest, with `defaults` for the fields left out or
 // at 0), returns their ids in scene order. Throws
 // InputError("entities[i].<field>") on the first bad one.
-std::vector<stc::EntityId> addScene(stc::World& world, const Scene& scene, const RequestDefaults& defaults = {});
+std::vector<EntityId> addScene(World& world, const Scene& scene, const RequestDefaults& defaults = {},
+                               MeshResolver resolve_mesh = meshPathWithinRoots);
 
-}  // namespace stc_ros
+}  // namespace stc
