@@ -22,7 +22,8 @@ struct BroadPair {
 
 class SweepAndPrune {
  public:
-  // Add/remove between ticks; pairs() reflects them after the next update().
+  // Add/remove between ticks; pairs() reflects them after the next update(),
+  // which drops removed boxes at a cost that follows their bands and pairs.
   // Adding an existing id or removing an unknown one throws InputError("id");
   // a non-finite box or min > max throws InputError("box"). Ids are arbitrary.
   void add(EntityId id, const Aabb& box);
@@ -36,6 +37,10 @@ class SweepAndPrune {
   // Pairs whose boxes overlap on all three axes (touching counts, as in
   // Aabb::overlaps) as of the last update(), in no particular order.
   const std::vector<BroadPair>& pairs() const { return pairs_; }
+  // The other entities of `id`'s pairs as of the last update() (one may
+  // have been removed since), into *out (emptied first): a walk of its own
+  // pairs, not of all. Unknown id throws InputError("id").
+  void partnersOf(EntityId id, std::vector<EntityId>* out) const;
   std::size_t size() const;
   // The box last given for an entity (by add or setBox); unknown id throws InputError("id").
   Aabb box(EntityId id) const;

@@ -18,6 +18,8 @@ using Quat = Eigen::Quaterniond;
 // Stable handle of an entity; never reused within one World.
 using EntityId = std::uint32_t;
 constexpr EntityId kInvalidEntity = std::numeric_limits<EntityId>::max();
+// A shape of the World's ShapeLibrary (shape_library.hpp), shared by its entities.
+using ShapeId = std::uint32_t;
 // An ordered pair of entities as one key: a in the high half, b in the low.
 inline std::uint64_t entityPairKey(EntityId a, EntityId b) { return (std::uint64_t{a} << 32) | std::uint64_t{b}; }
 

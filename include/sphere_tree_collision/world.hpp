@@ -1,4 +1,6 @@
-// World: owns shapes, trees, entities and the phases; step() runs one tick:
+// World: composes the shapes (ShapeLibrary), the entities' rows
+// (EntityTable), what follows them, fracture (WorldFracture) and the phases;
+// step() runs one tick:
 //   1 integrate  2 broad phase  3 narrow phase + scheduler  4 response
 // and returns a TickReport. Each phase reads what the previous one wrote.
 #pragma once
@@ -6,6 +8,7 @@
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
+#include "sphere_tree_collision/entity_table.hpp"
 #include "sphere_tree_collision/fracture.hpp"
 #include "sphere_tree_collision/island_levels.hpp"
 #include "sphere_tree_collision/islands.hpp"
@@ -15,6 +18,7 @@
 #include "sphere_tree_collision/perception.hpp"
 #include "sphere_tree_collision/response.hpp"
 #include "sphere_tree_collision/scheduler.hpp"
+#include "sphere_tree_collision/shape_library.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/static_cover.hpp"
 #include "sphere_tree_collision/sweep_and_prune.hpp"
@@ -22,7 +26,6 @@
 #include "sphere_tree_collision/workers.hpp"
 
 #include <array>
-#include <deque>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -32,19 +35,7 @@
 
 namespace stc {
 
-namespace detail {
-class FlatHashMap;  // src/core/flat_hash_map.hpp
-}  // namespace detail
-
-using ShapeId = std::uint32_t;
-
-// How an entity's broad-phase box is made (paper 3.2).
-enum class BoxMode : std::uint8_t {
-  Auto,     // chosen from the shape: Dynamic when elongated, else FixedCube
-  FixedCube,  // cube big enough for any orientation; only moves with the centre
-  Dynamic,    // tight AABB of the rotated root-level spheres, recomputed each tick
-};
-// "auto" | "fixed" | "dynamic"; throws InputError("box_mode").
+// BoxMode (entity_table.hpp): "auto" | "fixed" | "dynamic"; throws InputError("box_mode").
 BoxMode parseBoxMode(const std::string& name);
 
 struct WorldConfig {
@@ -164,28 +155,24 @@ struct BrokenEntity {
   std::vector<EntityId> pieces;
 };
 
-struct ShapeInfo {
-  std::string key;
-  VoxelShape voxels;
-  MassProperties unit_mass;   // density 1
-  Vec3 body_origin;           // centre of mass in the grid frame
-  SphereTree tree;
-  double bounding_radius = 0; // max distance from the body origin to the shape
-  bool elongated = false;     // Auto box mode picks Dynamic
-};
+class WorldFracture;  // src/core/world_fracture.hpp
 
-class World {
+// The shapes are a ShapeLibrary (shape_library.hpp) and the entities' rows
+// an EntityTable (entity_table.hpp), private bases: what World adds to them
+// is the validation, and the parts that follow each add and remove.
+class World : private ShapeLibrary, private EntityTable {
  public:
   explicit World(const WorldConfig& config = WorldConfig{});
   ~World();
   World(World&&) noexcept;
   World& operator=(World&&) noexcept;
 
-  // Shapes are shared: the same key returns the same id (the tree is built once).
+  // Shapes are shared: the same key returns the same id (the tree is built
+  // once, under config().voxel_limits and config().tree; ShapeLibrary).
   ShapeId addShape(const std::string& key, VoxelShape shape);
-  std::optional<ShapeId> findShape(const std::string& key) const;
-  const ShapeInfo& shape(ShapeId id) const;
-  std::size_t shapeCount() const { return shapes_.size(); }
+  using ShapeLibrary::findShape;
+  using ShapeLibrary::shape;
+  using ShapeLibrary::shapeCount;
 
   // Throws InputError naming the field ("shape", "pose.position",
   // "pose.orientation", "linear_velocity", "angular_velocity", "density",
@@ -196,7 +183,7 @@ class World {
   // built yet: the same errors, in the same order.
   void validateEntity(const EntitySpec& spec) const;
   bool removeEntity(EntityId id);
-  std::optional<EntityId> findByName(const std::string& name) const;
+  using EntityTable::findByName;
   void clear();  // removes every entity, keeps shapes
 
   // Breaks a body as an impact at `point` along `normal` (world frame) would
@@ -218,7 +205,7 @@ class World {
   // The entities the last step removed, with the reason.
   const std::vector<QuarantinedEntity>& quarantined() const { return quarantined_; }
   // The bodies the last step (and breakEntity since) broke, with their pieces.
-  const std::vector<BrokenEntity>& broken() const { return broken_; }
+  const std::vector<BrokenEntity>& broken() const;
 
   Perception& perception() { return perception_; }
   const Perception& perception() const { return perception_; }
@@ -243,13 +230,12 @@ class World {
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.
   // A sleeping body's pose or velocity edited here wakes its island at the next step.
-  std::size_t entityCount() const { return ids_.size(); }
-  const std::vector<EntityId>& entityIds() const { return ids_; }
-  const std::vector<BodyState>& bodies() const { return bodies_; }
-  std::vector<BodyState>& bodies() { return bodies_; }
-  const std::vector<ShapeId>& bodyShapes() const { return body_shapes_; }
-  const std::vector<std::string>& bodyNames() const { return names_; }
-  std::optional<std::size_t> indexOf(EntityId id) const;
+  using EntityTable::entityCount;
+  using EntityTable::entityIds;
+  using EntityTable::bodies;
+  using EntityTable::bodyShapes;
+  using EntityTable::bodyNames;
+  using EntityTable::indexOf;
 
   // Narrow-phase results of the last step: pairTests()[0..pairCount()).
   const std::vector<PairTest>& pairTests() const { return pair_tests_; }
@@ -280,25 +266,10 @@ class World {
   // First and last: removes bodies beyond the limits; bodies flagged in
   // `unchanged` (held through the tick) are not looked at again.
   void quarantine(TickReport& report, const std::vector<std::uint8_t>* unchanged = nullptr);
-  // After the response: bodies hit harder than their strength are queued in
-  // pending_breaks_. A break is made once its pieces' trees exist; a tree is
-  // built only when its estimated cost (tree_cost_) fits before the tick's
-  // deadline, but for one tree at each tick's start, so the queue always
-  // moves (world_fracture.cpp). Both take the clock at their start and return
-  // it at their end, reading it only when there is something to break.
+  // Fracture after the response, and the breaks that waited, at the tick's
+  // start (WorldFracture::fracture / breakPending, world_fracture.cpp).
   double fracture(double now, const Deadline& tick_end, TickReport& report);
   double breakPending(double now, const Deadline& tick_end, TickReport& report);
-  void breakQueued(const Deadline& trees_until, bool one_tree_anyway, TickReport& report);
-  // The fracture plane of an impact at `point` along `normal` (world frame)
-  // on body `index`, in its grid frame (fracturePlane).
-  SplitPlane gridPlaneOf(std::size_t index, const Vec3& point, const Vec3& normal) const;
-  // The split of body `index` by `plane` (its grid frame): its pieces, or
-  // nothing when it stays whole.
-  std::vector<VoxelPiece> piecesOf(std::size_t index, const SplitPlane& plane) const;
-  // A piece's shape: the one with its voxels, or std::nullopt (*key: the key to add it by).
-  std::optional<ShapeId> findPieceShape(const VoxelShape& voxels, std::string* key) const;
-  // Replaces body `index` by `pieces`; their trees are built here if missing.
-  std::vector<EntityId> placePieces(std::size_t index, std::vector<VoxelPiece>& pieces);
   // What the physics phases read and write this tick (physics.hpp); each
   // phase sets what is its own (dt, the solver's budget).
   StepContext physicsStep();
@@ -320,27 +291,14 @@ class World {
 
   WorldConfig config_;
   Workers workers_;  // before the phases that use it
-  std::deque<ShapeInfo> shapes_;  // deque: trees keep their address as shapes are added
-  std::deque<ShapeBounds> shape_bounds_;  // by shape id, built in addShape; they point at the trees
-  std::vector<CoverShape> cover_shapes_;  // by shape id: what StaticCover reads of each
-  std::unordered_map<std::string, ShapeId> shape_by_key_;
-
-  // Entities: flat arrays indexed densely; ids_ maps dense -> id.
-  std::vector<EntityId> ids_;
-  std::vector<BodyState> bodies_;
-  std::vector<ShapeId> body_shapes_;
-  std::vector<BoxMode> box_modes_;
-  std::vector<std::string> names_;
+  // The shapes: the ShapeLibrary base (shapes_, shape_bounds_, cover_shapes_).
+  // The entities' rows: the EntityTable base (ids_, bodies_, body_shapes_,
+  // box_modes_, names_, index_of_).
   StaticCover static_cover_;  // static bodies' faces other static bodies cover, by dense index
-  // Entity id -> dense index, open addressing on flat arrays: the pair walk
-  // of every tick looks up two per broad-phase pair (a settled pile of 5,000
-  // rocks: ~50,000 pairs; docs/sleeping.md).
-  std::unique_ptr<detail::FlatHashMap> index_of_;
-  std::unordered_map<std::string, EntityId> id_by_name_;
-  EntityId next_id_ = 0;
 
   SweepAndPrune broad_phase_;
   std::vector<Aabb> boxes_;  // this tick's box of each body, by dense index (pooled)
+  std::vector<EntityId> partners_;  // removeEntity: the broad-phase partners of the removed body (pooled)
   // The narrow phase's chunks, as many as it ever cuts (narrow_chunks.hpp): a
   // scheduler each and the arena of its pair tests' hits; in a vector made
   // once, so the arenas keep their address when the World is moved (the pair
@@ -376,23 +334,7 @@ class World {
   double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step
   std::vector<std::uint8_t> held_through_tick_;  // step: Islands::held() before endTick (pooled)
-  // A break waiting for its pieces' trees: the plane in the body's grid
-  // frame, so the split is the same whenever it is made.
-  struct PendingBreak {
-    EntityId id = kInvalidEntity;
-    SplitPlane plane;
-  };
-  std::vector<PendingBreak> pending_breaks_;
-  TreeCostEstimate tree_cost_;  // of the pieces' trees built so far
-  std::vector<BrokenEntity> broken_;  // since the last step began
-  // Contact impulses on each body this tick (by dense index; ticks with a
-  // breakable body in contact only), pooled.
-  struct BodyHits {
-    double impulse = 0.0;          // summed, N s
-    double hardest_impulse = 0.0;  // of the contact with the largest impulse
-    std::int32_t hardest = -1;     // that contact
-  };
-  std::vector<BodyHits> hits_;
+  std::unique_ptr<WorldFracture> fracture_;  // its queue, tree costs and what broke
 };
 
 }  // namespace stc

@@ -39,6 +39,7 @@
 #include "flat_hash_map.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 
@@ -141,6 +142,7 @@ struct SweepAndPrune::Impl {
   std::vector<std::uint32_t> free_slots;
   std::vector<std::uint32_t> added;    // slots to insert at the next update()
   std::vector<std::uint32_t> removed;  // slots to drop at the next update()
+  std::vector<std::uint32_t> removed_live;  // of those, the ones with endpoints and pairs
   FlatHashMap slot_of_id;
   std::uint32_t last_set = ~0u;  // slot of the last setBox: callers often go in add order
   std::size_t live_at_banding = 0;  // boxes when the bands were last chosen
@@ -162,6 +164,19 @@ struct SweepAndPrune::Impl {
   // arrays; pair_index maps a key to its index there.
   std::vector<std::uint64_t> pair_keys;
   FlatHashMap pair_index;
+  // Each slot's pairs, a doubly linked list through the pair array: end 0 of
+  // pair i is its lower slot (key >> 32), end 1 its higher; pair_links[i]
+  // holds the previous and next pair of each end's list (kNoPair ends it),
+  // first_pair (by slot) each list's head. Kept as pairs come, go and move,
+  // so a box's pairs are found without a walk over all pairs.
+  static constexpr std::uint32_t kNoPair = ~0u;
+  struct PairLinks {
+    std::uint32_t prev[2];
+    std::uint32_t next[2];
+  };
+  std::vector<PairLinks> pair_links;
+  std::vector<std::uint32_t> first_pair;
+  std::vector<std::uint32_t> dropped;  // dropRemoved: the places of the pairs it drops
 
   // Swaps that may change the pair set: moving slot << 32 | kind | passed slot;
   // events[0, event_count) are this update's, the rest is room.
@@ -200,27 +215,85 @@ struct SweepAndPrune::Impl {
     return true;
   }
 
+  // --- each slot's list of pairs ---
+
+  static std::uint32_t slotAt(std::uint64_t key, int end) {
+    return static_cast<std::uint32_t>(end == 0 ? key >> 32 : key & 0xFFFFFFFFu);
+  }
+  // The end of pair i that is `slot`.
+  int endOf(std::uint32_t i, std::uint32_t slot) const { return slotAt(pair_keys[i], 0) == slot ? 0 : 1; }
+  // The link that points at pair i from the front of `slot`'s list.
+  std::uint32_t& linkBefore(std::uint32_t prev, std::uint32_t slot) {
+    return prev == kNoPair ? first_pair[slot] : pair_links[prev].next[endOf(prev, slot)];
+  }
+
+  // Pair i (its key set) put at the head of its slots' lists.
+  void link(std::uint32_t i) {
+    for (int end = 0; end < 2; ++end) {
+      const std::uint32_t s = slotAt(pair_keys[i], end);
+      const std::uint32_t next = first_pair[s];
+      pair_links[i].prev[end] = kNoPair;
+      pair_links[i].next[end] = next;
+      if (next != kNoPair) pair_links[next].prev[endOf(next, s)] = i;
+      first_pair[s] = i;
+    }
+  }
+
+  void unlink(std::uint32_t i) {
+    for (int end = 0; end < 2; ++end) {
+      const std::uint32_t s = slotAt(pair_keys[i], end);
+      const std::uint32_t prev = pair_links[i].prev[end], next = pair_links[i].next[end];
+      linkBefore(prev, s) = next;
+      if (next != kNoPair) pair_links[next].prev[endOf(next, s)] = prev;
+    }
+  }
+
+  // The pair at `from` moved to `to` (key and links copied): its neighbours
+  // point at `to`.
+  void relink(std::uint32_t to) {
+    for (int end = 0; end < 2; ++end) {
+      const std::uint32_t s = slotAt(pair_keys[to], end);
+      const std::uint32_t prev = pair_links[to].prev[end], next = pair_links[to].next[end];
+      linkBefore(prev, s) = to;
+      if (next != kNoPair) pair_links[next].prev[endOf(next, s)] = to;
+    }
+  }
+
+  // --- the pair set ---
+
   void addPair(std::uint32_t a, std::uint32_t b, std::vector<BroadPair>& pairs) {
     const std::uint64_t key = pairKey(a, b);
     if (pair_index.find(key) != FlatHashMap::kMissing) return;
-    pair_index.set(key, static_cast<std::uint32_t>(pairs.size()));
+    const auto i = static_cast<std::uint32_t>(pairs.size());
+    pair_index.set(key, i);
     const EntityId ia = ids[a], ib = ids[b];
     pairs.push_back(ia < ib ? BroadPair{ia, ib} : BroadPair{ib, ia});
     pair_keys.push_back(key);
+    pair_links.emplace_back();
+    link(i);
     partner_bloom[a] |= bloomBit(b);
     partner_bloom[b] |= bloomBit(a);
   }
 
-  void removePairAt(std::size_t index, std::vector<BroadPair>& pairs) {
-    pair_index.erase(pair_keys[index]);
+  // The last pair moved to `index`, whose pair is gone (unlinked, out of the index).
+  void fillFromLast(std::size_t index, std::vector<BroadPair>& pairs) {
     const std::size_t last = pairs.size() - 1;
     if (index != last) {
       pairs[index] = pairs[last];
       pair_keys[index] = pair_keys[last];
+      pair_links[index] = pair_links[last];
+      relink(static_cast<std::uint32_t>(index));
       pair_index.set(pair_keys[index], static_cast<std::uint32_t>(index));
     }
     pairs.pop_back();
     pair_keys.pop_back();
+    pair_links.pop_back();
+  }
+
+  void removePairAt(std::size_t index, std::vector<BroadPair>& pairs) {
+    unlink(static_cast<std::uint32_t>(index));
+    pair_index.erase(pair_keys[index]);
+    fillFromLast(index, pairs);
   }
 
   void removePair(std::uint32_t a, std::uint32_t b, std::vector<BroadPair>& pairs) {
@@ -228,33 +301,66 @@ struct SweepAndPrune::Impl {
     if (index != FlatHashMap::kMissing) removePairAt(index, pairs);
   }
 
-  // Remove every pair for which drop(slot a, slot b) holds.
-  template <typename Drop>
-  void removePairsWhere(std::vector<BroadPair>& pairs, Drop drop) {
-    for (std::size_t i = 0; i < pairs.size();) {
-      const std::uint64_t key = pair_keys[i];
-      if (drop(static_cast<std::uint32_t>(key >> 32), static_cast<std::uint32_t>(key & 0xFFFFFFFFu)))
-        removePairAt(i, pairs);  // the last pair moved to i: look at i again
-      else
-        ++i;
-    }
-  }
-
-  // Drop the endpoints and pairs of removed slots and free the slots.
+  // Drop the endpoints and pairs of removed slots and free the slots: the
+  // bands that held a removed box, and its pairs through its list, so the
+  // cost follows the removed boxes, not the world.
   void dropRemoved(std::vector<BroadPair>& pairs) {
-    for (AxisLists& list : lists)
-      for (std::vector<Endpoint>& band : list.bands)
+    for (AxisLists& list : lists) {
+      for (const std::uint32_t slot : removed_live) {
+        for (std::uint32_t b = list.lo[slot]; b <= list.hi[slot]; ++b) list.band_lost[b] = 1;
+      }
+      for (std::size_t b = 0; b < list.bands.size(); ++b) {
+        if (!list.band_lost[b]) continue;
+        list.band_lost[b] = 0;
+        std::vector<Endpoint>& band = list.bands[b];
         band.erase(std::remove_if(band.begin(), band.end(),
                                   [&](const Endpoint& e) { return state[slotOf(e)] == SlotState::kRemoved; }),
                    band.end());
-    removePairsWhere(pairs, [&](std::uint32_t a, std::uint32_t b) {
-      return state[a] == SlotState::kRemoved || state[b] == SlotState::kRemoved;
-    });
-    for (std::uint32_t slot : removed) {
+      }
+    }
+    dropRemovedPairs(pairs);
+    for (const std::uint32_t slot : removed) {
       state[slot] = SlotState::kFree;
+      first_pair[slot] = kNoPair;
       free_slots.push_back(slot);
     }
     removed.clear();
+    removed_live.clear();
+  }
+
+  // The pairs of removed slots, left as a walk up the whole array would
+  // leave them that drops each at its place and moves the last pair there
+  // (the order the pairs always had): a place dropped takes the last pair
+  // not dropped; dropped pairs at the end just go.
+  void dropRemovedPairs(std::vector<BroadPair>& pairs) {
+    dropped.clear();
+    for (const std::uint32_t slot : removed_live) {
+      for (std::uint32_t i = first_pair[slot]; i != kNoPair; i = pair_links[i].next[endOf(i, slot)]) {
+        dropped.push_back(i);
+      }
+    }
+    std::sort(dropped.begin(), dropped.end());
+    dropped.erase(std::unique(dropped.begin(), dropped.end()), dropped.end());
+    for (const std::uint32_t i : dropped) {
+      unlink(i);
+      pair_index.erase(pair_keys[i]);
+    }
+    std::size_t lo = 0, hi = dropped.size();
+    while (lo < hi) {
+      if (dropped[hi - 1] == pairs.size() - 1) {  // dropped, at the end
+        pairs.pop_back();
+        pair_keys.pop_back();
+        pair_links.pop_back();
+        --hi;
+      } else {
+        fillFromLast(dropped[lo++], pairs);
+      }
+    }
+#ifndef NDEBUG
+    for (const std::uint64_t key : pair_keys) {
+      assert(state[slotAt(key, 0)] != SlotState::kRemoved && state[slotAt(key, 1)] != SlotState::kRemoved);
+    }
+#endif
   }
 
   // Bloom masks of the current pair set (removals leave stale bits: rebuild).
@@ -313,6 +419,8 @@ struct SweepAndPrune::Impl {
     }
     pairs.clear();
     pair_keys.clear();
+    pair_links.clear();
+    std::fill(first_pair.begin(), first_pair.end(), kNoPair);
     pair_index = FlatHashMap();
     added.clear();
     for (std::size_t s = 0; s < state.size(); ++s) {
@@ -593,6 +701,7 @@ void SweepAndPrune::add(EntityId id, const Aabb& box) {
     m.state.emplace_back();
     m.partner_bloom.emplace_back();
     m.moved.emplace_back();
+    m.first_pair.push_back(Impl::kNoPair);
   }
   m.setSpans(slot, box);
   m.ids[slot] = id;
@@ -605,8 +714,20 @@ void SweepAndPrune::remove(EntityId id) {
   Impl& m = *impl_;
   const std::uint32_t slot = m.slotOfId(id);
   m.slot_of_id.erase(id);
+  if (m.state[slot] == SlotState::kLive) m.removed_live.push_back(slot);
   m.state[slot] = SlotState::kRemoved;
   m.removed.push_back(slot);
+}
+
+void SweepAndPrune::partnersOf(EntityId id, std::vector<EntityId>* out) const {
+  const Impl& m = *impl_;
+  const std::uint32_t slot = m.slotOfId(id);
+  out->clear();
+  for (std::uint32_t i = m.first_pair[slot]; i != Impl::kNoPair; i = m.pair_links[i].next[m.endOf(i, slot)]) {
+    const std::uint32_t other = Impl::slotAt(m.pair_keys[i], 0) == slot ? Impl::slotAt(m.pair_keys[i], 1)
+                                                                         : Impl::slotAt(m.pair_keys[i], 0);
+    out->push_back(m.ids[other]);
+  }
 }
 
 bool SweepAndPrune::contains(EntityId id) const {
@@ -684,6 +805,7 @@ void SweepAndPrune::update() {
     if (pairs_.capacity() < 2 * entities) {
       pairs_.reserve(2 * entities);
       m.pair_keys.reserve(2 * entities);
+      m.pair_links.reserve(2 * entities);
     }
     m.insertAdded(pairs_);
   }

@@ -1,14 +1,17 @@
-// World: owns shapes, trees, entities and the phases of one tick.
+// World: composes shapes, entities, what follows them and fracture, and runs
+// the phases of one tick.
 #include "sphere_tree_collision/world.hpp"
 
 #include "flat_hash_map.hpp"
 #include "grow_capacity.hpp"
+#include "world_fracture.hpp"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 namespace stc {
 namespace {
@@ -31,48 +34,6 @@ bool narrowPhaseLimited(const Budget& budget, const Deadline& tick_end) {
          budget.sphere_tests < std::numeric_limits<std::int64_t>::max();
 }
 
-// Auto box mode: a shape whose occupied extent is this much longer along its
-// longest axis than along its shortest gets a dynamic box (paper 3.2: long,
-// thin objects are bounded badly by a fixed cube). With the presets at
-// resolution 8: rod, plate and the flat L and ring pass; cube, sphere, rock do not.
-constexpr double kElongationRatio = 2.5;
-
-// Max distance from `origin` to a corner of an occupied voxel: the radius of
-// a ball about the centre of mass that holds the shape in any orientation.
-double boundingRadius(const VoxelShape& shape, const Vec3& origin) {
-  const double s = shape.voxelSize();
-  double max_sq = 0.0;
-  for (int k = 0; k < shape.nz(); ++k) {
-    for (int j = 0; j < shape.ny(); ++j) {
-      for (int i = 0; i < shape.nx(); ++i) {
-        if (!shape.occupied(i, j, k)) continue;
-        const Vec3 lo = Vec3(i, j, k) * s - origin;
-        const Vec3 hi = lo + Vec3::Constant(s);
-        max_sq = std::max(max_sq, lo.cwiseAbs().cwiseMax(hi.cwiseAbs()).squaredNorm());
-      }
-    }
-  }
-  return std::sqrt(max_sq);
-}
-
-// Longest over shortest extent of the occupied voxels' bounding box (the
-// grid may be padded, the occupied part is what moves).
-bool isElongated(const VoxelShape& shape) {
-  Eigen::Vector3i lo(shape.nx(), shape.ny(), shape.nz());
-  Eigen::Vector3i hi(-1, -1, -1);
-  for (int k = 0; k < shape.nz(); ++k) {
-    for (int j = 0; j < shape.ny(); ++j) {
-      for (int i = 0; i < shape.nx(); ++i) {
-        if (!shape.occupied(i, j, k)) continue;
-        lo = lo.cwiseMin(Eigen::Vector3i(i, j, k));
-        hi = hi.cwiseMax(Eigen::Vector3i(i, j, k));
-      }
-    }
-  }
-  const Eigen::Vector3i extent = hi - lo + Eigen::Vector3i::Ones();
-  return extent.maxCoeff() >= kElongationRatio * extent.minCoeff();
-}
-
 }  // namespace
 
 World::World(const WorldConfig& config)
@@ -80,8 +41,8 @@ World::World(const WorldConfig& config)
       workers_(config.threads),
       narrow_chunks_(makeNarrowChunks(narrowChunkCount(static_cast<std::size_t>(workers_.threads()), false),
                                       config.scheduler)),
-      narrow_chunks_used_(static_cast<std::size_t>(workers_.threads())) {
-  index_of_ = std::make_unique<detail::FlatHashMap>();
+      narrow_chunks_used_(static_cast<std::size_t>(workers_.threads())),
+      fracture_(std::make_unique<WorldFracture>()) {
   validateLimits(config_.limits);
   validateMeshLimits(config_.mesh_limits);
   validateGravity(config_.gravity, config_.limits);
@@ -96,48 +57,7 @@ World& World::operator=(World&&) noexcept = default;
 // Shapes
 
 ShapeId World::addShape(const std::string& key, VoxelShape voxels) {
-  if (const auto found = findShape(key)) return *found;
-  const VoxelLimits& limits = config_.voxel_limits;
-  const std::int64_t cells = static_cast<std::int64_t>(voxels.nx()) * voxels.ny() * voxels.nz();
-  if (cells > limits.max_voxels) {
-    throw InputError("max_voxels", "grid of " + std::to_string(cells) + " voxels exceeds " +
-                                       std::to_string(limits.max_voxels));
-  }
-  if (!(voxels.voxelSize() >= limits.min_voxel_size && voxels.voxelSize() <= limits.max_voxel_size)) {
-    throw InputError("voxel_size", "outside [" + std::to_string(limits.min_voxel_size) + ", " +
-                                       std::to_string(limits.max_voxel_size) + "]");
-  }
-
-  ShapeInfo info;
-  info.key = key;
-  info.unit_mass = computeMassProperties(voxels, 1.0);
-  info.body_origin = info.unit_mass.centre_of_mass;
-  info.tree = SphereTree::build(voxels, info.body_origin, config_.tree);
-  info.bounding_radius = boundingRadius(voxels, info.body_origin);
-  info.elongated = isElongated(voxels);
-
-  // Bounds of every node, once per shape (contacts and sweeps read them each tick).
-  ShapeBounds bounds = makeShapeBounds(info.tree, &voxels, info.body_origin);
-  info.voxels = std::move(voxels);
-
-  const auto id = static_cast<ShapeId>(shapes_.size());
-  shapes_.push_back(std::move(info));  // deque: earlier shapes (and trees) stay put
-  bounds.tree = &shapes_.back().tree;  // the tree moved into the deque
-  shape_bounds_.push_back(std::move(bounds));
-  cover_shapes_.push_back(CoverShape{&shapes_.back().voxels, shapes_.back().body_origin, &shape_bounds_.back()});
-  shape_by_key_.emplace(key, id);
-  return id;
-}
-
-std::optional<ShapeId> World::findShape(const std::string& key) const {
-  const auto it = shape_by_key_.find(key);
-  if (it == shape_by_key_.end()) return std::nullopt;
-  return it->second;
-}
-
-const ShapeInfo& World::shape(ShapeId id) const {
-  if (id >= shapes_.size()) throw InputError("shape", "unknown shape id " + std::to_string(id));
-  return shapes_[id];
+  return ShapeLibrary::addShape(key, std::move(voxels), config_.voxel_limits, config_.tree);
 }
 
 // ---------------------------------------------------------------------------------
@@ -146,14 +66,14 @@ const ShapeInfo& World::shape(ShapeId id) const {
 void World::validateEntity(const EntitySpec& spec) const {
   validateBodyInput(spec.pose, spec.linear_velocity, spec.angular_velocity, spec.density,
                     spec.material, config_.limits);
-  if (!spec.name.empty() && id_by_name_.count(spec.name) != 0) {
+  if (!spec.name.empty() && findByName(spec.name)) {
     throw InputError("name", "'" + spec.name + "' is already used");
   }
   if (spec.closed_faces > kAllFaces || (spec.closed_faces != 0 && !spec.is_static)) {
     throw InputError("closed_faces", "static bodies only, a mask of faceBit values (at most " +
                                          std::to_string(kAllFaces) + ")");
   }
-  if (ids_.size() >= config_.max_entities || next_id_ == kInvalidEntity) {
+  if (ids_.size() >= config_.max_entities || !idsLeft()) {
     throw InputError("max_entities", "the world holds " + std::to_string(config_.max_entities) +
                                          " entities at most");
   }
@@ -183,20 +103,13 @@ EntityId World::addEntity(const EntitySpec& spec) {
   BoxMode mode = spec.box_mode;
   if (mode == BoxMode::Auto) mode = info.elongated ? BoxMode::Dynamic : BoxMode::FixedCube;
 
-  const EntityId id = next_id_;
-  const std::size_t index = ids_.size();
-  ids_.push_back(id);
-  bodies_.push_back(body);
-  body_shapes_.push_back(spec.shape);
-  box_modes_.push_back(mode);
-  names_.push_back(spec.name);
+  // The row, then what follows it.
+  const EntityId id = addRow(body, spec.shape, mode, spec.name);
+  const std::size_t index = ids_.size() - 1;
   static_cover_.add(body, spec.closed_faces);
-  index_of_->set(id, static_cast<std::uint32_t>(index));
-  if (!spec.name.empty()) id_by_name_.emplace(spec.name, id);
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
   islands_.add(info.bounding_radius);
   levels_.add();
-  ++next_id_;
   if (spec.is_static) physics_.forgetReuse();  // its neighbours' covered faces change
   invalidateLastTick();
   return id;
@@ -207,9 +120,9 @@ bool World::removeEntity(EntityId id) {
   if (found == detail::FlatHashMap::kMissing) return false;
   const std::size_t index = found;
   const std::size_t last = ids_.size() - 1;
-  for (const BroadPair& pair : broad_phase_.pairs()) {  // what it touched loses it: wakes
-    if (pair.first != id && pair.second != id) continue;
-    const std::uint32_t other = index_of_->find(pair.first == id ? pair.second : pair.first);
+  broad_phase_.partnersOf(id, &partners_);  // its own pairs, not all
+  for (const EntityId partner : partners_) {  // what it touched loses it: wakes
+    const std::uint32_t other = index_of_->find(partner);
     if (other != detail::FlatHashMap::kMissing) islands_.wake(other);  // missing: removed since the last update
   }
   if (bodies_[index].is_static) physics_.forgetReuse();  // its neighbours' covered faces change
@@ -217,47 +130,15 @@ bool World::removeEntity(EntityId id) {
   levels_.remove(index, last);
   static_cover_.remove(index, last);
   broad_phase_.remove(id);
-  if (!names_[index].empty()) id_by_name_.erase(names_[index]);
-  index_of_->erase(id);
-  if (index != last) {  // swap-remove keeps the arrays dense
-    ids_[index] = ids_[last];
-    bodies_[index] = bodies_[last];
-    body_shapes_[index] = body_shapes_[last];
-    box_modes_[index] = box_modes_[last];
-    names_[index] = std::move(names_[last]);
-    index_of_->set(ids_[index], static_cast<std::uint32_t>(index));
-  }
+  removeRow(index);  // swap-remove, as the three above
   pairs_seen_.clear();  // a dense index moved
-  ids_.pop_back();
-  bodies_.pop_back();
-  body_shapes_.pop_back();
-  box_modes_.pop_back();
-  names_.pop_back();
   invalidateLastTick();
   return true;
 }
 
-std::optional<EntityId> World::findByName(const std::string& name) const {
-  const auto it = id_by_name_.find(name);
-  if (it == id_by_name_.end()) return std::nullopt;
-  return it->second;
-}
-
-std::optional<std::size_t> World::indexOf(EntityId id) const {
-  const std::uint32_t found = index_of_->find(id);
-  if (found == detail::FlatHashMap::kMissing) return std::nullopt;
-  return static_cast<std::size_t>(found);
-}
-
 void World::clear() {
-  ids_.clear();
-  bodies_.clear();
-  body_shapes_.clear();
-  box_modes_.clear();
-  names_.clear();
-  *index_of_ = detail::FlatHashMap();
+  clearRows();
   pairs_seen_.clear();
-  id_by_name_.clear();
   broad_phase_ = SweepAndPrune();
   islands_.clear();
   levels_.clear();
@@ -324,7 +205,7 @@ TickReport World::step(double dt, const Budget& budget) {
   TickReport report;
   report.entities = ids_.size();
   quarantined_.clear();
-  broken_.clear();
+  fracture_->newStep();
   quarantine(report);  // states edited through bodies() since the last step
   // Sleeping saves physics: without a response nothing sleeps, and every pair
   // is tested (and reports its contacts) every tick.

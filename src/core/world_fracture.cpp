@@ -1,63 +1,85 @@
-// World's part of fracture: which bodies break this tick, their pieces'
-// trees built inside the tick budget, and the pieces placed, weighed and set
-// moving as the parent was (fracture.hpp).
-#include "sphere_tree_collision/world.hpp"
+// World's part of fracture (world_fracture.hpp): which bodies break this
+// tick, their pieces' trees built inside the tick budget, and the pieces
+// placed, weighed and set moving as the parent was (fracture.hpp).
+#include "world_fracture.hpp"
 
 #include <algorithm>
 #include <string>
 
 namespace stc {
 
+// ---------------------------------------------------------------------------------
+// World: its calls into the part
+
 std::vector<EntityId> World::breakEntity(EntityId id, const Vec3& point, const Vec3& normal) {
-  const auto found = indexOf(id);
-  if (!found || bodies_[*found].is_static || !point.allFinite() || !(normal.norm() > 0.0)) return {};
-  std::vector<VoxelPiece> pieces = piecesOf(*found, gridPlaneOf(*found, point, normal));
-  return placePieces(*found, pieces);
+  return fracture_->breakEntity(*this, id, point, normal);
 }
 
-SplitPlane World::gridPlaneOf(std::size_t index, const Vec3& point, const Vec3& normal) const {
-  const Pose& pose = bodies_[index].pose;
-  const ShapeInfo& info = shapes_[body_shapes_[index]];
+const std::vector<BrokenEntity>& World::broken() const { return fracture_->broken(); }
+
+double World::fracture(double now, const Deadline& tick_end, TickReport& report) {
+  return fracture_->fracture(*this, clock_, now, tick_end, report);
+}
+
+double World::breakPending(double now, const Deadline& tick_end, TickReport& report) {
+  return fracture_->breakPending(*this, clock_, now, tick_end, report);
+}
+
+// ---------------------------------------------------------------------------------
+// WorldFracture
+
+std::vector<EntityId> WorldFracture::breakEntity(World& world, EntityId id, const Vec3& point, const Vec3& normal) {
+  const auto found = world.indexOf(id);
+  if (!found || world.bodies()[*found].is_static || !point.allFinite() || !(normal.norm() > 0.0)) return {};
+  std::vector<VoxelPiece> pieces = piecesOf(world, *found, gridPlaneOf(world, *found, point, normal));
+  return placePieces(world, *found, pieces);
+}
+
+SplitPlane WorldFracture::gridPlaneOf(const World& world, std::size_t index, const Vec3& point, const Vec3& normal) {
+  const Pose& pose = world.bodies()[index].pose;
+  const ShapeInfo& info = world.shape(world.bodyShapes()[index]);
   // The body frame is the grid frame moved to the centre of mass.
   const Quat to_body = pose.orientation.conjugate();
   return fracturePlane(to_body * (point - pose.position) + info.body_origin, to_body * normal, info.body_origin);
 }
 
-std::vector<VoxelPiece> World::piecesOf(std::size_t index, const SplitPlane& plane) const {
-  const VoxelShape& voxels = shapes_[body_shapes_[index]].voxels;
-  std::vector<VoxelPiece> pieces = splitVoxelShape(voxels, plane, config_.fracture);
+std::vector<VoxelPiece> WorldFracture::piecesOf(const World& world, std::size_t index, const SplitPlane& plane) {
+  const VoxelShape& voxels = world.shape(world.bodyShapes()[index]).voxels;
+  std::vector<VoxelPiece> pieces = splitVoxelShape(voxels, plane, world.config().fracture);
   if (pieces.size() == 1 && pieces[0].voxels == voxels.occupiedCount()) return {};
-  if (ids_.size() - 1 + pieces.size() > config_.max_entities) return {};
+  if (world.entityCount() - 1 + pieces.size() > world.config().max_entities) return {};
   return pieces;
 }
 
-std::optional<ShapeId> World::findPieceShape(const VoxelShape& voxels, std::string* key) const {
+std::optional<ShapeId> WorldFracture::findPieceShape(const World& world, const VoxelShape& voxels, std::string* key) {
   // Content key; a clash with different voxels (never seen) gets a suffix.
   *key = pieceShapeKey(voxels);
-  while (const auto same_key = findShape(*key)) {
-    if (sameVoxels(shapes_[*same_key].voxels, voxels)) return same_key;
+  while (const auto same_key = world.findShape(*key)) {
+    if (sameVoxels(world.shape(*same_key).voxels, voxels)) return same_key;
     *key += "'";
   }
   return std::nullopt;
 }
 
-std::vector<EntityId> World::placePieces(std::size_t index, std::vector<VoxelPiece>& pieces) {
+std::vector<EntityId> WorldFracture::placePieces(World& world, std::size_t index, std::vector<VoxelPiece>& pieces) {
   if (pieces.empty()) return {};
-  const BodyState parent = bodies_[index];  // copied: the arrays change below
-  const ShapeInfo& info = shapes_[body_shapes_[index]];  // deque: stays put as pieces are added
+  const WorldConfig& config = world.config();
+  const BodyState parent = world.bodies()[index];  // copied: the arrays change below
+  const ShapeInfo& info = world.shape(world.bodyShapes()[index]);  // deque: stays put as pieces are added
   const Mat3 r = parent.pose.orientation.toRotationMatrix();
   // The parent's density: the pieces' exact mass properties follow from it.
   const double density = 1.0 / (parent.inv_mass * info.unit_mass.mass);
   const double s = info.voxels.voxelSize();
-  const std::string parent_name = names_[index];
+  const std::string parent_name = world.bodyNames()[index];
   std::vector<EntitySpec> specs(pieces.size());
   int next_name = 0;
   for (std::size_t k = 0; k < pieces.size(); ++k) {
     std::string key;
-    const auto found = findPieceShape(pieces[k].shape, &key);
-    const ShapeId shape = found ? *found : addShape(key, std::move(pieces[k].shape));
+    const auto found = findPieceShape(world, pieces[k].shape, &key);
+    const ShapeId shape = found ? *found : world.addShape(key, std::move(pieces[k].shape));
     // The piece's centre of mass, from the parent's: its voxels stay where they were.
-    const Vec3 offset = r * (pieces[k].offset.cast<double>() * s + shapes_[shape].body_origin - info.body_origin);
+    const Vec3 offset =
+        r * (pieces[k].offset.cast<double>() * s + world.shape(shape).body_origin - info.body_origin);
     EntitySpec& spec = specs[k];
     spec.shape = shape;
     spec.pose.position = parent.pose.position + offset;
@@ -67,41 +89,44 @@ std::vector<EntityId> World::placePieces(std::size_t index, std::vector<VoxelPie
     spec.density = density;
     spec.material = parent.material;
     spec.material.strength = pieceStrength(parent.material.strength, pieces[k].voxels,
-                                           info.voxels.occupiedCount(), config_.fracture.strength_exponent);
+                                           info.voxels.occupiedCount(), config.fracture.strength_exponent);
     if (!parent_name.empty()) {
       do {
         spec.name = parent_name + "/piece" + std::to_string(next_name++);
-      } while (id_by_name_.count(spec.name) != 0);
+      } while (world.findByName(spec.name));
     }
     // A piece the limits would reject (its rim faster than max_speed, say)
     // keeps the body whole: nothing is removed that cannot be replaced.
     try {
       validateBodyInput(spec.pose, spec.linear_velocity, spec.angular_velocity, spec.density,
-                        spec.material, config_.limits);
+                        spec.material, config.limits);
     } catch (const InputError&) {
       return {};
     }
   }
-  const EntityId id = ids_[index];
-  BrokenEntity broken{id, parent_name, body_shapes_[index], {}};
-  removeEntity(id);
-  for (const EntitySpec& spec : specs) broken.pieces.push_back(addEntity(spec));
+  const EntityId id = world.entityIds()[index];
+  BrokenEntity broken{id, parent_name, world.bodyShapes()[index], {}};
+  world.removeEntity(id);
+  for (const EntitySpec& spec : specs) broken.pieces.push_back(world.addEntity(spec));
   broken_.push_back(broken);
   return broken.pieces;
 }
 
-double World::fracture(double now, const Deadline& tick_end, TickReport& report) {
+double WorldFracture::fracture(World& world, const SecondsClock& clock, double now, const Deadline& tick_end,
+                               TickReport& report) {
+  const std::vector<BodyState>& bodies = world.bodies();
+  const std::vector<Contact>& contacts = world.contacts();
   bool breakable = false;
-  for (const Contact& c : contacts_) {
-    breakable = breakable || bodies_[c.index_a].material.strength > 0.0 ||
-                bodies_[c.index_b].material.strength > 0.0;
+  for (const Contact& c : contacts) {
+    breakable = breakable || bodies[c.index_a].material.strength > 0.0 ||
+                bodies[c.index_b].material.strength > 0.0;
   }
   if (!breakable) return now;
 
   // Summed impulse on each body, and its hardest-hit contact: the impact point.
-  hits_.assign(bodies_.size(), BodyHits{});
-  for (std::size_t i = 0; i < contacts_.size(); ++i) {
-    const Contact& c = contacts_[i];
+  hits_.assign(bodies.size(), BodyHits{});
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    const Contact& c = contacts[i];
     const double impulse = (c.normal_impulse * c.normal + c.friction_impulse).norm();
     for (const std::uint32_t body : {c.index_a, c.index_b}) {
       BodyHits& hits = hits_[body];
@@ -115,29 +140,30 @@ double World::fracture(double now, const Deadline& tick_end, TickReport& report)
   // Each breaking body's plane, in its own frame (the dense indices and the
   // contacts go stale with the first break), queued after the breaks older
   // ticks had no time for.
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    const BodyState& body = bodies_[i];
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const BodyState& body = bodies[i];
     if (body.is_static || !(body.material.strength > 0.0) || !(hits_[i].impulse > body.material.strength)) continue;
-    const EntityId id = ids_[i];
+    const EntityId id = world.entityIds()[i];
     const bool queued = std::any_of(pending_breaks_.begin(), pending_breaks_.end(),
                                     [id](const PendingBreak& p) { return p.id == id; });
     if (queued) continue;
-    const Contact& c = contacts_[hits_[i].hardest];
-    pending_breaks_.push_back({id, gridPlaneOf(i, c.point, c.normal)});
+    const Contact& c = contacts[hits_[i].hardest];
+    pending_breaks_.push_back({id, gridPlaneOf(world, i, c.point, c.normal)});
   }
-  breakQueued(tick_end, false, report);
-  const double end = clock_();
+  breakQueued(world, clock, tick_end, false, report);
+  const double end = clock();
   report.fracture_s += end - now;
   return end;
 }
 
-double World::breakPending(double now, const Deadline& tick_end, TickReport& report) {
+double WorldFracture::breakPending(World& world, const SecondsClock& clock, double now, const Deadline& tick_end,
+                                   TickReport& report) {
   if (pending_breaks_.empty()) return now;
   // At the tick's start one tree only (and the breaks whose trees exist):
   // integrate and the broad phase that follow cannot be cut short, so more
   // trees wait for the tick's end, where the time left is known.
-  breakQueued(tick_end.isSet() ? Deadline(&clock_, now) : tick_end, true, report);
-  const double end = clock_();
+  breakQueued(world, clock, tick_end.isSet() ? Deadline(&clock, now) : tick_end, true, report);
+  const double end = clock();
   report.fracture_s += end - now;
   return end;
 }
@@ -146,31 +172,32 @@ double World::breakPending(double now, const Deadline& tick_end, TickReport& rep
 // pieces share one); a missing tree is built when its estimated cost fits
 // before the deadline, or, once, when asked (the queue always moves). The
 // first break whose trees do not fit stops the walk: it and the rest wait.
-void World::breakQueued(const Deadline& trees_until, bool one_tree_anyway, TickReport& report) {
+void WorldFracture::breakQueued(World& world, const SecondsClock& clock, const Deadline& trees_until,
+                                bool one_tree_anyway, TickReport& report) {
   std::size_t done = 0;
   for (; done < pending_breaks_.size(); ++done) {
     const PendingBreak& p = pending_breaks_[done];
-    const auto index = indexOf(p.id);
+    const auto index = world.indexOf(p.id);
     if (!index) continue;  // removed meanwhile
-    std::vector<VoxelPiece> pieces = piecesOf(*index, p.plane);
+    std::vector<VoxelPiece> pieces = piecesOf(world, *index, p.plane);
     bool ready = true;
     for (const VoxelPiece& piece : pieces) {
       std::string key;
-      if (findPieceShape(piece.shape, &key)) continue;
+      if (findPieceShape(world, piece.shape, &key)) continue;
       if (!one_tree_anyway && !(tree_cost_.seconds(piece.voxels) <= trees_until.remaining())) {
         ready = false;
         break;
       }
       one_tree_anyway = false;
-      const double start = clock_();
-      addShape(key, piece.shape);
-      const double seconds = clock_() - start;
+      const double start = clock();
+      world.addShape(key, piece.shape);
+      const double seconds = clock() - start;
       tree_cost_.record(piece.voxels, seconds);
       ++report.piece_trees;
       report.piece_tree_s += seconds;
     }
     if (!ready) break;
-    if (!placePieces(*index, pieces).empty()) ++report.fractures;
+    if (!placePieces(world, *index, pieces).empty()) ++report.fractures;
   }
   pending_breaks_.erase(pending_breaks_.begin(), pending_breaks_.begin() + done);
   report.fractures_deferred = pending_breaks_.size();

@@ -11,6 +11,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <string>
 #include <utility>
 
 namespace stc {
@@ -232,6 +233,57 @@ TEST(World, RemoveSwapsTheLastIntoTheHoleAndClearKeepsShapes) {
 // The broad phase's pairs keep their dense indices from tick to tick
 // (setUpPairTests), so a removal, which moves the last body into the hole,
 // must not leave a pair test reading another body's pose.
+TEST(World, RemovingEntitiesLeavesThePairsOfAWorldBuiltWithoutThem) {
+  // A lattice of cubes 1.2 sides apart: each one's fixed-cube box overlaps
+  // all 26 neighbours' (the cubes do not touch; no gravity: nothing moves).
+  // Two batches of removals, a tick apart, as the quarantine makes them,
+  // must leave the broad-phase pairs of a world built with the rest alone.
+  const int n = 12;
+  const double spacing = 1.2 * 0.4;
+  const auto build = [&](World& w, const std::vector<bool>& skip) {
+    const ShapeId cube = addPreset(w, "cube");
+    for (int k = 0; k < n * n * n; ++k) {
+      if (skip[static_cast<std::size_t>(k)]) continue;
+      w.addEntity(specAt(cube, Vec3(k % n, (k / n) % n, k / (n * n)) * spacing, "c" + std::to_string(k)));
+    }
+  };
+  const auto namedPairs = [](const World& w) {
+    std::set<std::pair<std::string, std::string>> out;
+    for (const BroadPair& p : w.broadPhase().pairs()) {
+      const std::string& a = w.bodyNames()[*w.indexOf(p.first)];
+      const std::string& b = w.bodyNames()[*w.indexOf(p.second)];
+      out.emplace(std::min(a, b), std::max(a, b));
+    }
+    return out;
+  };
+  std::vector<bool> removed(n * n * n, false);
+  World big;
+  build(big, removed);
+  const double dt = 1.0 / 60.0;
+  big.step(dt, Budget::unlimited());
+  const std::size_t pairs_before = big.broadPhase().pairs().size();
+  EXPECT_GT(pairs_before, static_cast<std::size_t>(10 * n * n * n));
+  std::mt19937 rng(3);
+  std::vector<int> order(n * n * n);
+  for (int k = 0; k < n * n * n; ++k) order[static_cast<std::size_t>(k)] = k;
+  std::shuffle(order.begin(), order.end(), rng);
+  for (const int batch : {300, 100}) {
+    for (int r = 0; r < batch; ++r) {
+      const int k = order.back();
+      order.pop_back();
+      removed[static_cast<std::size_t>(k)] = true;
+      EXPECT_TRUE(big.removeEntity(*big.findByName("c" + std::to_string(k))));
+    }
+    big.step(dt, Budget::unlimited());
+  }
+  World fresh;
+  build(fresh, removed);
+  fresh.step(dt, Budget::unlimited());
+  ASSERT_EQ(big.entityCount(), fresh.entityCount());
+  EXPECT_LT(big.broadPhase().pairs().size(), pairs_before);
+  EXPECT_EQ(namedPairs(big), namedPairs(fresh));
+}
+
 TEST(World, PairTestsReadTheirOwnBodiesThroughRemovals) {
   SceneParams params;
   params.entities = 300;

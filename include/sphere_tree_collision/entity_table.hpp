@@ -1,0 +1,79 @@
+// EntityTable: the entities' rows. Each per-entity fact is one flat array
+// indexed by a dense index 0..entityCount(), with ids and names mapped to
+// it; removing a row moves the last row into its place (swap-remove), so the
+// arrays stay dense. Ids are never reused.
+//
+// What else is kept per entity follows each add and remove in one place,
+// World::addEntity / World::removeEntity: Islands, IslandLevels and
+// StaticCover (by dense index, with the same swap-remove) and the broad
+// phase (by id). The World derives from the table privately, so the tick
+// reads the arrays by their names.
+#pragma once
+
+#include "sphere_tree_collision/body.hpp"
+#include "sphere_tree_collision/types.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace stc {
+
+namespace detail {
+class FlatHashMap;  // src/core/flat_hash_map.hpp
+}  // namespace detail
+
+// How an entity's broad-phase box is made (paper 3.2).
+enum class BoxMode : std::uint8_t {
+  Auto,     // chosen from the shape: Dynamic when elongated, else FixedCube
+  FixedCube,  // cube big enough for any orientation; only moves with the centre
+  Dynamic,    // tight AABB of the rotated root-level spheres, recomputed each tick
+};
+
+class EntityTable {
+ public:
+  EntityTable();
+  ~EntityTable();
+  EntityTable(EntityTable&&) noexcept;
+  EntityTable& operator=(EntityTable&&) noexcept;
+
+  std::size_t entityCount() const { return ids_.size(); }
+  const std::vector<EntityId>& entityIds() const { return ids_; }
+  const std::vector<BodyState>& bodies() const { return bodies_; }
+  std::vector<BodyState>& bodies() { return bodies_; }
+  const std::vector<ShapeId>& bodyShapes() const { return body_shapes_; }
+  const std::vector<std::string>& bodyNames() const { return names_; }
+  std::optional<std::size_t> indexOf(EntityId id) const;
+  std::optional<EntityId> findByName(const std::string& name) const;
+  // Whether one more entity can get an id (they are never reused).
+  bool idsLeft() const { return next_id_ != kInvalidEntity; }
+
+ protected:
+  // A row at the end (dense index entityCount() - 1) with the next id, which
+  // is returned. The name is empty or unused (checked by the caller).
+  EntityId addRow(const BodyState& body, ShapeId shape, BoxMode box_mode, std::string name);
+  // Row `index` removed: the last row takes its place.
+  void removeRow(std::size_t index);
+  // Every row removed; ids go on counting.
+  void clearRows();
+
+  // By dense index; ids_ maps dense -> id.
+  std::vector<EntityId> ids_;
+  std::vector<BodyState> bodies_;
+  std::vector<ShapeId> body_shapes_;
+  std::vector<BoxMode> box_modes_;
+  std::vector<std::string> names_;
+  // Entity id -> dense index, open addressing on flat arrays: the pair walk
+  // of every tick looks up two per broad-phase pair (a settled pile of 5,000
+  // rocks: ~50,000 pairs; docs/sleeping.md).
+  std::unique_ptr<detail::FlatHashMap> index_of_;
+
+ private:
+  std::unordered_map<std::string, EntityId> id_by_name_;
+  EntityId next_id_ = 0;
+};
+
+}  // namespace stc
