@@ -336,4 +336,12 @@ void Physics::solve(const StepContext& step) {
   report_.solve = solver_.solve(*step.bodies, contacts, run, step.dt, step.budget);
 }
 
+void Physics::releaseMemory() {
+  for (ChunkContacts& chunk : chunk_contacts_) dropSpareCapacity(chunk.contacts);
+  dropSpareCapacity(solver_);
+  dropSpareCapacity(start_);
+  dropSpareCapacity(body_bounds_);
+  dropSpareCapacity(sweep_hit_of_pair_);
+}
+
 }  // namespace stc

@@ -208,26 +208,41 @@ void WorldNode::guarded(const char* what, F&& callback) {
 
 void WorldNode::tick() {
   ++beats_;
-  releaseFreedMemory();
   if (paused_ && steps_pending_ == 0) {
     guarded("entity list", [this] { publishEntityList(); });  // inputs still change the world while paused
+    releaseFreedMemory();
     return;
   }
   if (steps_pending_ > 0) --steps_pending_;
   guarded("tick", [this] { runTick(); });
+  releaseFreedMemory();
 }
 
-// glibc keeps freed heap for the process: without this a node that once held a
-// flood of 10,000 entities kept 2.7 x its resident set after they were gone.
-// Handed back when the world shrank to half its peak, by at least 1,000.
+// After the world shrank to half its peak, by at least 1,000 entities (at the
+// end of a tick: this tick's buffers are sized for what is left), the arrays
+// and messages sized for the peak are cut to size, and glibc hands the freed
+// heap back (it keeps it for the process otherwise). A flood of 10,000
+// spawns and despawns left the resident set at 2.7 x its level before with
+// neither, 2.0-2.1 x with malloc_trim alone (docs/results.md). The heap is
+// trimmed again kRetrimTicks later: by then the messages of the peak (the
+// latched entity list, the publishers' queues) were replaced and freed.
 void WorldNode::releaseFreedMemory() {
   constexpr std::size_t kMinDrop = 1000;
+  constexpr std::uint32_t kRetrimTicks = 10;
+  if (retrim_in_ > 0 && --retrim_in_ == 0) malloc_trim(0);
   const std::size_t n = world_.entityCount();
   peak_entities_ = std::max(peak_entities_, n);
-  if (peak_entities_ >= n + kMinDrop && 2 * n <= peak_entities_) {
-    malloc_trim(0);
-    peak_entities_ = n;
-  }
+  if (peak_entities_ < n + kMinDrop || 2 * n > peak_entities_) return;
+  peak_entities_ = n;
+  retrim_in_ = kRetrimTicks;
+  world_.releaseMemory();
+  markers_->releaseMemory();
+  entity_states_.releaseMemory();
+  contacts_msg_.contacts.shrink_to_fit();
+  tf_msg_.transforms.shrink_to_fit();
+  colors_.rehash(0);
+  frames_.rehash(0);
+  malloc_trim(0);
 }
 
 void WorldNode::setPaused(bool paused) {

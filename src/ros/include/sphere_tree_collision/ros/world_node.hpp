@@ -115,6 +115,7 @@ class WorldNode final : public WorldControl {
   std::uint64_t tick_ = 0;
   std::uint64_t ticks_per_states_ = 1;
   std::size_t peak_entities_ = 0;  // most entities since memory was last handed back
+  std::uint32_t retrim_in_ = 0;    // ticks to the heap's second trim after a release
   std::uint64_t beats_ = 0;  // timer callbacks: ticks and those while paused (~entities' rate)
   bool paused_ = false;
   std::uint64_t steps_pending_ = 0;  // paused: ticks ~step still asks for
