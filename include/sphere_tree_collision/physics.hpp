@@ -96,6 +96,9 @@ class Physics {
   void solve(const StepContext& step);
   const PhysicsReport& lastReport() const { return report_; }
   void forget() { solver_.forget(); }
+  // Pooled arrays cut to their size (World::releaseMemory); the caches of
+  // carried contacts keep theirs.
+  void releaseMemory();
 
   // Whether the response carries contacts over (ResponseOptions::reuse_tolerance).
   static bool reusesContacts(const ResponseOptions& options) {

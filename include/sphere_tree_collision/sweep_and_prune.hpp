@@ -44,6 +44,10 @@ class SweepAndPrune {
   std::size_t size() const;
   // The box last given for an entity (by add or setBox); unknown id throws InputError("id").
   Aabb box(EntityId id) const;
+  // Rebuilt for the boxes it holds now, then updated (World::releaseMemory):
+  // its per-slot arrays and lists keep the size of its peak otherwise. The
+  // pairs stay the same set, perhaps in another order.
+  void releaseMemory();
   // Endpoint swaps done by the last update(): the measure of coherence.
   std::size_t lastSwapCount() const { return last_swaps_; }
 

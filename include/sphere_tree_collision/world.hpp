@@ -185,6 +185,13 @@ class World : private ShapeLibrary, private EntityTable {
   bool removeEntity(EntityId id);
   using EntityTable::findByName;
   void clear();  // removes every entity, keeps shapes
+  // Hands back what the pooled arrays keep beyond today's entities and pairs
+  // (after a large removal: a flood of 10,000 spawns and despawns left 13 MB
+  // in them). Changes no state but the order of the broad phase's pairs (it
+  // is rebuilt), so later ticks may differ in their last bits, as after any
+  // removal; the next ticks allocate again what they need. Not for every
+  // tick: it copies every per-entity array.
+  void releaseMemory();
 
   // Breaks a body as an impact at `point` along `normal` (world frame) would
   // (fracture.hpp): its pieces replace it, each with the parent's velocity at

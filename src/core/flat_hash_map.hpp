@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace stc {
@@ -58,6 +59,14 @@ class FlatHashMap {
     if (n * 2 > slots_.size()) grow(n * 2);
   }
   std::size_t size() const { return size_; }
+  // Rebuilt at the smallest table its entries fit (after many erases).
+  void shrinkToFit() {
+    FlatHashMap fitted;
+    fitted.reserve(size_);
+    for (const Slot& s : slots_)
+      if (s.key != kEmpty) fitted.set(s.key, s.value);
+    *this = std::move(fitted);
+  }
   // Empties the map and keeps its capacity.
   void clear() {
     if (size_ == 0) return;

@@ -34,4 +34,12 @@ void resizeRewritten(std::vector<T>& v, std::size_t n) {
   v.resize(n);
 }
 
+// The opposite, after a large removal (World::releaseMemory): a vector, or an
+// object made of vectors, copied anew holds each at its size, not at the
+// capacity it grew to; the copy replaces it.
+template <typename T>
+void dropSpareCapacity(T& holder) {
+  holder = T(holder);
+}
+
 }  // namespace stc

@@ -383,4 +383,12 @@ void Physics::solve(const StepContext& step) {
   }
 }
 
+void Physics::releaseMemory() {
+  for (ChunkContacts& chunk : chunk_contacts_) dropSpareCapacity(chunk.contacts);
+  dropSpareCapacity(solver_);
+  dropSpareCapacity(start_);
+  dropSpareCapacity(body_bounds_);
+  dropSpareCapacity(sweep_hit_of_pair_);
+}
+
 }  // namespace stc

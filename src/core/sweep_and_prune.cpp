@@ -710,6 +710,19 @@ void SweepAndPrune::add(EntityId id, const Aabb& box) {
   m.added.push_back(slot);
 }
 
+void SweepAndPrune::releaseMemory() {
+  const Impl& m = *impl_;
+  SweepAndPrune fitted;
+  for (std::uint32_t slot = 0; slot < m.state.size(); ++slot) {
+    if (m.state[slot] == SlotState::kAdded || m.state[slot] == SlotState::kLive) {
+      fitted.add(m.ids[slot], box(m.ids[slot]));
+    }
+  }
+  fitted.update();
+  fitted.last_swaps_ = last_swaps_;
+  *this = std::move(fitted);
+}
+
 void SweepAndPrune::remove(EntityId id) {
   Impl& m = *impl_;
   const std::uint32_t slot = m.slotOfId(id);

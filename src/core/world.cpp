@@ -147,6 +147,31 @@ void World::clear() {
   invalidateLastTick();
 }
 
+void World::releaseMemory() {
+  dropSpareCapacity(ids_);
+  dropSpareCapacity(bodies_);
+  dropSpareCapacity(body_shapes_);
+  dropSpareCapacity(box_modes_);
+  dropSpareCapacity(names_);
+  dropSpareCapacity(static_cover_);
+  broad_phase_.releaseMemory();
+  index_of_->shrinkToFit();
+  id_by_name_.rehash(0);  // as few buckets as its entries need
+  dropSpareCapacity(boxes_);
+  dropSpareCapacity(pair_bodies_);
+  dropSpareCapacity(pair_tested_);
+  dropSpareCapacity(pairs_seen_);
+  dropSpareCapacity(pair_priority_);
+  dropSpareCapacity(pair_reused_);
+  dropSpareCapacity(contacts_);
+  physics_.releaseMemory();
+  dropSpareCapacity(islands_);
+  dropSpareCapacity(levels_);
+  dropSpareCapacity(out_of_step_);
+  dropSpareCapacity(held_through_tick_);
+  dropSpareCapacity(hits_);
+}
+
 void World::setScheduler(const SchedulerOptions& options) {
   // All made before any is replaced (makeScheduler may throw: change nothing).
   // The chunks stay: their arenas hold the last tick's pairs.

@@ -73,4 +73,11 @@ void EntityStatePublisher::publishStates(const stc::World& world, const Frames& 
   states_pub_.publish(m);
 }
 
+void EntityStatePublisher::releaseMemory() {
+  states_msg_.names.shrink_to_fit();
+  states_msg_.ids.shrink_to_fit();
+  states_msg_.poses.shrink_to_fit();
+  states_msg_.twists.shrink_to_fit();
+}
+
 }  // namespace stc_ros

@@ -80,6 +80,14 @@ void MarkerPublisher::retune(const NodeParams& next) {
   worldCleared();
 }
 
+void MarkerPublisher::releaseMemory() {
+  msg_ = visualization_msgs::MarkerArray();  // each array is built from its start
+  bounds_msg_.markers.shrink_to_fit();
+  colors_by_index_.shrink_to_fit();
+  removed_.shrink_to_fit();
+  sent_.rehash(0);
+}
+
 void MarkerPublisher::publish(const ros::Time& stamp) {
   if (pub_.getNumSubscribers() == 0) {
     // Nobody to keep up to date: the next subscriber starts from a snapshot.

@@ -191,6 +191,16 @@ class WorldUnderTest {
       }
       if (recording_) tf_[m->transforms.front().header.stamp] = *m;
     });
+    // Static entities are on tf_static (latched, sent whole when they change), not in each tick's tf.
+    tf_static_sub_ = nh.subscribe<tf2_msgs::TFMessage>("tf_static", 10, [this](const tf2_msgs::TFMessage::ConstPtr& m) {
+      static_poses_.clear();
+      for (const auto& t : m->transforms) {
+        const auto id = idOfFrame(t.child_frame_id);
+        if (!id) continue;
+        frames_seen_.insert(*id);
+        static_poses_[*id] = stc::Pose{stc_ros::toEigen(t.transform.translation), stc_ros::toEigen(t.transform.rotation)};
+      }
+    });
     stats_sub_ = nh.subscribe<TickStats>("collision_world/tick_stats", 1000, [this](const TickStats::ConstPtr& m) {
       if (!recording_) return;
       ++stats_ticks_;
@@ -235,17 +245,19 @@ class WorldUnderTest {
   std::size_t contactTicks() const { return contacts_.size(); }
   const std::map<ros::Time, ContactArray>& contacts() const { return contacts_; }
   const std::map<ros::Time, tf2_msgs::TFMessage>& tf() const { return tf_; }
+  const std::map<stc::EntityId, stc::Pose>& staticPoses() const { return static_poses_; }
 
  private:
   std::string ns_;
   ros::Publisher spawn_pub_;
-  ros::Subscriber contacts_sub_, tf_sub_, stats_sub_;
+  ros::Subscriber contacts_sub_, tf_sub_, tf_static_sub_, stats_sub_;
   std::size_t stats_ticks_ = 0;
   std::int64_t sphere_tests_ = 0;
   std::set<stc::EntityId> frames_seen_, frames_before_;
   bool recording_ = false;
   std::map<ros::Time, ContactArray> contacts_;
   std::map<ros::Time, tf2_msgs::TFMessage> tf_;
+  std::map<stc::EntityId, stc::Pose> static_poses_;  // from the last tf_static
 };
 
 // ---------------------------------------------------------------------------
@@ -349,6 +361,7 @@ Tally check(const WorldUnderTest& world, const std::map<stc::EntityId, Truth>& t
       p.orientation = stc_ros::toEigen(tr.transform.rotation);
       poses[*id] = p;
     }
+    poses.insert(world.staticPoses().begin(), world.staticPoses().end());
     EXPECT_EQ(poses.size(), truth.size()) << world.ns() << ": tf of tick " << stamp << " lacks entities";
 
     std::map<std::pair<stc::EntityId, stc::EntityId>, PairContact> pairs;

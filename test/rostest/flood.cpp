@@ -3,10 +3,10 @@
 // (markers, error bounds, contacts, tick_stats, entities, entity states, tf).
 // Asserted: no message is dropped or refused (tick_stats' entity count reaches
 // exactly 10,000 and then 0, the latched entity list says the same, nothing is
-// counted as rejected). Waits are liveness bounds. Printed, not asserted: the
-// tick time each half took, and the node's resident set before, full and after
-// (issue 47 asks for after <= 1.5 x before; the core keeps its pooled arrays'
-// capacity, so that is not met yet: docs/results.md, "Targets not met").
+// counted as rejected), and the node's resident set, once the world is empty
+// again, is within 1.5 x its level before the flood (issue 47): a state, read
+// from /proc/<pid>/status. Waits are liveness bounds. Printed, not asserted:
+// the tick time each half took, and the resident set before, full and after.
 #include "rostest_util.hpp"
 
 #include <gtest/gtest.h>
@@ -127,6 +127,9 @@ TEST(Flood, TenThousandSpawnsAndDespawnsAreAllApplied) {
   // Let a few ticks run on the empty world, then compare the resident set.
   ASSERT_TRUE(stats.waitFor(stats.count() + 30, stc_test::kLivenessSeconds));
   const long rss_after = residentKb(pid);
+  // What the world held is handed back (WorldNode::releaseFreedMemory): the
+  // libraries and the empty world are most of the level before.
+  EXPECT_LE(rss_after, rss_before * 3 / 2) << "RSS " << rss_before << " kB before, " << rss_full << " kB full";
 
   // Figures, not asserts: the tick time each half took, summed over the node's ticks.
   auto tickTime = [&](std::size_t from, std::size_t to) {

@@ -6,8 +6,11 @@
 
 #include <gtest/gtest.h>
 #include <sphere_tree_collision/ContactArray.h>
+#include <sphere_tree_collision/Despawn.h>
 #include <sphere_tree_collision/GazePoint.h>
+#include <sphere_tree_collision/SpawnEntity.h>
 #include <sphere_tree_collision/TickStats.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -17,6 +20,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <string>
 
 namespace {
 
@@ -205,6 +209,61 @@ TEST(Smoke, TickStatsAndContactsEveryTick) {
   EXPECT_GT(stats.last.tick, 0u);
   EXPECT_EQ(stats.last.scheduler, "priority_queues");
   EXPECT_FALSE(stats.last.perception_used) << "no gaze published: no projection work";
+}
+
+// Static entities never move: their frames go out on /tf_static (latched, one
+// message with every static frame, the camera's too), again whole when a
+// static entity comes or goes; /tf carries the moving ones each tick. Last:
+// it spawns an entity (and despawns it), which the tests above do not expect.
+TEST(Smoke, StaticFramesOnTfStaticMovingOnesOnTf) {
+  ros::NodeHandle nh;
+  Recorder<tf2_msgs::TFMessage> tf(nh, "/tf", 100);
+  tf.keep_all = true;
+  Recorder<tf2_msgs::TFMessage> tf_static(nh, "/tf_static", 10);
+  ros::Publisher spawn = nh.advertise<sphere_tree_collision::SpawnEntity>("/collision_world/spawn", 10);
+  ros::Publisher despawn = nh.advertise<sphere_tree_collision::Despawn>("/collision_world/despawn", 10);
+  const auto framesOf = [](const tf2_msgs::TFMessage& m) {
+    std::set<std::string> out;
+    for (const auto& t : m.transforms) out.insert(t.child_frame_id);
+    return out;
+  };
+  ASSERT_TRUE(stc_test::spinUntil(
+      [&] { return tf_static.count() > 0 && spawn.getNumSubscribers() > 0 && despawn.getNumSubscribers() > 0; },
+      stc_test::kLivenessSeconds));
+  EXPECT_EQ(framesOf(tf_static.last), std::set<std::string>{"perception_camera"}) << "no entity of the scene is static";
+
+  sphere_tree_collision::SpawnEntity shelf;
+  shelf.name = "shelf";
+  shelf.preset = "cube";
+  shelf.resolution = 4;
+  shelf.voxel_size = 0.1;
+  shelf.is_static = true;
+  shelf.pose.position.z = -3.0;  // away from the scene: no contact
+  shelf.pose.orientation.w = 1.0;
+  spawn.publish(shelf);
+  ASSERT_TRUE(stc_test::spinUntil([&] { return framesOf(tf_static.last).count("shelf") == 1; },
+                                  stc_test::kLivenessSeconds))
+      << "the static entity's frame on /tf_static";
+  EXPECT_EQ(framesOf(tf_static.last).count("perception_camera"), 1u) << "sent whole: the camera's frame stays";
+  for (const auto& t : tf_static.last.transforms) {
+    if (t.child_frame_id == "shelf") EXPECT_EQ(t.transform.translation.z, -3.0);
+  }
+
+  tf.clear();
+  ASSERT_TRUE(tf.waitFor(3, stc_test::kLivenessSeconds));
+  for (const auto& m : tf.all) {
+    const std::set<std::string> frames = framesOf(m);
+    EXPECT_EQ(frames.count("shelf"), 0u) << "a static frame on /tf";
+    for (const std::string& e : entityFrames()) EXPECT_EQ(frames.count(e), 1u) << "moving " << e << " not on /tf";
+  }
+
+  sphere_tree_collision::Despawn gone;
+  gone.name = "shelf";
+  despawn.publish(gone);
+  ASSERT_TRUE(stc_test::spinUntil([&] { return framesOf(tf_static.last).count("shelf") == 0; },
+                                  stc_test::kLivenessSeconds))
+      << "the despawned static entity's frame still on /tf_static";
+  EXPECT_EQ(framesOf(tf_static.last), std::set<std::string>{"perception_camera"});
 }
 
 }  // namespace

@@ -480,6 +480,31 @@ TEST(SweepAndPrune, ThousandMoversMatchBruteForceEveryTick) {
   RecordProperty("max_pairs", static_cast<int>(max_pairs));
 }
 
+// releaseMemory (after most boxes left, some removals still pending) keeps
+// the pair set, and the rebuilt lists go on finding the right pairs.
+TEST(SweepAndPrune, ReleaseMemoryKeepsThePairsAndGoesOn) {
+  MoverScene scene(77);
+  SweepAndPrune sap;
+  for (int i = 0; i < 1000; ++i) scene.addRandom(sap);
+  sap.update();
+  for (int i = 0; i < 700; ++i) scene.removeRandom(sap);
+  sap.update();
+  for (int i = 0; i < 100; ++i) scene.removeRandom(sap);  // pending at the release
+  for (int i = 0; i < 20; ++i) scene.addRandom(sap);
+  sap.releaseMemory();
+  ASSERT_EQ(sap.size(), scene.size());
+  ASSERT_EQ(sorted(sap.pairs()), scene.bruteForcePairs());
+  ASSERT_GT(sap.pairs().size(), 0u);
+  for (int tick = 0; tick < 200; ++tick) {
+    scene.move(sap, tick % 50 == 25 ? 0.2 : 0.002);
+    if (tick % 40 == 10) {
+      for (int i = 0; i < 50; ++i) scene.addRandom(sap);
+    }
+    sap.update();
+    ASSERT_EQ(sorted(sap.pairs()), scene.bruteForcePairs()) << "tick " << tick;
+  }
+}
+
 // A world mostly at rest: updates that touch few boxes sort only the bands
 // of the moved ones and quantise them with the last full update's maps, also
 // when a box jumps out of the bounds those maps were made for.

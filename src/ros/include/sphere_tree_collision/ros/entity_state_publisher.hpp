@@ -31,6 +31,8 @@ class EntityStatePublisher {
   void publishListIfChanged(const stc::World& world, const Frames& frames, const ros::Time& stamp,
                             std::uint64_t beat);
   void publishStates(const stc::World& world, const Frames& frames, const ros::Time& stamp);
+  // After a large removal: the states buffer cut to what it holds.
+  void releaseMemory();
 
  private:
   std::string world_frame_;

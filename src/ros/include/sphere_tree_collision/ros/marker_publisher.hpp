@@ -54,6 +54,8 @@ class MarkerPublisher {
   // Live tuning: marker rate, levels and voxels shown. New levels or voxels
   // redraw every entity (the next array starts with DELETEALL).
   void retune(const NodeParams& next);
+  // After a large removal: the message buffers cut to what they hold.
+  void releaseMemory();
 
  private:
   void publish(const ros::Time& stamp);

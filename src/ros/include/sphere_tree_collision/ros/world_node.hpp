@@ -21,6 +21,7 @@
 #include "sphere_tree_collision/world.hpp"
 
 #include <geometry_msgs/PointStamped.h>
+#include <geometry_msgs/TransformStamped.h>
 #include <ros/ros.h>
 #include <sphere_tree_collision/ContactArray.h>
 #include <sphere_tree_collision/Despawn.h>
@@ -31,7 +32,6 @@
 #include <std_msgs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
 #include <memory>
@@ -104,6 +104,8 @@ class WorldNode final : public WorldControl {
   void publishStats(const stc::TickReport& report, const ros::Time& stamp);
   void publishContacts(const ros::Time& stamp);
   void publishTf(const ros::Time& stamp);
+  void publishStaticFrames(const ros::Time& stamp);
+  bool entityTransform(std::size_t index, const ros::Time& stamp, geometry_msgs::TransformStamped& t);
 
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
@@ -115,6 +117,7 @@ class WorldNode final : public WorldControl {
   std::uint64_t tick_ = 0;
   std::uint64_t ticks_per_states_ = 1;
   std::size_t peak_entities_ = 0;  // most entities since memory was last handed back
+  std::uint32_t retrim_in_ = 0;    // ticks to the heap's second trim after a release
   std::uint64_t beats_ = 0;  // timer callbacks: ticks and those while paused (~entities' rate)
   bool paused_ = false;
   std::uint64_t steps_pending_ = 0;  // paused: ticks ~step still asks for
@@ -131,7 +134,8 @@ class WorldNode final : public WorldControl {
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;  // only with ~camera_frame
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   bool camera_from_tf_ = false;
-  std::unique_ptr<tf2_ros::StaticTransformBroadcaster> camera_broadcaster_;  // without ~camera_frame
+  std::optional<geometry_msgs::TransformStamped> camera_tf_;  // on /tf_static, without ~camera_frame
+  bool static_frames_changed_ = true;  // /tf_static is sent again at the next tick
   std::unique_ptr<PerceptionCameraInfo> camera_info_;  // ~camera_info, and ~camera_info_topic
 
   // Rejected inputs, total and per topic.
@@ -148,7 +152,7 @@ class WorldNode final : public WorldControl {
   tf2_msgs::TFMessage tf_msg_;
   sphere_tree_collision::TickStats stats_msg_;
 
-  ros::Publisher contacts_pub_, stats_pub_, tf_pub_, quarantined_pub_;
+  ros::Publisher contacts_pub_, stats_pub_, tf_pub_, tf_static_pub_, quarantined_pub_;
   ros::Subscriber spawn_sub_, despawn_sub_, clear_sub_, gaze_sub_, clicked_sub_;
   std::unique_ptr<LiveTuning> tuning_;
   std::unique_ptr<NodeDiagnostics> diagnostics_;
