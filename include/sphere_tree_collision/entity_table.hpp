@@ -59,6 +59,8 @@ class EntityTable {
   void removeRow(std::size_t index);
   // Every row removed; ids go on counting.
   void clearRows();
+  // The arrays and maps cut to what the rows hold (after a flood of removals).
+  void releaseRowMemory();
 
   // By dense index; ids_ maps dense -> id.
   std::vector<EntityId> ids_;

@@ -2,6 +2,7 @@
 #include "sphere_tree_collision/entity_table.hpp"
 
 #include "flat_hash_map.hpp"
+#include "grow_capacity.hpp"
 
 #include <cassert>
 #include <utility>
@@ -67,6 +68,16 @@ void EntityTable::clearRows() {
   names_.clear();
   *index_of_ = detail::FlatHashMap();
   id_by_name_.clear();
+}
+
+void EntityTable::releaseRowMemory() {
+  dropSpareCapacity(ids_);
+  dropSpareCapacity(bodies_);
+  dropSpareCapacity(body_shapes_);
+  dropSpareCapacity(box_modes_);
+  dropSpareCapacity(names_);
+  index_of_->shrinkToFit();
+  id_by_name_.rehash(0);  // as few buckets as its entries need
 }
 
 }  // namespace stc

@@ -148,15 +148,9 @@ void World::clear() {
 }
 
 void World::releaseMemory() {
-  dropSpareCapacity(ids_);
-  dropSpareCapacity(bodies_);
-  dropSpareCapacity(body_shapes_);
-  dropSpareCapacity(box_modes_);
-  dropSpareCapacity(names_);
+  releaseRowMemory();
   dropSpareCapacity(static_cover_);
   broad_phase_.releaseMemory();
-  index_of_->shrinkToFit();
-  id_by_name_.rehash(0);  // as few buckets as its entries need
   dropSpareCapacity(boxes_);
   dropSpareCapacity(pair_bodies_);
   dropSpareCapacity(pair_tested_);
@@ -169,7 +163,7 @@ void World::releaseMemory() {
   dropSpareCapacity(levels_);
   dropSpareCapacity(out_of_step_);
   dropSpareCapacity(held_through_tick_);
-  dropSpareCapacity(hits_);
+  fracture_->releaseMemory();
 }
 
 void World::setScheduler(const SchedulerOptions& options) {

@@ -6,6 +6,7 @@
 // one and calls it from step() and breakEntity().
 #pragma once
 
+#include "grow_capacity.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/fracture.hpp"
 #include "sphere_tree_collision/world.hpp"
@@ -33,6 +34,7 @@ class WorldFracture {
                       TickReport& report);
   // A step begins: broken() empties.
   void newStep() { broken_.clear(); }
+  void releaseMemory() { dropSpareCapacity(hits_); }
   const std::vector<BrokenEntity>& broken() const { return broken_; }
 
  private:
