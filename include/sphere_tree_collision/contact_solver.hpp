@@ -413,6 +413,20 @@ class ContactSolver {
   const Workers* workers_ = nullptr;
   std::size_t task_manifolds_ = 1;  // read only with workers_
   Team* team_ = nullptr;  // while the passes run on workers_ (solve)
+  // Runs `passes` on a team of workers_ (awake from stage to stage, team_ set
+  // meanwhile), or on the calling thread without workers.
+  template <typename Passes>
+  void onTeam(Passes&& passes) {
+    if (workers_ == nullptr) {
+      passes();
+      return;
+    }
+    workers_->withTeam([&](Team& team) {
+      team_ = &team;
+      passes();
+      team_ = nullptr;
+    });
+  }
   // Blocks (contact_solver_blocks.cpp): the manifolds in the order from the
   // ground (groups_, each one's first place in order_), their blocks, and in
   // block order where each block's manifolds start.

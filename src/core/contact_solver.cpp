@@ -876,20 +876,11 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
   // afforded to every later stage.
   // The restitution waves, the warm start and the passes run on a team: the
   // workers stay awake from stage to stage.
-  const auto warmAndIterate = [&] {
+  onTeam([&] {
     collide(options, stats);
     if (options.warm_starting) warmStart(contacts, bodies, stats);
     iterate(options, budget, stats);
-  };
-  if (workers_ != nullptr) {
-    workers_->withTeam([&](Team& team) {
-      team_ = &team;
-      warmAndIterate();
-      team_ = nullptr;
-    });
-  } else {
-    warmAndIterate();
-  }
+  });
   store(bodies, contacts, dt);
   if (!options.warm_starting) forget();
   return stats;

@@ -280,22 +280,13 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
     });
   }
   const bool hold = heavy_on_light.load();
-  const auto run = [&] {
+  onTeam([&] {
     if (!rows_.empty()) {
       collide(sequential, stats);
       if (options.warm_starting) warmStart(contacts, bodies, stats);
     }
     substeps(bodies, options, dt, hold);
-  };
-  if (workers_ != nullptr) {
-    workers_->withTeam([&](Team& team) {
-      team_ = &team;
-      run();
-      team_ = nullptr;
-    });
-  } else {
-    run();
-  }
+  });
   stats.velocity_passes = rows_.empty() ? 0 : 2 * options.substeps;
   // The warm start keeps the last substep's impulses; the contacts report the tick's.
   forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
