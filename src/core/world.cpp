@@ -81,12 +81,9 @@ void World::validateEntity(const EntitySpec& spec) const {
 
 EntityId World::addEntity(const EntitySpec& spec) {
   // Validate everything first: on throw nothing has changed.
-  if (spec.shape >= shapes_.size()) {
-    throw InputError("shape", "unknown shape id " + std::to_string(spec.shape));
-  }
+  const ShapeInfo& info = shape(spec.shape);  // throws InputError("shape") for an unknown id
   validateEntity(spec);
 
-  const ShapeInfo& info = shapes_[spec.shape];
   BodyState body;
   body.pose.position = spec.pose.position;
   body.pose.orientation = spec.pose.orientation.normalized();
