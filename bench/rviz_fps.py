@@ -34,11 +34,11 @@ ROOT = os.path.dirname(HERE)
 VARIANTS = {
     "before": ("rocks as voxels, walls as voxels, anti-aliased (before issue 50)",
                ["marker_levels:=[2]", "static_voxel_markers:=true", "marker_keyframe_period:=2.0"],
-               {"voxels": True, "tree_level_2": False}, []),
-    "aa": ("rocks as tree level 2, walls as boxes, anti-aliased (rviz's default)", [], {}, []),
-    "demo": ("the demo's: rocks as tree level 2, walls as boxes, no anti-aliasing", [], {},
+               {"voxels": True, "tree_level_1": False, "tree_level_2": False}, []),
+    "aa": ("rocks as tree level 1, walls as boxes, anti-aliased (rviz's default)", [], {}, []),
+    "demo": ("the demo's: rocks as tree level 1, walls as boxes, no anti-aliasing", [], {},
              ["--disable-anti-aliasing"]),
-    "level1": ("the same, rocks as tree level 1", ["marker_levels:=[1]"], {"tree_level_2": False, "tree_level_1": True},
+    "level2": ("the same, rocks as tree level 2", ["marker_levels:=[2]"], {"tree_level_1": False, "tree_level_2": True},
                ["--disable-anti-aliasing"]),
     "walls_hidden": ("the same, walls hidden", [], {"static_boxes": False}, ["--disable-anti-aliasing"]),
     "marker_rate5": ("the same, 5 marker arrays a second instead of 10", ["marker_rate:=5"], {},
@@ -150,7 +150,7 @@ def trial(name, args, tmp, display, hook, shot):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--variants", default="aa,demo,level1,walls_hidden,marker_rate5",
+    p.add_argument("--variants", default="aa,demo,level2,walls_hidden,marker_rate5",
                    help="comma-separated, of: " + ", ".join(VARIANTS))
     p.add_argument("--rounds", type=int, default=4)
     p.add_argument("--startup", type=float, default=5.0, help="s from roslaunch to rviz")

@@ -14,13 +14,16 @@ using visualization_msgs::Marker;
 // Spheres whose radii differ by less than this ratio share one SPHERE_LIST,
 // drawn at the group's largest radius (never smaller than the true sphere).
 constexpr double kRadiusGroupRatio = 1.03;
-// Coarse levels fainter than fine ones, so two levels drawn together both read.
-float levelAlpha(int level) { return level <= 1 ? 0.3f : 0.5f; }
+// Coarse levels fainter than fine ones, so two levels drawn together both read;
+// a level drawn alone is nearly opaque, so its bodies read as solid (the
+// demo's: level 1 alone, the cheapest for rviz that still shows each rock),
+// and contacts inside still show through.
+float levelAlpha(int level, bool alone) { return alone ? 0.8f : level <= 1 ? 0.3f : 0.5f; }
 constexpr double kVoxelFill = 0.94;  // cubes a little smaller than the voxel: the grid shows
 constexpr int kMaxGroups = 512;      // radius groups per level and entity (marker id = entity id * 512 + group)
 
 // One hue per level, so neighbouring levels read apart.
-std_msgs::ColorRGBA levelColor(int level) {
+std_msgs::ColorRGBA levelColor(int level, bool alone) {
   static const std::array<std::array<float, 3>, 8> kHues{{{1.0f, 1.0f, 1.0f},
                                                           {0.25f, 0.55f, 1.0f},
                                                           {0.1f, 1.0f, 0.75f},
@@ -30,7 +33,7 @@ std_msgs::ColorRGBA levelColor(int level) {
                                                           {0.2f, 0.9f, 0.9f},
                                                           {0.9f, 0.5f, 0.8f}}};
   const auto& h = kHues[static_cast<std::size_t>(level) % kHues.size()];
-  return toColorMsg(h[0], h[1], h[2], levelAlpha(level));
+  return toColorMsg(h[0], h[1], h[2], levelAlpha(level, alone));
 }
 
 const std_msgs::ColorRGBA kResolvedColor = toColorMsg(0.2f, 0.9f, 0.2f, 1.0f);
@@ -193,7 +196,7 @@ void MarkerBuilder::addEntity(const stc::World& world, std::size_t index, const 
       Marker& m = next(out, levelNamespace(level), groupId(id, k), Marker::SPHERE_LIST, when, frame);
       place(m);
       m.scale.x = m.scale.y = m.scale.z = 2.0 * groups[k].radius;
-      m.color = levelColor(level);
+      m.color = levelColor(level, options.levels.size() == 1);
       m.points.assign(groups[k].centres.begin(), groups[k].centres.end());
     }
   }

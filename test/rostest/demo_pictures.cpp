@@ -6,9 +6,9 @@
 // launch's drop_count) and every entity is at rest (entity_states: no speed
 // above kRestSpeed), must show the pile (demo_rest.ppm; docs/demo_rest.png).
 //
-// What is a moving entity on screen: the demo draws sphere-tree level 2 for
+// What is a moving entity on screen: the demo draws sphere-tree level 1 for
 // movable entities only (static_tree_markers false: walls have none), in the
-// level's teal, and rocks' voxels in warm greys (red > green > blue) where a
+// level's blue (teal for level 2), and rocks' voxels in warm greys (red > green > blue) where a
 // config shows them (demo.rviz hides them); walls (one grey box per tile),
 // grid and background are neutral or blue-grey. Contacts (green, orange), the
 // gaze (magenta) and the error bounds (amber) are other hues and not counted.
@@ -47,11 +47,12 @@ using stc_rviz::kScreenHeight;
 constexpr long kMinMoverPixels = 5000;
 constexpr double kRenderTimeout = 120.0;  // s: rviz start-up and first frames in software GL on a loaded machine
 
-// Tree level 2 (teal) or a rock's voxel (warm grey).
+// A tree level's colour (level 1 blue, level 2 teal: green and blue well above
+// red) or a rock's voxel (warm grey).
 bool moverColour(int r, int g, int b) {
-  const bool teal = g - r > 40 && b - r > 30;
+  const bool tree = g - r > 40 && b - r > 30;
   const bool rock = r > g && g > b && r - b >= 12 && r - b <= 70 && r > 50;
-  return teal || rock;
+  return tree || rock;
 }
 
 TEST(DemoPictures, MovingEntitiesInViewAt10sAnd60sAndThePileAtRest) {
