@@ -5,7 +5,7 @@
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 bash "$STC_ROOT/scripts/install_deps.sh"
-bash "$STC_ROOT/scripts/build.sh"
+bash "$STC_ROOT/scripts/build.sh" --demo
 # ROS setup files read unset variables: source them without -u.
 set +u
 # shellcheck disable=SC1091
