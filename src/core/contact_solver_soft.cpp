@@ -18,6 +18,10 @@ using namespace contact_rows;
 namespace {
 
 constexpr std::size_t kRowsPerTask = 256;
+// A substep of at most this many sqrt(bound / |g|) (bound: a contact's
+// sphere bound, about a voxel): see substepCount.
+constexpr double kSubstepPerScale = 0.07;
+constexpr int kMaxSubsteps = 64;
 constexpr double kPi = 3.14159265358979323846;
 
 // A soft contact as a damped spring of `hertz` and `damping_ratio`, solved
@@ -289,14 +293,42 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
     });
   }
   const bool hold = heavy_on_light.load();
+  // Substeps: a soft contact is at most a quarter of the substep rate stiff
+  // (omega <= pi / 2h), so a body resting on it under gravity g gives
+  // |g| / omega^2 >= 0.4 |g| h^2, and a stack of n such bodies about n^2 / 2
+  // times that at its foot. Against the contact's size (its sphere bound,
+  // about a voxel) that is (h / sqrt(bound / |g|))^2: small bodies or long
+  // ticks need shorter substeps, or the give outgrows the voxel and cubes
+  // sink into each other (a stack of 1 mm voxels at 60 Hz, or of 5 cm
+  // voxels at dt = 0.1 s, fell through itself with 4). So the substeps are
+  // at least options.substeps and as many as keep h <= kSubstepPerScale
+  // sqrt(bound / |g|) for every contact (|g|: what integrate added to a
+  // movable body's v, per second). Serial: the same count at any threads.
+  ResponseOptions stepped = options;
+  {
+    double worst = 0.0;  // max over rows of |g| / bound (1 / s^2)
+    for (std::size_t r = 0; r < rows_.size(); ++r) {
+      const Row& row = rows_[r];
+      const double bound = contacts[info_[r].contact].sphere_bound;
+      if (!(bound > 0.0)) continue;
+      double gain = 0.0;
+      if (!bodies[row.a].is_static) gain = soft_gain_[row.a].v.squaredNorm();
+      if (!bodies[row.b].is_static) gain = std::max(gain, soft_gain_[row.b].v.squaredNorm());
+      worst = std::max(worst, std::sqrt(gain) / (dt * bound));
+    }
+    if (worst > 0.0) {
+      const double needed = std::ceil(dt * std::sqrt(worst) / kSubstepPerScale - 1e-9);
+      stepped.substeps = static_cast<int>(std::min<double>(kMaxSubsteps, std::max<double>(options.substeps, needed)));
+    }
+  }
   onTeam([&] {
     if (!rows_.empty()) {
       collide(sequential, stats);
       if (options.warm_starting) warmStart(contacts, bodies, stats);
     }
-    substeps(bodies, options, dt, hold);
+    substeps(bodies, stepped, dt, hold);
   });
-  stats.velocity_passes = rows_.empty() ? 0 : 2 * options.substeps;
+  stats.velocity_passes = rows_.empty() ? 0 : 2 * stepped.substeps;
   // The warm start keeps the last substep's impulses; the contacts report the tick's.
   forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
