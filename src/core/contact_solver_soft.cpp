@@ -101,6 +101,15 @@ void ContactSolver::prepareSoft(const std::vector<Contact>& contacts, const Resp
       const Contact& c = contacts[info.contact];
       row.separation = c.separation;
       row.slop = options.allowed_penetration > 0.0 ? options.allowed_penetration : 0.02 * c.sphere_bound;
+      // A contact the narrow phase did not prove (a budget cut it at the
+      // root spheres or a frontier: separation 0 or a gap bound, wherever the
+      // bodies were predicted) says nothing of how near the bodies were at
+      // the tick's start: its separation holds from there, as the default
+      // solver holds it from the poses it is found at. Measured back from the
+      // predicted poses instead, a rock sliding down a plate under a starved
+      // budget was let close a "gap" of its own predicted move each tick and
+      // sank 1.6 voxels into the plate.
+      if (!c.resolved) row.separation -= separationNow(row) - row.separation;
       // Wave 0 of the restitution as prepare() classifies it, but from the
       // gap at the tick's start: a contact bounces when it closes that gap
       // this tick faster than the threshold.
