@@ -35,13 +35,16 @@ struct ResponseOptions {
   bool position_turns = false;
   double allowed_penetration = 0.0;     // metres kept as slop (0: 2% of the contact's gap bound h_a + h_b)
   SolverKind solver = SolverKind::Sequential;
-  // The soft step (solver = Soft) only: substeps a tick (>= 1; `iterations`,
-  // position_correction and shock_propagation are not used), and its soft
-  // contacts: a penetration is pushed out as a spring of `contact_hertz`
-  // (Hz, > 0; twice that against an immovable body, at most a quarter of the
-  // substep rate) with `contact_damping_ratio` (> 0), at most `max_push_speed` m/s (> 0).
+  // The soft step (solver = Soft) only: substeps a tick (>= 1; more when a
+  // contact is small for the tick: h <= 0.07 sqrt(its sphere bound / |g|), at
+  // most 64; `iterations`, position_correction and shock_propagation are not
+  // used), and its soft
+  // contacts: a penetration beyond the slop is pushed out as a spring of
+  // `contact_hertz` (Hz, >= 0; 0: a quarter of the substep rate, the most it
+  // may be; twice that against an immovable body) with `contact_damping_ratio`
+  // (> 0), at most `max_push_speed` m/s (> 0).
   int substeps = 4;
-  double contact_hertz = 30.0;
+  double contact_hertz = 0.0;
   double contact_damping_ratio = 10.0;
   double max_push_speed = 3.0;
   // Sequential passes take four manifolds that share no movable body at a

@@ -18,6 +18,10 @@ using namespace contact_rows;
 namespace {
 
 constexpr std::size_t kRowsPerTask = 256;
+// A substep of at most this many sqrt(bound / |g|) (bound: a contact's
+// sphere bound, about a voxel): see substepCount.
+constexpr double kSubstepPerScale = 0.07;
+constexpr int kMaxSubsteps = 64;
 constexpr double kPi = 3.14159265358979323846;
 
 // A soft contact as a damped spring of `hertz` and `damping_ratio`, solved
@@ -62,9 +66,14 @@ STC_HOT_INLINE void softRow(ContactSolver::Row& row, double s, const SoftPass& p
     // its last substep moved with.
     if (!pass.bias) return;
     bias = s * pass.inv_h;
-  } else if (pass.bias) {
+  } else if (pass.bias && s + row.slop < 0.0) {
+    // Beyond the slop: soft. Within it the row holds rigidly, as in the
+    // relaxing pass: no push, and no give either (a soft row there let its
+    // impulse leak each substep, so a resting body sank on towards the slop
+    // while the relaxing pass stored it still: the sliding cube of
+    // test_physics crept at 1e-4 m/s after it stopped).
     const Softness& soft = (row.inv_ma == 0.0 || row.inv_mb == 0.0) ? pass.immovable : pass.moving;
-    bias = std::max(soft.bias_rate * std::min(0.0, s + row.slop), -pass.max_push);
+    bias = std::max(soft.bias_rate * (s + row.slop), -pass.max_push);
     mass_scale = soft.mass_scale;
     impulse_scale = soft.impulse_scale;
   }
@@ -92,6 +101,15 @@ void ContactSolver::prepareSoft(const std::vector<Contact>& contacts, const Resp
       const Contact& c = contacts[info.contact];
       row.separation = c.separation;
       row.slop = options.allowed_penetration > 0.0 ? options.allowed_penetration : 0.02 * c.sphere_bound;
+      // A contact the narrow phase did not prove (a budget cut it at the
+      // root spheres or a frontier: separation 0 or a gap bound, wherever the
+      // bodies were predicted) says nothing of how near the bodies were at
+      // the tick's start: its separation holds from there, as the default
+      // solver holds it from the poses it is found at. Measured back from the
+      // predicted poses instead, a rock sliding down a plate under a starved
+      // budget was let close a "gap" of its own predicted move each tick and
+      // sank 1.6 voxels into the plate.
+      if (!c.resolved) row.separation -= separationNow(row) - row.separation;
       // Wave 0 of the restitution as prepare() classifies it, but from the
       // gap at the tick's start: a contact bounces when it closes that gap
       // this tick faster than the threshold.
@@ -108,7 +126,11 @@ void ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptio
   const int count = options.substeps;
   const double h = dt / count;
   SoftPass pass;
-  const double hertz = std::min(options.contact_hertz, 0.25 / h);
+  // A quarter of the substep rate (the stiffest a soft contact stays stable
+  // at, Box2D v3's bound), or contact_hertz below it: the stiffness follows
+  // the tick, so a resting body's give (|g| / omega^2) shrinks with dt.
+  const double quarter_rate = 0.25 / h;
+  const double hertz = options.contact_hertz > 0.0 ? std::min(options.contact_hertz, quarter_rate) : quarter_rate;
   pass.moving = makeSoftness(hertz, options.contact_damping_ratio, h);
   pass.immovable = makeSoftness(2.0 * hertz, options.contact_damping_ratio, h);
   pass.inv_h = 1.0 / h;
@@ -280,14 +302,42 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
     });
   }
   const bool hold = heavy_on_light.load();
+  // Substeps: a soft contact is at most a quarter of the substep rate stiff
+  // (omega <= pi / 2h), so a body resting on it under gravity g gives
+  // |g| / omega^2 >= 0.4 |g| h^2, and a stack of n such bodies about n^2 / 2
+  // times that at its foot. Against the contact's size (its sphere bound,
+  // about a voxel) that is (h / sqrt(bound / |g|))^2: small bodies or long
+  // ticks need shorter substeps, or the give outgrows the voxel and cubes
+  // sink into each other (a stack of 1 mm voxels at 60 Hz, or of 5 cm
+  // voxels at dt = 0.1 s, fell through itself with 4). So the substeps are
+  // at least options.substeps and as many as keep h <= kSubstepPerScale
+  // sqrt(bound / |g|) for every contact (|g|: what integrate added to a
+  // movable body's v, per second). Serial: the same count at any threads.
+  ResponseOptions stepped = options;
+  {
+    double worst = 0.0;  // max over rows of |g| / bound (1 / s^2)
+    for (std::size_t r = 0; r < rows_.size(); ++r) {
+      const Row& row = rows_[r];
+      const double bound = contacts[info_[r].contact].sphere_bound;
+      if (!(bound > 0.0)) continue;
+      double gain = 0.0;
+      if (!bodies[row.a].is_static) gain = soft_gain_[row.a].v.squaredNorm();
+      if (!bodies[row.b].is_static) gain = std::max(gain, soft_gain_[row.b].v.squaredNorm());
+      worst = std::max(worst, std::sqrt(gain) / (dt * bound));
+    }
+    if (worst > 0.0) {
+      const double needed = std::ceil(dt * std::sqrt(worst) / kSubstepPerScale - 1e-9);
+      stepped.substeps = static_cast<int>(std::min<double>(kMaxSubsteps, std::max<double>(options.substeps, needed)));
+    }
+  }
   onTeam([&] {
     if (!rows_.empty()) {
       collide(sequential, stats);
       if (options.warm_starting) warmStart(contacts, bodies, stats);
     }
-    substeps(bodies, options, dt, hold);
+    substeps(bodies, stepped, dt, hold);
   });
-  stats.velocity_passes = rows_.empty() ? 0 : 2 * options.substeps;
+  stats.velocity_passes = rows_.empty() ? 0 : 2 * stepped.substeps;
   // The warm start keeps the last substep's impulses; the contacts report the tick's.
   forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {

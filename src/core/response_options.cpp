@@ -48,8 +48,8 @@ void validateResponseOptions(const ResponseOptions& o) {
   if (o.substeps < 1 || o.substeps > 64) {
     throw InputError("response.substeps", "must be in [1, 64]");
   }
-  if (!(o.contact_hertz > 0.0 && std::isfinite(o.contact_hertz))) {
-    throw InputError("response.contact_hertz", "must be finite and > 0");
+  if (!(o.contact_hertz >= 0.0 && std::isfinite(o.contact_hertz))) {
+    throw InputError("response.contact_hertz", "must be finite and >= 0 (0: a quarter of the substep rate)");
   }
   if (!(o.contact_damping_ratio > 0.0 && std::isfinite(o.contact_damping_ratio))) {
     throw InputError("response.contact_damping_ratio", "must be finite and > 0");

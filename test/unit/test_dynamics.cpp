@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 namespace stc {
 namespace {
@@ -322,7 +323,9 @@ TEST(Response, OptionsAndSolverNamesAreValidatedByField) {
   o.substeps = 0;
   EXPECT_EQ(thrownField([&] { validateResponseOptions(o); }), "response.substeps");
   o = ResponseOptions{};
-  o.contact_hertz = 0.0;
+  o.contact_hertz = -1.0;
+  EXPECT_EQ(thrownField([&] { validateResponseOptions(o); }), "response.contact_hertz");
+  o.contact_hertz = std::numeric_limits<double>::infinity();
   EXPECT_EQ(thrownField([&] { validateResponseOptions(o); }), "response.contact_hertz");
   o = ResponseOptions{};
   o.contact_damping_ratio = std::nan("");
