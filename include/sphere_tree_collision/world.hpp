@@ -86,6 +86,13 @@ struct EntitySpec {
   // faces +z): a body pressed deeper than half the wall's thickness is still
   // pushed back in, not out through the back. 0: every face is a surface.
   std::uint8_t closed_faces = 0;
+  // A saved world's body (scene_file.hpp), restored as it was at the end of
+  // a tick: not new (a new body's box wakes the sleepers it touches), and
+  // with sleep_group > 0 asleep with the other bodies of that group, which
+  // wake together (its velocities must be 0; movable bodies only). Ignored
+  // with sleeping or the response off. Throws InputError("sleep").
+  bool restored = false;
+  std::uint32_t sleep_group = 0;
 };
 
 struct TickReport {
@@ -236,6 +243,9 @@ class World : private ShapeLibrary, private EntityTable {
   // Sleeping islands (islands.hpp). wake: the entity's island; false for an unknown id.
   bool wake(EntityId id);
   bool isSleeping(EntityId id) const;
+  // The group the body at dense index `index` sleeps with (0: awake): what a
+  // saved world writes (EntitySpec::sleep_group).
+  std::uint32_t sleepGroup(std::size_t index) const { return islands_.group(index); }
   // Awake and failing the rest test at the last step (it moved out of its
   // rest balls, rest_test.hpp): what keeps its island awake. False when asleep.
   bool isRestless(EntityId id) const;

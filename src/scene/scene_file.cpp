@@ -166,7 +166,7 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
             {"name", "preset", "resolution", "voxel_size", "seed", "position", "orientation", "velocity",
              "angular_velocity", "density", "restitution", "friction", "color", "static", "box_mode",
              "repeat", "mesh_resource", "scale", "strength", "rolling_resistance", "up_axis", "closed_faces",
-             "grid"});
+             "grid", "sleep"});
   // Which shape source, and what belongs to it, is validateRequest's to judge
   // when the scene is added: a file, a topic and a service refuse alike.
   EntityRequest r;
@@ -191,6 +191,11 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   if (node["position"]) r.spec.pose.position = readVec3(node["position"], p + "position");
   if (node["orientation"]) {
     r.spec.pose.orientation = readOrientation(node["orientation"], p + "orientation", &r.spec.exact_orientation);
+  }
+  if (node["sleep"]) {  // a saved world's entity (EntitySpec::restored)
+    if (node["repeat"]) throw InputError(p + "sleep", "not with repeat");
+    r.spec.restored = true;
+    r.spec.sleep_group = static_cast<std::uint32_t>(readInt(node["sleep"], p + "sleep", 0, 0xffffffffll));
   }
   if (node["grid"]) {
     for (const char* key : {"resolution", "voxel_size", "seed"}) {
@@ -475,6 +480,7 @@ std::string writeSceneYaml(const World& world, const ColorOf& color_of) {
       }
     }
     out += body.is_static ? ", static: true" : ", static: false";
+    out += ", sleep: " + std::to_string(world.sleepGroup(i));
     out += std::string(", box_mode: ") + toString(world.bodyBoxModes()[i]);
     const std::vector<std::string> faces = faceNames(world.closedFaces(i));
     if (!faces.empty()) {
@@ -490,7 +496,8 @@ std::string writeSceneYaml(const World& world, const ColorOf& color_of) {
 void writeFileAtomically(const std::string& path, const std::string& text, const std::string& field) {
   validateText(path, field);
   const std::string temporary = path + ".tmp" + std::to_string(::getpid());
-  std::FILE* file = std::fopen(temporary.c_str(), "wb");
+  std::remove(temporary.c_str());  // a crashed save's; "x": never through a link planted in its place
+  std::FILE* file = std::fopen(temporary.c_str(), "wbx");
   if (file == nullptr) throw InputError(field, "cannot write '" + path + "': " + std::strerror(errno));
   const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
   const int write_errno = errno;

@@ -20,6 +20,7 @@
 //       static: false
 //       box_mode: auto           # auto | fixed | dynamic
 //       repeat: {count: [3, 1, 1], spacing: [0.5, 0, 0]}   # copies on a grid, names get _i
+//       sleep: 0                 # a saved world's: EntitySpec::restored, sleep_group (not with repeat)
 //     - mesh_resource: package://pkg/meshes/link.stl   # instead of preset: STL, OBJ, DAE
 //       scale: [1, 1, 1]         # mesh only, per axis
 //       resolution: 32           # voxels along the mesh's longest side, unless voxel_size is given
@@ -58,10 +59,11 @@ using ColorOf = std::function<std::optional<Rgba>(EntityId)>;
 // its name, shape (its recipe: a preset, a mesh resource as requested, or
 // else its voxels as a grid), pose (orientation as unit_quat: kept bit for
 // bit), velocities, density, material, colour (by `color_of`), static flag,
-// box mode (as resolved) and closed faces. Numbers are written to 17
-// significant digits: they read back as the same bits. The new World's ids
-// are 0, 1, ... in that order; what a tick keeps between ticks (contact
-// cache, warm start, sleep) starts afresh (docs/scene_files.md).
+// box mode (as resolved), closed faces and sleep group. Numbers are written
+// to 17 significant digits: they read back as the same bits. The new World's
+// ids are 0, 1, ... in that order; the contacts carried between ticks, the
+// warm start and awake bodies' rest timers start afresh
+// (docs/ros_interface.md, "Saved worlds").
 std::string writeSceneYaml(const World& world, const ColorOf& color_of = nullptr);
 
 // `text` into `path` atomically: a temporary file beside it, flushed, then
