@@ -448,7 +448,7 @@ void putShape(std::string& out, const ShapeInfo& info) {
 }  // namespace
 
 std::string writeSceneYaml(const World& world, const ColorOf& color_of) {
-  std::string out = "# A saved world (~save; docs/scene_files.md): numbers to 17 digits load back bit for bit.\n";
+  std::string out = "# A saved world (~save; docs/ros_interface.md, Saved worlds): numbers to 17 digits load back bit for bit.\n";
   out += "gravity: ";
   putNumbers(out, world.config().gravity.data(), 3);
   out += "\nentities:";
