@@ -46,6 +46,11 @@ class EntityTable {
   std::vector<BodyState>& bodies() { return bodies_; }
   const std::vector<ShapeId>& bodyShapes() const { return body_shapes_; }
   const std::vector<std::string>& bodyNames() const { return names_; }
+  // The density each entity was added with (kg/m^3; a static body's too),
+  // and its box mode as resolved (never Auto): what a saved world needs
+  // that BodyState does not keep.
+  const std::vector<double>& bodyDensities() const { return densities_; }
+  const std::vector<BoxMode>& bodyBoxModes() const { return box_modes_; }
   std::optional<std::size_t> indexOf(EntityId id) const;
   std::optional<EntityId> findByName(const std::string& name) const;
   // Whether one more entity can get an id (they are never reused).
@@ -54,7 +59,7 @@ class EntityTable {
  protected:
   // A row at the end (dense index entityCount() - 1) with the next id, which
   // is returned. The name is empty or unused (checked by the caller).
-  EntityId addRow(const BodyState& body, ShapeId shape, BoxMode box_mode, std::string name);
+  EntityId addRow(const BodyState& body, ShapeId shape, BoxMode box_mode, double density, std::string name);
   // Row `index` removed: the last row takes its place.
   void removeRow(std::size_t index);
   // Every row removed; ids go on counting.
@@ -67,6 +72,7 @@ class EntityTable {
   std::vector<BodyState> bodies_;
   std::vector<ShapeId> body_shapes_;
   std::vector<BoxMode> box_modes_;
+  std::vector<double> densities_;
   std::vector<std::string> names_;
   // Entity id -> dense index, open addressing on flat arrays: the pair walk
   // of every tick looks up two per broad-phase pair (a settled pile of 5,000

@@ -52,6 +52,10 @@ class Islands {
   // distance from its centre of mass), a body swap-removed (index takes
   // last's place), all removed.
   void add(double reach);
+  // The body just added as a saved world had it at the end of a tick: not
+  // fresh, and asleep in `group` (> 0) at `pose`, or awake (0).
+  void restore(std::size_t body, std::uint32_t group, const Pose& pose);
+  std::uint32_t group(std::size_t body) const { return group_[body]; }
   void remove(std::size_t index, std::size_t last);
   void clear();
 

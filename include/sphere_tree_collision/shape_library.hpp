@@ -20,8 +20,22 @@
 
 namespace stc {
 
+// How a shape was made, so a saved world makes it again (scene_file.hpp
+// writes it): a preset by name and parameters, a mesh by its resource as
+// requested and how it was voxelised, or, with neither (a grid of a spawn
+// message, a fracture piece), its voxels as they are.
+struct ShapeRecipe {
+  std::string preset;            // e.g. "rock"
+  PresetParams preset_params;    // a preset's; of a mesh, the resolution
+  std::string mesh_resource;     // package://, file:// or a path, unresolved
+  Vec3 mesh_scale = Vec3::Ones();
+  double mesh_voxel_size = 0.0;  // 0: by resolution
+  std::uint8_t mesh_up_axis = 0; // ColladaUpAxis (mesh_loader.hpp)
+};
+
 struct ShapeInfo {
   std::string key;
+  ShapeRecipe recipe;         // empty (preset and mesh_resource ""): its voxels
   VoxelShape voxels;
   MassProperties unit_mass;   // density 1
   Vec3 body_origin;           // centre of mass in the grid frame
@@ -41,6 +55,9 @@ class ShapeLibrary {
   std::optional<ShapeId> findShape(const std::string& key) const;
   const ShapeInfo& shape(ShapeId id) const;  // throws InputError("shape") for an unknown id
   std::size_t shapeCount() const { return shapes_.size(); }
+  // Records how shape `id` was made (ShapeInfo::recipe); the first recipe
+  // of a shape stays (a shape found again by its key was made by it).
+  void setShapeRecipe(ShapeId id, const ShapeRecipe& recipe);
 
  protected:
   // By shape id. Deques: a shape (and its tree) keeps its address as shapes

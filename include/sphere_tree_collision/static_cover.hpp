@@ -28,6 +28,8 @@ constexpr std::uint8_t kAllFaces = 63;
 // "+x", "-x", "+y", "-y", "+z", "-z" (body frame) -> their faceBits OR'ed;
 // throws InputError("closed_faces") naming an unknown face.
 std::uint8_t parseFaces(const std::vector<std::string>& names);
+// The names of a mask's faces, in faceBit order (parseFaces' inverse).
+std::vector<std::string> faceNames(std::uint8_t mask);
 
 // What the cover needs of a shape: its grid, the grid point the body frame is
 // centred on (ShapeInfo::body_origin) and its node boxes.
@@ -59,6 +61,8 @@ class StaticCover {
   const std::uint8_t* of(std::size_t index) const {
     return index < masks_.size() && !masks_[index].empty() ? masks_[index].data() : nullptr;
   }
+  // EntitySpec::closed_faces of body `index`, as added.
+  std::uint8_t closedFaces(std::size_t index) const { return closed_[index]; }
 
  private:
   std::vector<std::vector<std::uint8_t>> masks_;  // by dense index; empty: nothing covered

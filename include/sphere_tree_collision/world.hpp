@@ -37,6 +37,7 @@ namespace stc {
 
 // BoxMode (entity_table.hpp): "auto" | "fixed" | "dynamic"; throws InputError("box_mode").
 BoxMode parseBoxMode(const std::string& name);
+const char* toString(BoxMode mode);
 
 struct WorldConfig {
   Vec3 gravity = Vec3::Zero();
@@ -61,10 +62,18 @@ struct WorldConfig {
   int threads = 1;
 };
 
+// How far from 1 the norm of an EntitySpec::exact_orientation may be (a
+// pose the integrator normalised is within a few ulp).
+constexpr double kExactOrientationTolerance = 1e-12;
+
 struct EntitySpec {
   std::string name;         // optional; unique when given
   ShapeId shape = 0;
   Pose pose;                // of the body frame (origin at the centre of mass)
+  // The orientation as given, bit for bit, not normalised: a saved world's,
+  // unit to round-off (within kExactOrientationTolerance, else
+  // InputError("pose.orientation")). False: normalised.
+  bool exact_orientation = false;
   Vec3 linear_velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();
   double density = 1000.0;  // kg/m^3, > 0
@@ -77,6 +86,13 @@ struct EntitySpec {
   // faces +z): a body pressed deeper than half the wall's thickness is still
   // pushed back in, not out through the back. 0: every face is a surface.
   std::uint8_t closed_faces = 0;
+  // A saved world's body (scene_file.hpp), restored as it was at the end of
+  // a tick: not new (a new body's box wakes the sleepers it touches), and
+  // with sleep_group > 0 asleep with the other bodies of that group, which
+  // wake together (its velocities must be 0; movable bodies only). Ignored
+  // with sleeping or the response off. Throws InputError("sleep").
+  bool restored = false;
+  std::uint32_t sleep_group = 0;
 };
 
 struct TickReport {
@@ -173,6 +189,7 @@ class World : private ShapeLibrary, private EntityTable {
   using ShapeLibrary::findShape;
   using ShapeLibrary::shape;
   using ShapeLibrary::shapeCount;
+  using ShapeLibrary::setShapeRecipe;
 
   // Throws InputError naming the field ("shape", "pose.position",
   // "pose.orientation", "linear_velocity", "angular_velocity", "density",
@@ -226,6 +243,9 @@ class World : private ShapeLibrary, private EntityTable {
   // Sleeping islands (islands.hpp). wake: the entity's island; false for an unknown id.
   bool wake(EntityId id);
   bool isSleeping(EntityId id) const;
+  // The group the body at dense index `index` sleeps with (0: awake): what a
+  // saved world writes (EntitySpec::sleep_group).
+  std::uint32_t sleepGroup(std::size_t index) const { return islands_.group(index); }
   // Awake and failing the rest test at the last step (it moved out of its
   // rest balls, rest_test.hpp): what keeps its island awake. False when asleep.
   bool isRestless(EntityId id) const;
@@ -242,6 +262,10 @@ class World : private ShapeLibrary, private EntityTable {
   using EntityTable::bodies;
   using EntityTable::bodyShapes;
   using EntityTable::bodyNames;
+  using EntityTable::bodyDensities;
+  using EntityTable::bodyBoxModes;
+  // EntitySpec::closed_faces of the entity at dense index `index`.
+  std::uint8_t closedFaces(std::size_t index) const { return static_cover_.closedFaces(index); }
   using EntityTable::indexOf;
 
   // Narrow-phase results of the last step: pairTests()[0..pairCount()).
@@ -300,7 +324,7 @@ class World : private ShapeLibrary, private EntityTable {
   Workers workers_;  // before the phases that use it
   // The shapes: the ShapeLibrary base (shapes_, shape_bounds_, cover_shapes_).
   // The entities' rows: the EntityTable base (ids_, bodies_, body_shapes_,
-  // box_modes_, names_, index_of_).
+  // box_modes_, densities_, names_, index_of_).
   StaticCover static_cover_;  // static bodies' faces other static bodies cover, by dense index
 
   SweepAndPrune broad_phase_;

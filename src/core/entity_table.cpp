@@ -26,7 +26,7 @@ std::optional<EntityId> EntityTable::findByName(const std::string& name) const {
   return it->second;
 }
 
-EntityId EntityTable::addRow(const BodyState& body, ShapeId shape, BoxMode box_mode, std::string name) {
+EntityId EntityTable::addRow(const BodyState& body, ShapeId shape, BoxMode box_mode, double density, std::string name) {
   assert(idsLeft() && (name.empty() || id_by_name_.count(name) == 0));
   const EntityId id = next_id_++;
   const std::size_t index = ids_.size();
@@ -34,6 +34,7 @@ EntityId EntityTable::addRow(const BodyState& body, ShapeId shape, BoxMode box_m
   bodies_.push_back(body);
   body_shapes_.push_back(shape);
   box_modes_.push_back(box_mode);
+  densities_.push_back(density);
   if (!name.empty()) id_by_name_.emplace(name, id);
   names_.push_back(std::move(name));
   index_of_->set(id, static_cast<std::uint32_t>(index));
@@ -50,6 +51,7 @@ void EntityTable::removeRow(std::size_t index) {
     bodies_[index] = bodies_[last];
     body_shapes_[index] = body_shapes_[last];
     box_modes_[index] = box_modes_[last];
+    densities_[index] = densities_[last];
     names_[index] = std::move(names_[last]);
     index_of_->set(ids_[index], static_cast<std::uint32_t>(index));
   }
@@ -57,6 +59,7 @@ void EntityTable::removeRow(std::size_t index) {
   bodies_.pop_back();
   body_shapes_.pop_back();
   box_modes_.pop_back();
+  densities_.pop_back();
   names_.pop_back();
 }
 
@@ -65,6 +68,7 @@ void EntityTable::clearRows() {
   bodies_.clear();
   body_shapes_.clear();
   box_modes_.clear();
+  densities_.clear();
   names_.clear();
   *index_of_ = detail::FlatHashMap();
   id_by_name_.clear();
@@ -75,6 +79,7 @@ void EntityTable::releaseRowMemory() {
   dropSpareCapacity(bodies_);
   dropSpareCapacity(body_shapes_);
   dropSpareCapacity(box_modes_);
+  dropSpareCapacity(densities_);
   dropSpareCapacity(names_);
   index_of_->shrinkToFit();
   id_by_name_.rehash(0);  // as few buckets as its entries need

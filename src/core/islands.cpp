@@ -43,6 +43,16 @@ void Islands::add(double reach) {
   rest_time_.push_back(0.0);
 }
 
+void Islands::restore(std::size_t body, std::uint32_t group, const Pose& pose) {
+  fresh_[body] = 0;
+  if (group == kAwake) return;
+  group_[body] = group;
+  moving_[body] = 0;
+  rest_pose_[body] = pose;
+  ++sleeping_;
+  if (group >= next_group_) next_group_ = group == std::numeric_limits<std::uint32_t>::max() ? 1 : group + 1;
+}
+
 void Islands::remove(std::size_t index, std::size_t last) {
   if (group_[index] != kAwake) {
     // The removed body's island loses a support: the rest of it wakes.

@@ -58,6 +58,7 @@ UnresolvedPolicy parseUnresolvedPolicy(const std::string& name) {
 }
 const char* toString(UnresolvedPolicy policy) { return nameOf(kPolicies, policy); }
 BoxMode parseBoxMode(const std::string& name) { return parseName(kBoxModes, name, "box_mode"); }
+const char* toString(BoxMode mode) { return nameOf(kBoxModes, mode); }
 const char* toString(PairStatus s) { return nameOf(kStatuses, s); }
 
 }  // namespace stc

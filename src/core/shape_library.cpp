@@ -98,4 +98,9 @@ const ShapeInfo& ShapeLibrary::shape(ShapeId id) const {
   return shapes_[id];
 }
 
+void ShapeLibrary::setShapeRecipe(ShapeId id, const ShapeRecipe& recipe) {
+  ShapeInfo& info = shapes_.at(id);
+  if (info.recipe.preset.empty() && info.recipe.mesh_resource.empty()) info.recipe = recipe;
+}
+
 }  // namespace stc

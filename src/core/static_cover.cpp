@@ -67,8 +67,20 @@ std::uint8_t nodeMask(const Placed& body, std::int32_t node, const std::vector<c
 
 }  // namespace
 
+namespace {
+const char* const kFaceNames[] = {"+x", "-x", "+y", "-y", "+z", "-z"};  // faceBit order
+}  // namespace
+
+std::vector<std::string> faceNames(std::uint8_t mask) {
+  std::vector<std::string> names;
+  for (int bit = 0; bit < 6; ++bit) {
+    if ((mask & (1u << bit)) != 0) names.emplace_back(kFaceNames[bit]);
+  }
+  return names;
+}
+
 std::uint8_t parseFaces(const std::vector<std::string>& names) {
-  static const char* const kNames[] = {"+x", "-x", "+y", "-y", "+z", "-z"};  // faceBit order
+  const auto& kNames = kFaceNames;
   std::uint8_t mask = 0;
   for (const std::string& name : names) {
     const auto* found = std::find(std::begin(kNames), std::end(kNames), name);

@@ -69,6 +69,13 @@ void World::validateEntity(const EntitySpec& spec) const {
   if (!spec.name.empty() && findByName(spec.name)) {
     throw InputError("name", "'" + spec.name + "' is already used");
   }
+  if (spec.exact_orientation && !(std::abs(spec.pose.orientation.norm() - 1.0) <= kExactOrientationTolerance)) {
+    throw InputError("pose.orientation", "an exact orientation must be a unit quaternion (within 1e-12)");
+  }
+  if (spec.sleep_group != 0 && (!spec.restored || spec.is_static || !spec.linear_velocity.isZero(0.0) ||
+                                 !spec.angular_velocity.isZero(0.0))) {
+    throw InputError("sleep", "only a restored movable body at rest (velocities 0) sleeps");
+  }
   if (spec.closed_faces > kAllFaces || (spec.closed_faces != 0 && !spec.is_static)) {
     throw InputError("closed_faces", "static bodies only, a mask of faceBit values (at most " +
                                          std::to_string(kAllFaces) + ")");
@@ -86,7 +93,7 @@ EntityId World::addEntity(const EntitySpec& spec) {
 
   BodyState body;
   body.pose.position = spec.pose.position;
-  body.pose.orientation = spec.pose.orientation.normalized();
+  body.pose.orientation = spec.exact_orientation ? spec.pose.orientation : spec.pose.orientation.normalized();
   body.material = spec.material;
   body.is_static = spec.is_static;
   if (!spec.is_static) {  // static bodies never move: zero velocities and inverse masses
@@ -101,11 +108,15 @@ EntityId World::addEntity(const EntitySpec& spec) {
   if (mode == BoxMode::Auto) mode = info.elongated ? BoxMode::Dynamic : BoxMode::FixedCube;
 
   // The row, then what follows it.
-  const EntityId id = addRow(body, spec.shape, mode, spec.name);
+  const EntityId id = addRow(body, spec.shape, mode, spec.density, spec.name);
   const std::size_t index = ids_.size() - 1;
   static_cover_.add(body, spec.closed_faces);
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
   islands_.add(info.bounding_radius);
+  if (spec.restored) {
+    const bool sleeps = config_.sleeping.enabled && config_.response.enabled;
+    islands_.restore(index, sleeps ? spec.sleep_group : 0, body.pose);
+  }
   levels_.add();
   if (spec.is_static) physics_.forgetReuse();  // its neighbours' covered faces change
   invalidateLastTick();

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstdlib>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -28,7 +29,7 @@ const std::set<std::string>& knownParams() {
       "min_voxel_size", "max_voxel_size", "entity_states_rate", "entities_rate", "publish_clock", "error_report",
       "min_piece_voxels", "small_pieces", "strength_exponent", "threads", "reuse_tolerance",
       "diagnostic_period", "camera_info_topic", "mesh_roots", "max_mesh_bytes", "max_mesh_vertices",
-      "max_mesh_triangles"};  // diagnostic_period: read by diagnostic_updater
+      "max_mesh_triangles", "save_dir"};  // diagnostic_period: read by diagnostic_updater
   return kNames;
 }
 
@@ -43,6 +44,14 @@ auto parsed(const std::string& name, F&& parse) {
 }
 
 }  // namespace
+
+std::string defaultSaveDir() {
+  const char* ros_home = std::getenv("ROS_HOME");
+  if (ros_home != nullptr && ros_home[0] == '/') return std::string(ros_home) + "/sphere_tree_collision";
+  const char* home = std::getenv("HOME");
+  if (home != nullptr && home[0] == '/') return std::string(home) + "/.ros/sphere_tree_collision";
+  return "/tmp/sphere_tree_collision";
+}
 
 stc::Budget NodeParams::budget(double publish_s) const {
   stc::Budget b;
@@ -205,6 +214,11 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   std::vector<std::string> roots;
   readParam(nh, "mesh_roots", roots);
   p.world.mesh_roots = stc::canonicalMeshRoots(roots, "mesh_roots");
+  // The one folder ~save writes into (a file name, never a path: docs/ros_interface.md).
+  p.save_dir = defaultSaveDir();
+  readParam(nh, "save_dir", p.save_dir);
+  stc::validateText(p.save_dir, "save_dir");
+  if (p.save_dir.empty() || p.save_dir[0] != '/') throw InputError("save_dir", "must be an absolute path");
   stc::MeshLimits& mesh = p.world.mesh_limits;  // what a mesh file may hold (docs/meshes.md)
   mesh.max_mesh_bytes = intParamIn(nh, "max_mesh_bytes", static_cast<int>(mesh.max_mesh_bytes), 1, INT_MAX);
   mesh.max_mesh_vertices =

@@ -14,12 +14,29 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <filesystem>
+#include <optional>
 
 namespace stc_ros {
 namespace {
 
 const char* const kInputTopics[] = {"spawn", "despawn", "gaze", "clicked_point"};
 const Rgba kWallColor{0.55f, 0.57f, 0.6f, 1.0f};
+
+// ~save's file: a plain name in ~save_dir, never a path (no '/', so nothing
+// outside the folder; no leading '.', so no hidden or '..' files).
+void validateSaveFileName(const std::string& file) {
+  if (file.size() > 128) throw stc::InputError("file", "longer than 128 characters");
+  for (char c : file) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+                    c == '-' || c == '.';
+    if (!ok) throw stc::InputError("file", "'" + file + "' may hold only letters, digits, '_', '-' and '.' (a name in ~save_dir)");
+  }
+  const std::string suffix = ".yaml";
+  if (file[0] == '.' || file.size() <= suffix.size() || file.compare(file.size() - suffix.size(), suffix.size(), suffix) != 0) {
+    throw stc::InputError("file", "'" + file + "' must end with .yaml and not start with '.'");
+  }
+}
 
 // A path or a .yaml name is a scene file; anything else names a built-in scene.
 bool isSceneFile(const std::string& scene) {
@@ -561,10 +578,49 @@ void WorldNode::clearWorld() {
 }
 
 void WorldNode::resetWorld() {
-  clearWorld();
-  const stc::Pose camera_pose = loadScene();  // a new World: the camera is set again (tf overrides it next tick)
+  // ~scene as the parameter server holds it now: set to a saved world, ~reset loads that.
+  const std::string start_scene = params_.scene;
+  std::string scene = params_.scene;
+  pnh_.getParam("scene", scene);
+  stc::validateText(scene, "scene");
+  // Built beside the world it replaces: a scene that fails to load changes nothing.
+  stc::World before = std::move(world_);
+  auto colors_before = std::move(colors_);
+  auto frames_before = std::move(frames_);
+  colors_.clear();
+  frames_.clear();
+  params_.scene = scene;
+  stc::Pose camera_pose;
+  try {
+    camera_pose = loadScene();  // a new World: the camera is set again (tf overrides it next tick)
+  } catch (...) {
+    world_ = std::move(before);
+    colors_ = std::move(colors_before);
+    frames_ = std::move(frames_before);
+    params_.scene = start_scene;
+    throw;
+  }
+  markers_->worldCleared();
+  entity_states_.markChanged();
+  static_frames_changed_ = true;
   world_.perception().setCamera(cameraAt(params_.camera, camera_pose));
-  ROS_INFO("reset: %zu entities of the start scene", world_.entityCount());
+  ROS_INFO("reset: %zu entities of %s", world_.entityCount(), scene.empty() ? "the default scene" : scene.c_str());
+}
+
+std::string WorldNode::saveWorld(const std::string& file) {
+  const std::string name = file.empty() ? "world.yaml" : file;
+  validateSaveFileName(name);
+  std::error_code error;
+  std::filesystem::create_directories(params_.save_dir, error);
+  if (error) throw stc::InputError("file", "cannot make ~save_dir '" + params_.save_dir + "': " + error.message());
+  const std::string path = params_.save_dir + "/" + name;
+  const std::string yaml = stc::writeSceneYaml(world_, [this](stc::EntityId id) -> std::optional<Rgba> {
+    const auto color = colors_.find(id);
+    return color == colors_.end() ? std::nullopt : std::optional<Rgba>(color->second);
+  });
+  stc::writeFileAtomically(path, yaml, "file");
+  ROS_INFO("save: %zu entities to %s", world_.entityCount(), path.c_str());
+  return path;
 }
 
 void WorldNode::setFixation(double x, double y, const ros::Time& stamp, const char* x_field, const char* y_field) {

@@ -74,6 +74,7 @@ WorldServices::WorldServices(ros::NodeHandle& pnh, WorldControl& node)
   servers_.push_back(pnh.advertiseService("unpause", &WorldServices::unpause, this));
   servers_.push_back(pnh.advertiseService("reset", &WorldServices::reset, this));
   servers_.push_back(pnh.advertiseService("step", &WorldServices::step, this));
+  servers_.push_back(pnh.advertiseService("save", &WorldServices::save, this));
 }
 
 // A call waiting for the node's spinner gives up, so the spinner's thread can be joined.
@@ -179,6 +180,13 @@ bool WorldServices::unpause(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
 bool WorldServices::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   answer(res, "reset", [&] { node_.resetWorld(); });
   node_.publishEntityList();
+  return true;
+}
+
+bool WorldServices::save(sphere_tree_collision::SaveWorld::Request& req,
+                         sphere_tree_collision::SaveWorld::Response& res) {
+  answer(res, "save", [&] { res.path = node_.saveWorld(req.file); });
+  if (!res.success) res.path.clear();
   return true;
 }
 

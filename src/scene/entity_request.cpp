@@ -131,12 +131,23 @@ EntityId addRequest(World& world, EntityRequest request, const RequestDefaults& 
     request.spec.shape = addMeshShape(world, resolve_mesh(request.mesh_resource, world.config().mesh_roots),
                                       request.mesh_scale.value_or(Vec3::Ones()), options,
                                       request.mesh_up_axis.value_or(ColladaUpAxis::AsWritten));
+    ShapeRecipe recipe;
+    recipe.mesh_resource = request.mesh_resource;
+    recipe.preset_params.resolution = request.preset_params.resolution;
+    recipe.mesh_scale = request.mesh_scale.value_or(Vec3::Ones());
+    recipe.mesh_voxel_size = request.mesh_voxel_size;
+    recipe.mesh_up_axis = static_cast<std::uint8_t>(request.mesh_up_axis.value_or(ColladaUpAxis::AsWritten));
+    world.setShapeRecipe(request.spec.shape, recipe);
   } else if (!request.preset.empty()) {
     const std::string key = presetShapeKey(request.preset, request.preset_params);
     const auto found = world.findShape(key);
     request.spec.shape = found ? *found
                                : world.addShape(key, makePreset(request.preset, request.preset_params,
                                                                 world.config().voxel_limits));
+    ShapeRecipe recipe;
+    recipe.preset = request.preset;
+    recipe.preset_params = request.preset_params;
+    world.setShapeRecipe(request.spec.shape, recipe);
   } else {
     request.spec.shape = gridShape(world, std::move(*request.grid));
   }

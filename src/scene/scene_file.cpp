@@ -10,10 +10,18 @@
 #include <set>
 #include <sstream>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <unistd.h>
+
 namespace stc {
 namespace {
 
 constexpr std::int64_t kMaxSceneEntities = 1000000;  // repeats expanded, whole file
+// An explicit grid's sides and voxels (before the World's own max_voxels).
+constexpr std::int64_t kMaxSceneGridSide = 4096;
+constexpr std::int64_t kMaxSceneGridVoxels = 64ll << 20;
 
 void checkKeys(const YAML::Node& node, const std::string& path, const std::set<std::string>& allowed) {
   for (const auto& kv : node) {
@@ -80,8 +88,9 @@ Quat fromRpy(double roll, double pitch, double yaw) {
                    Eigen::AngleAxisd(roll, Vec3::UnitX()));
 }
 
-// {rpy: [r, p, y]} (radians, fixed axes X then Y then Z) or {quat: [x, y, z, w]}.
-Quat readOrientation(const YAML::Node& node, const std::string& field) {
+// {rpy: [r, p, y]} (radians, fixed axes X then Y then Z), {quat: [x, y, z, w]}
+// (normalised) or {unit_quat: [x, y, z, w]} (as written: *exact set).
+Quat readOrientation(const YAML::Node& node, const std::string& field, bool* exact) {
   if (!node.IsMap() || node.size() != 1) {
     throw InputError(field, "expected {rpy: [roll, pitch, yaw]} or {quat: [x, y, z, w]}");
   }
@@ -93,7 +102,48 @@ Quat readOrientation(const YAML::Node& node, const std::string& field) {
     const auto v = readNumbers(node["quat"], field + ".quat", 4);
     return Quat(v[3], v[0], v[1], v[2]);  // validated (unit norm) by addRequest
   }
-  throw InputError(field, "expected {rpy: [roll, pitch, yaw]} or {quat: [x, y, z, w]}");
+  if (node["unit_quat"]) {  // kept bit for bit (EntitySpec::exact_orientation)
+    const auto v = readNumbers(node["unit_quat"], field + ".unit_quat", 4);
+    *exact = true;
+    return Quat(v[3], v[0], v[1], v[2]);
+  }
+  throw InputError(field, "expected {rpy: [roll, pitch, yaw]}, {quat: [x, y, z, w]} or {unit_quat: [x, y, z, w]}");
+}
+
+// {size: [nx, ny, nz], voxel_size: s, runs: [empty, solid, empty, ...]}:
+// the occupancy (x fastest) as alternating run lengths, empty first.
+ExplicitGrid readGrid(const YAML::Node& node, const std::string& field) {
+  if (!node.IsMap()) throw InputError(field, "expected {size: [nx, ny, nz], voxel_size: s, runs: [...]}");
+  checkKeys(node, field + ".", {"size", "voxel_size", "runs"});
+  if (!node["size"] || !node["voxel_size"] || !node["runs"]) throw InputError(field, "needs size, voxel_size and runs");
+  ExplicitGrid grid;
+  if (!node["size"].IsSequence() || node["size"].size() != 3) throw InputError(field + ".size", "expected [nx, ny, nz]");
+  grid.nx = static_cast<int>(readInt(node["size"][0], field + ".size", 1, kMaxSceneGridSide));
+  grid.ny = static_cast<int>(readInt(node["size"][1], field + ".size", 1, kMaxSceneGridSide));
+  grid.nz = static_cast<int>(readInt(node["size"][2], field + ".size", 1, kMaxSceneGridSide));
+  const std::int64_t cells = std::int64_t{grid.nx} * grid.ny * grid.nz;
+  if (cells > kMaxSceneGridVoxels) {
+    throw InputError(field + ".size", "more than " + std::to_string(kMaxSceneGridVoxels) + " voxels");
+  }
+  grid.voxel_size = readDouble(node["voxel_size"], field + ".voxel_size");
+  const YAML::Node runs = node["runs"];
+  if (!runs.IsSequence()) throw InputError(field + ".runs", "expected a list of run lengths");
+  std::vector<std::int64_t> lengths;
+  std::int64_t total = 0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    lengths.push_back(readInt(runs[i], field + ".runs", 0, cells));
+    total += lengths.back();
+    if (total > cells) break;
+  }
+  if (total != cells) {
+    throw InputError(field + ".runs", "the runs add up to " + std::to_string(total) + ", not size's " +
+                                          std::to_string(cells) + " voxels");
+  }
+  grid.occupancy.reserve(static_cast<std::size_t>(cells));
+  for (std::size_t i = 0; i < lengths.size(); ++i) {
+    grid.occupancy.insert(grid.occupancy.end(), static_cast<std::size_t>(lengths[i]), i % 2 == 1 ? 1 : 0);
+  }
+  return grid;
 }
 
 Rgba readColor(const YAML::Node& node, const std::string& field) {
@@ -115,7 +165,8 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   checkKeys(node, p,
             {"name", "preset", "resolution", "voxel_size", "seed", "position", "orientation", "velocity",
              "angular_velocity", "density", "restitution", "friction", "color", "static", "box_mode",
-             "repeat", "mesh_resource", "scale", "strength", "rolling_resistance", "up_axis", "closed_faces"});
+             "repeat", "mesh_resource", "scale", "strength", "rolling_resistance", "up_axis", "closed_faces",
+             "grid", "sleep"});
   // Which shape source, and what belongs to it, is validateRequest's to judge
   // when the scene is added: a file, a topic and a service refuse alike.
   EntityRequest r;
@@ -138,7 +189,20 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
   }
   if (node["seed"]) r.preset_params.seed = static_cast<std::uint32_t>(readInt(node["seed"], p + "seed", 0, 0xffffffffll));
   if (node["position"]) r.spec.pose.position = readVec3(node["position"], p + "position");
-  if (node["orientation"]) r.spec.pose.orientation = readOrientation(node["orientation"], p + "orientation");
+  if (node["orientation"]) {
+    r.spec.pose.orientation = readOrientation(node["orientation"], p + "orientation", &r.spec.exact_orientation);
+  }
+  if (node["sleep"]) {  // a saved world's entity (EntitySpec::restored)
+    if (node["repeat"]) throw InputError(p + "sleep", "not with repeat");
+    r.spec.restored = true;
+    r.spec.sleep_group = static_cast<std::uint32_t>(readInt(node["sleep"], p + "sleep", 0, 0xffffffffll));
+  }
+  if (node["grid"]) {
+    for (const char* key : {"resolution", "voxel_size", "seed"}) {
+      if (node[key]) throw InputError(p + key, "not for a grid (its voxel size is grid.voxel_size)");
+    }
+    r.grid = readGrid(node["grid"], p + "grid");
+  }
   if (node["velocity"]) r.spec.linear_velocity = readVec3(node["velocity"], p + "velocity");
   if (node["angular_velocity"]) r.spec.angular_velocity = readVec3(node["angular_velocity"], p + "angular_velocity");
   if (node["density"]) r.spec.density = readDouble(node["density"], p + "density");
@@ -295,6 +359,159 @@ entities:
      color: [0.80, 0.35, 0.60, 1.0]}
 )";
   return kYaml;
+}
+
+namespace {
+
+// 17 significant digits: every double reads back as the same bits (-0 as -0).
+void putNumber(std::string& out, double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  out += buf;
+}
+
+void putNumbers(std::string& out, const double* v, std::size_t n) {
+  out += '[';
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i > 0) out += ", ";
+    putNumber(out, v[i]);
+  }
+  out += ']';
+}
+
+void putVec3(std::string& out, const char* key, const Vec3& v) {
+  out += ", ";
+  out += key;
+  out += ": ";
+  putNumbers(out, v.data(), 3);
+}
+
+void putKeyNumber(std::string& out, const char* key, double v) {
+  out += ", ";
+  out += key;
+  out += ": ";
+  putNumber(out, v);
+}
+
+// YAML double-quoted (control bytes are refused on input: only \ and " need escaping).
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + '"';
+}
+
+// The shape's recipe (ShapeInfo::recipe), or its voxels as a grid.
+void putShape(std::string& out, const ShapeInfo& info) {
+  const ShapeRecipe& recipe = info.recipe;
+  if (!recipe.preset.empty()) {
+    out += "preset: " + recipe.preset + ", resolution: " + std::to_string(recipe.preset_params.resolution);
+    putKeyNumber(out, "voxel_size", recipe.preset_params.voxel_size);
+    if (recipe.preset == "rock") out += ", seed: " + std::to_string(recipe.preset_params.seed);
+    return;
+  }
+  if (!recipe.mesh_resource.empty()) {
+    out += "mesh_resource: " + quoted(recipe.mesh_resource);
+    out += ", resolution: " + std::to_string(recipe.preset_params.resolution);
+    if (recipe.mesh_voxel_size != 0.0) putKeyNumber(out, "voxel_size", recipe.mesh_voxel_size);
+    putVec3(out, "scale", recipe.mesh_scale);
+    if (recipe.mesh_up_axis == static_cast<std::uint8_t>(ColladaUpAxis::ToZUp)) out += ", up_axis: z_up";
+    return;
+  }
+  const VoxelShape& v = info.voxels;
+  if (v.isSphere() || v.surfaceMargin() != 0.0) {  // never made without a recipe (presets, meshes)
+    throw InputError("shape", "shape '" + info.key + "' has no recipe and is not a plain grid");
+  }
+  out += "grid: {size: [" + std::to_string(v.nx()) + ", " + std::to_string(v.ny()) + ", " + std::to_string(v.nz()) +
+         "], voxel_size: ";
+  putNumber(out, v.voxelSize());
+  out += ", runs: [";
+  std::uint8_t value = 0;  // runs alternate, empty first
+  std::size_t run = 0;
+  bool first = true;
+  for (std::uint8_t cell : v.occupancy()) {
+    const std::uint8_t solid = cell != 0 ? 1 : 0;
+    if (solid != value) {
+      out += first ? "" : ", ";
+      out += std::to_string(run);
+      first = false;
+      value = solid;
+      run = 0;
+    }
+    ++run;
+  }
+  out += (first ? "" : ", ") + std::to_string(run) + "]}";
+}
+
+}  // namespace
+
+std::string writeSceneYaml(const World& world, const ColorOf& color_of) {
+  std::string out = "# A saved world (~save; docs/ros_interface.md, Saved worlds): numbers to 17 digits load back bit for bit.\n";
+  out += "gravity: ";
+  putNumbers(out, world.config().gravity.data(), 3);
+  out += "\nentities:";
+  if (world.entityCount() == 0) out += " []";
+  out += '\n';
+  for (std::size_t i = 0; i < world.entityCount(); ++i) {
+    const BodyState& body = world.bodies()[i];
+    out += "  - {";
+    if (!world.bodyNames()[i].empty()) out += "name: " + world.bodyNames()[i] + ", ";
+    putShape(out, world.shape(world.bodyShapes()[i]));
+    putVec3(out, "position", body.pose.position);
+    const Quat& q = body.pose.orientation;
+    const double xyzw[4] = {q.x(), q.y(), q.z(), q.w()};
+    out += ", orientation: {unit_quat: ";
+    putNumbers(out, xyzw, 4);
+    out += '}';
+    putVec3(out, "velocity", body.linear_velocity);
+    putVec3(out, "angular_velocity", body.angular_velocity);
+    putKeyNumber(out, "density", world.bodyDensities()[i]);
+    putKeyNumber(out, "restitution", body.material.restitution);
+    putKeyNumber(out, "friction", body.material.friction);
+    putKeyNumber(out, "strength", body.material.strength);
+    putKeyNumber(out, "rolling_resistance", body.material.rolling_resistance);
+    if (color_of) {
+      if (const std::optional<Rgba> color = color_of(world.entityIds()[i])) {
+        const double rgba[4] = {(*color)[0], (*color)[1], (*color)[2], (*color)[3]};
+        out += ", color: ";
+        putNumbers(out, rgba, 4);
+      }
+    }
+    out += body.is_static ? ", static: true" : ", static: false";
+    out += ", sleep: " + std::to_string(world.sleepGroup(i));
+    out += std::string(", box_mode: ") + toString(world.bodyBoxModes()[i]);
+    const std::vector<std::string> faces = faceNames(world.closedFaces(i));
+    if (!faces.empty()) {
+      out += ", closed_faces: [";
+      for (std::size_t f = 0; f < faces.size(); ++f) out += (f > 0 ? ", " : "") + faces[f];
+      out += ']';
+    }
+    out += "}\n";
+  }
+  return out;
+}
+
+void writeFileAtomically(const std::string& path, const std::string& text, const std::string& field) {
+  validateText(path, field);
+  const std::string temporary = path + ".tmp" + std::to_string(::getpid());
+  std::remove(temporary.c_str());  // a crashed save's; "x": never through a link planted in its place
+  std::FILE* file = std::fopen(temporary.c_str(), "wbx");
+  if (file == nullptr) throw InputError(field, "cannot write '" + path + "': " + std::strerror(errno));
+  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
+  const int write_errno = errno;
+  const bool synced = std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
+  const bool closed = std::fclose(file) == 0;
+  if (!written || !synced || !closed) {
+    std::remove(temporary.c_str());
+    throw InputError(field, "cannot write '" + path + "': " + std::strerror(written ? errno : write_errno));
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const int rename_errno = errno;
+    std::remove(temporary.c_str());
+    throw InputError(field, "cannot write '" + path + "': " + std::strerror(rename_errno));
+  }
 }
 
 }  // namespace stc

@@ -28,6 +28,7 @@ struct CameraParams {
 
 struct NodeParams {
   std::string scene;                 // YAML file, built-in scene name, or "" = embedded default
+  std::string save_dir;              // ~save writes files here only (absolute; made on the first save)
   int scene_entities = 0;            // built-in scenes: movable entities (0: the scene's default)
   std::uint32_t scene_seed = 1;      // built-in scenes
   double scene_entity_size = 0.4;    // built-in scenes: metres
@@ -94,6 +95,10 @@ std::string formatMarkerLevels(const std::vector<int>& levels);
 
 // Throws stc::InputError whose field is the parameter name (e.g. "rate").
 NodeParams readNodeParams(const ros::NodeHandle& private_nh);
+
+// ~save_dir's default: $ROS_HOME/sphere_tree_collision, else
+// $HOME/.ros/sphere_tree_collision (where ROS keeps its own files).
+std::string defaultSaveDir();
 
 // A message every this many ticks: round(tick rate / message rate), at least 1
 // (markers, entity states).

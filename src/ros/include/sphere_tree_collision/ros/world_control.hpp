@@ -21,7 +21,10 @@ class WorldControl {
   virtual stc::EntityId spawnEntity(const sphere_tree_collision::SpawnEntity& msg) = 0;  // pose in worldFrame()
   virtual void despawnEntity(stc::EntityId id, const std::string& name) = 0;              // by name unless empty
   virtual void clearWorld() = 0;
-  virtual void resetWorld() = 0;  // the start scene again
+  virtual void resetWorld() = 0;  // the start scene again (~scene as the parameter server holds it now)
+  // Writes the world as a scene file named `file` in ~save_dir; returns its
+  // path. Throws InputError("file") for a bad name or a file that cannot be written.
+  virtual std::string saveWorld(const std::string& file) = 0;
   virtual void setPaused(bool paused) = 0;
   virtual bool paused() const = 0;
   // Queues n ticks while paused; the tick number tick_stats reaches when they are done.

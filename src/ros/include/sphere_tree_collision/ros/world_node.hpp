@@ -59,6 +59,7 @@ class WorldNode final : public WorldControl {
   stc::EntityId spawnEntity(const sphere_tree_collision::SpawnEntity& msg) override;  // pose in ~world_frame
   void despawnEntity(stc::EntityId id, const std::string& name) override;              // by name unless empty
   void clearWorld() override;
+  std::string saveWorld(const std::string& file) override;
   void resetWorld() override;  // the start scene again (~scene); ticks and physics time go on
   void setPaused(bool paused) override;
   bool paused() const override { return paused_; }

@@ -5,7 +5,9 @@
 //     its own, so its wait for tf never holds the ticks; the spawn itself is made on
 //     the node's spinner, between ticks, as every other change to the world.
 //   ~despawn (DespawnEntity): by name, else by id.
-//   ~clear, ~pause, ~unpause, ~reset (std_srvs/Trigger): reset rebuilds the start scene.
+//   ~clear, ~pause, ~unpause, ~reset (std_srvs/Trigger): reset rebuilds the start scene
+//     (~scene as the parameter server holds it at the call: a saved world, say).
+//   ~save (SaveWorld): the world as a scene file in ~save_dir, written atomically.
 //   ~step (Step): while paused, queues n ticks and answers at once with the tick
 //     number tick_stats reaches when they are done.
 #pragma once
@@ -16,6 +18,7 @@
 #include <ros/ros.h>
 #include <ros/spinner.h>
 #include <sphere_tree_collision/DespawnEntity.h>
+#include <sphere_tree_collision/SaveWorld.h>
 #include <sphere_tree_collision/Spawn.h>
 #include <sphere_tree_collision/Step.h>
 #include <std_srvs/Trigger.h>
@@ -47,6 +50,7 @@ class WorldServices {
   bool unpause(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool reset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool step(sphere_tree_collision::Step::Request& req, sphere_tree_collision::Step::Response& res);
+  bool save(sphere_tree_collision::SaveWorld::Request& req, sphere_tree_collision::SaveWorld::Response& res);
   // The request's entity with its pose and twist in ~world_frame; throws InputError("header.frame_id").
   sphere_tree_collision::SpawnEntity inWorldFrame(const sphere_tree_collision::Spawn::Request& req);
   // Runs `work` on the node's spinner, between ticks, and waits for it; throws

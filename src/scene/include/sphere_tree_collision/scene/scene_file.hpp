@@ -10,7 +10,7 @@
 //       voxel_size: 0.05         # metres (absent or 0: ~default_voxel_size)
 //       seed: 1                  # rock only
 //       position: [0, 0, 1]      # of the centre of mass, world frame
-//       orientation: {rpy: [0, 0, 0]}   # or {quat: [x, y, z, w]}
+//       orientation: {rpy: [0, 0, 0]}   # or {quat: [x, y, z, w]}, or {unit_quat: [x, y, z, w]} (not normalised)
 //       velocity: [0, 0, 0]
 //       angular_velocity: [0, 0, 0]
 //       density: 1000            # kg/m^3 (absent or 0: ~default_density)
@@ -20,13 +20,18 @@
 //       static: false
 //       box_mode: auto           # auto | fixed | dynamic
 //       repeat: {count: [3, 1, 1], spacing: [0.5, 0, 0]}   # copies on a grid, names get _i
+//       sleep: 0                 # a saved world's: EntitySpec::restored, sleep_group (not with repeat)
 //     - mesh_resource: package://pkg/meshes/link.stl   # instead of preset: STL, OBJ, DAE
 //       scale: [1, 1, 1]         # mesh only, per axis
 //       resolution: 32           # voxels along the mesh's longest side, unless voxel_size is given
+//     - grid: {size: [2, 1, 1], voxel_size: 0.05, runs: [0, 2]}   # instead of preset: voxels, x fastest,
+//                                # as run lengths alternating empty and solid, empty first
 #pragma once
 
 #include "sphere_tree_collision/scene/entity_request.hpp"
 
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +50,26 @@ struct Scene {
 // Throws InputError naming the field, e.g. "entities[2].position".
 Scene parseSceneYaml(const std::string& yaml_text);
 Scene loadSceneYaml(const std::string& path);
+
+// The colour an entity is written with; nullopt: none (the loader's palette).
+using ColorOf = std::function<std::optional<Rgba>(EntityId)>;
+
+// The world as a scene file that parseSceneYaml and addScene load back into
+// a new World as it is: gravity, then every entity in dense order, each with
+// its name, shape (its recipe: a preset, a mesh resource as requested, or
+// else its voxels as a grid), pose (orientation as unit_quat: kept bit for
+// bit), velocities, density, material, colour (by `color_of`), static flag,
+// box mode (as resolved), closed faces and sleep group. Numbers are written
+// to 17 significant digits: they read back as the same bits. The new World's
+// ids are 0, 1, ... in that order; the contacts carried between ticks, the
+// warm start and awake bodies' rest timers start afresh
+// (docs/ros_interface.md, "Saved worlds").
+std::string writeSceneYaml(const World& world, const ColorOf& color_of = nullptr);
+
+// `text` into `path` atomically: a temporary file beside it, flushed, then
+// renamed over it, so a reader sees the old file or the new, never a part.
+// Throws InputError(field) when it cannot be written; the path is then untouched.
+void writeFileAtomically(const std::string& path, const std::string& text, const std::string& field = "path");
 
 // The embedded default: a handful of presets spread out on a static floor.
 const std::string& defaultSceneYaml();
