@@ -29,7 +29,7 @@ const std::set<std::string>& knownParams() {
       "min_voxel_size", "max_voxel_size", "entity_states_rate", "entities_rate", "publish_clock", "error_report",
       "min_piece_voxels", "small_pieces", "strength_exponent", "threads", "reuse_tolerance",
       "diagnostic_period", "camera_info_topic", "mesh_roots", "max_mesh_bytes", "max_mesh_vertices",
-      "max_mesh_triangles", "save_dir"};  // diagnostic_period: read by diagnostic_updater
+      "max_mesh_triangles", "save_dir", "autosave_period"};  // diagnostic_period: read by diagnostic_updater
   return kNames;
 }
 
@@ -219,6 +219,10 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   readParam(nh, "save_dir", p.save_dir);
   stc::validateText(p.save_dir, "save_dir");
   if (p.save_dir.empty() || p.save_dir[0] != '/') throw InputError("save_dir", "must be an absolute path");
+  readParam(nh, "autosave_period", p.autosave_period);
+  if (!std::isfinite(p.autosave_period) || p.autosave_period < 0.0) {
+    throw InputError("autosave_period", "must be a finite number of seconds >= 0 (0: no autosave)");
+  }
   stc::MeshLimits& mesh = p.world.mesh_limits;  // what a mesh file may hold (docs/meshes.md)
   mesh.max_mesh_bytes = intParamIn(nh, "max_mesh_bytes", static_cast<int>(mesh.max_mesh_bytes), 1, INT_MAX);
   mesh.max_mesh_vertices =

@@ -294,6 +294,7 @@ void WorldNode::runTick() {
   ++tick_;
   for (const stc::BrokenEntity& b : world_.broken()) onBroken(b);
   for (const stc::QuarantinedEntity& q : world_.quarantined()) onQuarantined(q, now);
+  autosave();  // before tick_stats: a reader that sees the tick finds its autosave written
   publishStats(report, now);
   if (error_report_) {
     error_report_->write(stats_msg_, world_.perception().fixation());
@@ -607,7 +608,20 @@ void WorldNode::resetWorld() {
   ROS_INFO("reset: %zu entities of %s", world_.entityCount(), scene.empty() ? "the default scene" : scene.c_str());
 }
 
+void WorldNode::autosave() {
+  if (!(params_.autosave_period > 0.0)) return;
+  const auto every = std::max<long long>(1, std::llround(params_.autosave_period / dt_));
+  if (tick_ % static_cast<std::uint64_t>(every) != 0) return;
+  guarded("autosave", [this] { writeWorld(kAutosaveFile); });
+}
+
 std::string WorldNode::saveWorld(const std::string& file) {
+  const std::string path = writeWorld(file);
+  ROS_INFO("save: %zu entities to %s", world_.entityCount(), path.c_str());
+  return path;
+}
+
+std::string WorldNode::writeWorld(const std::string& file) {
   const std::string name = file.empty() ? "world.yaml" : file;
   validateSaveFileName(name);
   std::error_code error;
@@ -619,7 +633,6 @@ std::string WorldNode::saveWorld(const std::string& file) {
     return color == colors_.end() ? std::nullopt : std::optional<Rgba>(color->second);
   });
   stc::writeFileAtomically(path, yaml, "file");
-  ROS_INFO("save: %zu entities to %s", world_.entityCount(), path.c_str());
   return path;
 }
 

@@ -120,6 +120,7 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"mesh_roots", strings({"/nonexistent_dir"})}}, "mesh_roots[0]"},
       {world, {{"mesh_roots", "/tmp"}}, "mesh_roots"},  // a list of folders, not one
       {world, {{"save_dir", "saves"}}, "save_dir"},  // not absolute
+      {world, {{"autosave_period", -0.5}}, "autosave_period"},
       {"gaze_simulator", {{"mode", "blink"}}, "mode"},
       {"gaze_simulator", {{"mode", "follow"}}, "target"},
       {"rockfall_spawner", {{"rate", 0.0}}, "rate"},

@@ -130,6 +130,31 @@ TEST_F(SaveRestore, ASavedWorldLoadsBackAndGoesOnTheSame) {
   EXPECT_TRUE(trigger("unpause").response.success);  // tick_stats flows again for the next test
 }
 
+// ~autosave_period 0.1 s at 30 Hz (the launch): every 3rd tick the world goes
+// to autosave.yaml as ~save writes it.
+TEST_F(SaveRestore, AutosaveWritesTheWorldEveryPeriod) {
+  ASSERT_TRUE(trigger("pause").response.success);
+  stepTicks(1);
+  while (stats_.last.tick % 3 != 0) stepTicks(1);
+  const std::string autosaved = save_dir_ + "/autosave.yaml";
+  const SaveWorld now = save("now.yaml");
+  ASSERT_TRUE(now.response.success) << now.response.message;
+  EXPECT_EQ(readFile(autosaved), readFile(now.response.path));  // the whole world of this tick
+  // A body spawned now is in the next autosave, 3 ticks on, not before.
+  Spawn late;
+  late.request.entity.name = "late_comer";
+  late.request.entity.preset = "sphere";
+  late.request.entity.pose.position.z = 3.0;
+  late = call("spawn", late);
+  ASSERT_TRUE(late.response.success) << late.response.message;
+  stepTicks(2);
+  EXPECT_EQ(readFile(autosaved).find("late_comer"), std::string::npos);
+  stepTicks(1);
+  EXPECT_NE(readFile(autosaved).find("name: late_comer"), std::string::npos);
+  EXPECT_EQ(readFile(autosaved), readFile(save("now.yaml").response.path));
+  EXPECT_TRUE(trigger("unpause").response.success);
+}
+
 TEST_F(SaveRestore, RefusalsNameTheFieldAndChangeNothing) {
   ASSERT_TRUE(trigger("pause").response.success);
   stepTicks(1);

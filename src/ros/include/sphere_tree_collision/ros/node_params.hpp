@@ -29,6 +29,7 @@ struct CameraParams {
 struct NodeParams {
   std::string scene;                 // YAML file, built-in scene name, or "" = embedded default
   std::string save_dir;              // ~save writes files here only (absolute; made on the first save)
+  double autosave_period = 0.0;      // s of physics time between saves to ~save_dir/autosave.yaml (0: none)
   int scene_entities = 0;            // built-in scenes: movable entities (0: the scene's default)
   std::uint32_t scene_seed = 1;      // built-in scenes
   double scene_entity_size = 0.4;    // built-in scenes: metres

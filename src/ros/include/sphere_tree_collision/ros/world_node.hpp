@@ -70,6 +70,13 @@ class WorldNode final : public WorldControl {
   void publishEntityList() override { entity_states_.publishListIfChanged(world_, frames_, clock_.now(), beats_); }
 
  private:
+  static constexpr const char* kAutosaveFile = "autosave.yaml";
+  // Every ~autosave_period of physics time (whole ticks, at least one), the
+  // world goes to kAutosaveFile in ~save_dir as ~save writes it: a crash
+  // loses at most one period. A failed save is logged and the ticks go on.
+  void autosave();
+  // The world as a scene file `file` in ~save_dir, written atomically; its path.
+  std::string writeWorld(const std::string& file);
   enum class Input { Spawn, Despawn, Gaze, ClickedPoint };
   void onSpawn(const sphere_tree_collision::SpawnEntity& msg);
   void onDespawn(const sphere_tree_collision::Despawn& msg);
