@@ -222,7 +222,7 @@ void World::setClock(SecondsClock clock) {
 TickReport World::step(double dt, const Budget& budget) {
   if (!(std::isfinite(dt) && dt >= 0.0)) throw InputError("dt", "must be finite and >= 0");
   TickReport report;
-  report.entities = ids_.size();
+  report.bodies.entities = ids_.size();
   quarantined_.clear();
   fracture_->newStep();
   quarantine(report);  // states edited through bodies() since the last step
@@ -235,7 +235,7 @@ TickReport World::step(double dt, const Budget& budget) {
   const bool timed_tick = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
   const bool levelled = responseLimited(budget);
   const Deadline tick_end = timed_tick ? Deadline(&clock_, t0 + std::max(budget.tick_seconds, 0.0)) : Deadline();
-  if (timed_tick) report.tick_budget_s = std::max(budget.tick_seconds, 0.0);
+  if (timed_tick) report.budget.tick_budget_s = std::max(budget.tick_seconds, 0.0);
   double t0i = 0.0, t1 = 0.0, t2 = 0.0, t2s = 0.0, t3 = 0.0, t4 = 0.0, t5 = 0.0, scheduled = 0.0;
   // One team for the phases: the workers stay awake from loop to loop
   // (waking one costs more than many a loop here: docs/parallel.md).
@@ -251,36 +251,36 @@ TickReport World::step(double dt, const Budget& budget) {
     t2s = clock_();
     scheduled = narrowPhase(dt, budget, tick_end, t2s, report);
     t3 = clock_();
-    if (timed_tick) report.response_budget_s = std::max(tick_end.at() - t3, 0.0);
+    if (timed_tick) report.budget.response_budget_s = std::max(tick_end.at() - t3, 0.0);
     response(dt, budget, tick_end, t3, report);
     t4 = clock_();
     t5 = fracture(t4, tick_end, report);
   });
   const LoopTimes loops_after = workers_.loopTimes();
-  report.team_loops = loops_after.loops - loops_before.loops;
-  report.team_loop_s = loops_after.loop_s - loops_before.loop_s;
-  report.team_wait_s = loops_after.wait_s - loops_before.wait_s;
-  report.integrate_s = t1 - t0i;
-  report.broad_s = t2 - t1;
-  report.sweep_s = t2s - t2;
-  report.narrow_s = t3 - t2s;
-  report.response_s = t4 - t3;
-  report.total_s = t5 - t0;
-  report.contacts = contacts_.size();
-  report.entities = ids_.size();
-  reserve_s_ = std::max(t4 - scheduled - report.response_refinement_s, kReserveDecay * reserve_s_);
+  report.phases.team_loops = loops_after.loops - loops_before.loops;
+  report.phases.team_loop_s = loops_after.loop_s - loops_before.loop_s;
+  report.phases.team_wait_s = loops_after.wait_s - loops_before.wait_s;
+  report.phases.integrate_s = t1 - t0i;
+  report.phases.broad_s = t2 - t1;
+  report.phases.sweep_s = t2s - t2;
+  report.phases.narrow_s = t3 - t2s;
+  report.phases.response_s = t4 - t3;
+  report.phases.total_s = t5 - t0;
+  report.response.contacts = contacts_.size();
+  report.bodies.entities = ids_.size();
+  reserve_s_ = std::max(t4 - scheduled - report.response.response_refinement_s, kReserveDecay * reserve_s_);
   // Held through the tick, a sleeper was neither moved nor solved: its state
   // passed the first check unchanged (endTick releases the holds).
   held_through_tick_ = islands_.held();
   islands_.endTick(bodies_, contacts_, dt, sleeping);  // held islands are not movable: no rest, no sleep
   if (levelled) {
-    levels_.release(bodies_, report.levels);
-    if (timed_tick) learnLevelCosts((t2s - t0) + (t5 - t4), t4 - scheduled - report.response_refinement_s, report);
+    levels_.release(bodies_, report.response.levels);
+    if (timed_tick) learnLevelCosts((t2s - t0) + (t5 - t4), t4 - scheduled - report.response.response_refinement_s, report);
   } else {
     levels_.unused();
   }
   quarantine(report, &held_through_tick_);
-  report.sleeping = islands_.sleepingCount();
+  report.bodies.sleeping = islands_.sleepingCount();
   return report;
 }
 
@@ -371,7 +371,7 @@ void World::broadPhase(double dt, TickReport& report) {
     if (!bodies_[i].is_static || (held && levels_.isHeld(i))) broad_phase_.setBox(ids_[i], boxes_[i]);
   }
   broad_phase_.update();
-  report.broad_pairs = broad_phase_.pairs().size();
+  report.detection.broad_pairs = broad_phase_.pairs().size();
 
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
   if (pair_tests_.size() < pairs.size()) {  // pool grows only; last tick's tests are not read again
@@ -437,10 +437,10 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
   double end = std::numeric_limits<double>::infinity();
   if (budget.seconds < end) end = start + budget.seconds;
   if (tick_end.isSet()) {
-    report.reserve_s = kReserveMargin * reserve_s_;
-    end = std::min(end, tick_end.at() - report.reserve_s);
+    report.budget.reserve_s = kReserveMargin * reserve_s_;
+    end = std::min(end, tick_end.at() - report.budget.reserve_s);
   }
-  if (end < std::numeric_limits<double>::infinity()) report.narrow_budget_s = std::max(end - start, 0.0);
+  if (end < std::numeric_limits<double>::infinity()) report.budget.narrow_budget_s = std::max(end - start, 0.0);
   const bool gaze = perception_.hasFixation();
   // Each chunk: reset its tests into its arena, then its scheduler over them
   // under its share of the sphere tests; every chunk watches the deadline.
@@ -481,10 +481,10 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
   }, limited ? Team::Claim::OwnShareWhole : Team::Claim::Balanced);
   const ScheduleStats stats = mergedStats(narrow_chunks_, chunks);
   const double scheduled = clock_();
-  report.sphere_tests = stats.sphere_tests;
-  report.interrupted = stats.interrupted;
-  report.scheduling_overhead_s = stats.overhead_seconds;
-  report.perception_used = stats.used_perception;
+  report.detection.sphere_tests = stats.sphere_tests;
+  report.detection.interrupted = stats.interrupted;
+  report.detection.scheduling_overhead_s = stats.overhead_seconds;
+  report.accuracy.perception_used = stats.used_perception;
 
   const bool accept = config_.unresolved_policy == UnresolvedPolicy::Accept;
   for (std::size_t i = 0; i < pair_count_; ++i) {
@@ -492,24 +492,24 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
     pair_priority_[i] = 0.0;
     switch (test.status()) {
       case PairStatus::Colliding:
-        ++report.colliding;
-        if (pair_reused_[i] != PairContactCache::kNone) ++report.reused;
+        ++report.detection.colliding;
+        if (pair_reused_[i] != PairContactCache::kNone) ++report.detection.reused;
         break;
-      case PairStatus::Separate: ++report.separate; break;
-      case PairStatus::Unresolved: ++report.unresolved; break;
+      case PairStatus::Separate: ++report.detection.separate; break;
+      case PairStatus::Unresolved: ++report.detection.unresolved; break;
     }
     const bool accepted_unresolved = accept && test.status() == PairStatus::Unresolved;
     if (accepted_unresolved) {
-      ++report.unresolved_accepted;
-      report.geometric_inaccuracy += test.gapEstimate();
-      report.geometric_bound += test.gapBound();
+      ++report.detection.unresolved_accepted;
+      report.accuracy.geometric_inaccuracy += test.gapEstimate();
+      report.accuracy.geometric_bound += test.gapBound();
     }
     // Perceptual priority of every pair that becomes a contact; P sums the
     // accepted unresolved ones only (the artefacts a viewer could notice).
     if (gaze && (accepted_unresolved || test.status() == PairStatus::Colliding)) {
       pair_priority_[i] = perception_.measure(test).priority;
-      report.perception_used = true;
-      if (accepted_unresolved) report.perceived_inaccuracy += pair_priority_[i];
+      report.accuracy.perception_used = true;
+      if (accepted_unresolved) report.accuracy.perceived_inaccuracy += pair_priority_[i];
     }
   }
   return scheduled;
@@ -526,13 +526,13 @@ void World::response(double dt, const Budget& budget, const Deadline& tick_end, 
   step.steady_frontier = narrowPhaseLimited(budget, tick_end);
   if (levels_.anyHeld()) step.held_asleep = &outOfStep();  // held pairs keep their warm start as sleepers'
   physics_.buildContacts(step);
-  report.contacts_s = clock_() - start;
-  report.frontier_kept = physics_.lastReport().frontier_kept;
+  report.phases.contacts_s = clock_() - start;
+  report.response.frontier_kept = physics_.lastReport().frontier_kept;
   physics_.solve(step);
   const SolveStats& stats = physics_.lastReport().solve;
-  report.velocity_passes = stats.velocity_passes;
-  report.position_passes = stats.position_passes;
-  report.response_refinement_s = stats.refinement_seconds;
+  report.response.velocity_passes = stats.velocity_passes;
+  report.response.position_passes = stats.position_passes;
+  report.response.response_refinement_s = stats.refinement_seconds;
 }
 
 // A body the tick left non-finite or beyond the limits (an explosion, a
@@ -547,12 +547,12 @@ void World::quarantine(TickReport& report, const std::vector<std::uint8_t>* unch
     const Quarantine reason = quarantineReason(bodies_[i], config_.limits);
     if (reason == Quarantine::None) continue;
     quarantined_.push_back({ids_[i], names_[i], body_shapes_[i], reason});
-    ++(reason == Quarantine::LeftWorld ? report.left_world : report.quarantined);
+    ++(reason == Quarantine::LeftWorld ? report.bodies.left_world : report.bodies.quarantined);
   }
   if (quarantined_.size() == first) return;
   for (std::size_t q = first; q < quarantined_.size(); ++q) removeEntity(quarantined_[q].id);
-  report.entities = ids_.size();
-  report.contacts = contacts_.size();
+  report.bodies.entities = ids_.size();
+  report.response.contacts = contacts_.size();
 }
 
 }  // namespace stc

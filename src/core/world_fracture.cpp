@@ -152,7 +152,7 @@ double WorldFracture::fracture(World& world, const SecondsClock& clock, double n
   }
   breakQueued(world, clock, tick_end, false, report);
   const double end = clock();
-  report.fracture_s += end - now;
+  report.fracture.fracture_s += end - now;
   return end;
 }
 
@@ -164,7 +164,7 @@ double WorldFracture::breakPending(World& world, const SecondsClock& clock, doub
   // trees wait for the tick's end, where the time left is known.
   breakQueued(world, clock, tick_end.isSet() ? Deadline(&clock, now) : tick_end, true, report);
   const double end = clock();
-  report.fracture_s += end - now;
+  report.fracture.fracture_s += end - now;
   return end;
 }
 
@@ -193,14 +193,14 @@ void WorldFracture::breakQueued(World& world, const SecondsClock& clock, const D
       world.addShape(key, piece.shape);
       const double seconds = clock() - start;
       tree_cost_.record(piece.voxels, seconds);
-      ++report.piece_trees;
-      report.piece_tree_s += seconds;
+      ++report.fracture.piece_trees;
+      report.fracture.piece_tree_s += seconds;
     }
     if (!ready) break;
-    if (!placePieces(world, *index, pieces).empty()) ++report.fractures;
+    if (!placePieces(world, *index, pieces).empty()) ++report.fracture.fractures;
   }
   pending_breaks_.erase(pending_breaks_.begin(), pending_breaks_.begin() + done);
-  report.fractures_deferred = pending_breaks_.size();
+  report.fracture.fractures_deferred = pending_breaks_.size();
 }
 
 }  // namespace stc

@@ -55,7 +55,7 @@ void World::chooseLevels(const Budget& budget, TickReport& report) {
   in.contacts = &contacts_;  // last tick's (emptied when entities came or went)
   in.perception = &perception_;
   in.allowance = allowance;
-  levels_.choose(in, report.levels);
+  levels_.choose(in, report.response.levels);
 }
 
 // After the broad phase's pairs are set up: a held island that a moving
@@ -89,7 +89,7 @@ void World::joinHeldIslands(double dt, TickReport& report) {
     return (ma - mb).squaredNorm() <= reach * reach;
   };
   bool joined = false;
-  while (levels_.join(bodies_, pairs.size(), pair_at, near, report.levels)) {
+  while (levels_.join(bodies_, pairs.size(), pair_at, near, report.response.levels)) {
     joined = true;
     if (setUpPairTests()) setUpPairTests();
   }
@@ -102,7 +102,7 @@ void World::joinHeldIslands(double dt, TickReport& report) {
 
 void World::learnLevelCosts(double must_run_s, double response_mandatory_s, const TickReport& report) {
   must_run_s_ = must_run_s_ > 0.0 ? must_run_s_ + kCostUnitWeight * (must_run_s - must_run_s_) : must_run_s;
-  const double units = static_cast<double>(contacts_.size() + report.levels.bodies_full);
+  const double units = static_cast<double>(contacts_.size() + report.response.levels.bodies_full);
   if (!(units > 0.0)) return;
   const double measured = response_mandatory_s / units;
   cost_unit_s_ = cost_unit_s_ > 0.0 ? cost_unit_s_ + kCostUnitWeight * (measured - cost_unit_s_) : measured;
