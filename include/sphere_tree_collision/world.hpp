@@ -97,6 +97,7 @@ struct BrokenEntity {
 };
 
 class WorldFracture;  // src/core/world_fracture.hpp
+struct TickContext;   // src/core/tick_context.hpp
 
 // The shapes are a ShapeLibrary (shape_library.hpp) and the entities' rows
 // an EntityTable (entity_table.hpp), private bases: what World adds to them
@@ -204,23 +205,22 @@ class World : private ShapeLibrary, private EntityTable {
   const PhysicsReport& physicsReport() const { return physics_.lastReport(); }
 
  private:
-  // Phases, in tick order.
-  void integrate(double dt, TickReport& report);
-  void broadPhase(double dt, TickReport& report);   // also sets up the pair tests of its pairs
-  void continuousCollision(TickReport& report);
-  // Returns the clock when the scheduler stopped (what follows is not interruptible).
-  double narrowPhase(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
-  void response(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
+  // The tick's context, made once at its start (tick_context.hpp), then the
+  // phases in tick order; each times itself into the report (PhaseTimer).
+  TickContext beginTick(double dt, const Budget& budget, TickReport& report);
+  void integrate(TickContext& tick);
+  void broadPhase(TickContext& tick);  // also sets up the pair tests of its pairs
+  void continuousCollision(TickContext& tick);
+  void narrowPhase(TickContext& tick);  // notes when the scheduler stopped (what follows is not interruptible)
+  void response(TickContext& tick);
   // First and last: removes bodies beyond the limits; bodies flagged in
   // `unchanged` (held through the tick) are not looked at again.
   void quarantine(TickReport& report, const std::vector<std::uint8_t>* unchanged = nullptr);
   // Fracture after the response, and the breaks that waited, at the tick's
-  // start (WorldFracture::fracture / breakPending, world_fracture.cpp).
-  double fracture(double now, const Deadline& tick_end, TickReport& report);
-  double breakPending(double now, const Deadline& tick_end, TickReport& report);
-  // What the physics phases read and write this tick (physics.hpp); each
-  // phase sets what is its own (dt, the solver's budget).
-  StepContext physicsStep();
+  // start (WorldFracture::fracture / breakPending, world_fracture.cpp); their
+  // time counts in TickFracture::fracture_s.
+  void fracture(TickContext& tick);
+  void breakPending(TickContext& tick);
   Aabb boxOf(std::size_t index) const;
   Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
@@ -231,7 +231,7 @@ class World : private ShapeLibrary, private EntityTable {
   // unit of cost took and what the phases that must run took, for the next.
   static bool responseLimited(const Budget& budget);
   void chooseLevels(const Budget& budget, TickReport& report);
-  void joinHeldIslands(double dt, TickReport& report);
+  void joinHeldIslands(TickContext& tick);
   void learnLevelCosts(double must_run_s, double response_mandatory_s, const TickReport& report);
   // The solver's "held" bodies: asleep or held by their level (for its warm-start store).
   const std::vector<std::uint8_t>& outOfStep();

@@ -3,6 +3,8 @@
 // placed, weighed and set moving as the parent was (fracture.hpp).
 #include "world_fracture.hpp"
 
+#include "tick_context.hpp"
+
 #include <algorithm>
 #include <string>
 
@@ -17,12 +19,12 @@ std::vector<EntityId> World::breakEntity(EntityId id, const Vec3& point, const V
 
 const std::vector<BrokenEntity>& World::broken() const { return fracture_->broken(); }
 
-double World::fracture(double now, const Deadline& tick_end, TickReport& report) {
-  return fracture_->fracture(*this, clock_, now, tick_end, report);
+void World::fracture(TickContext& tick) {
+  tick.time.now = fracture_->fracture(*this, clock_, tick.time.now, tick.tick_end, tick.report);
 }
 
-double World::breakPending(double now, const Deadline& tick_end, TickReport& report) {
-  return fracture_->breakPending(*this, clock_, now, tick_end, report);
+void World::breakPending(TickContext& tick) {
+  tick.time.now = fracture_->breakPending(*this, clock_, tick.time.now, tick.tick_end, tick.report);
 }
 
 // ---------------------------------------------------------------------------------

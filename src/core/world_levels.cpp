@@ -3,6 +3,8 @@
 // what a unit of cost took.
 #include "sphere_tree_collision/world.hpp"
 
+#include "tick_context.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -64,7 +66,8 @@ void World::chooseLevels(const Budget& budget, TickReport& report) {
 // sleeper, which moves from now on too: until nothing more joins. Then the
 // joined bodies are integrated, from where they were held; their boxes
 // (IslandLevels::heldBox) already cover where that takes them.
-void World::joinHeldIslands(double dt, TickReport& report) {
+void World::joinHeldIslands(TickContext& tick) {
+  const double dt = tick.dt;
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
   const auto pair_at = [&](std::size_t k) { return pairs_seen_[k].indices; };
   // Each body's path this tick as a segment of its centre: a held body's
@@ -89,13 +92,12 @@ void World::joinHeldIslands(double dt, TickReport& report) {
     return (ma - mb).squaredNorm() <= reach * reach;
   };
   bool joined = false;
-  while (levels_.join(bodies_, pairs.size(), pair_at, near, report.response.levels)) {
+  while (levels_.join(bodies_, pairs.size(), pair_at, near, tick.report.response.levels)) {
     joined = true;
     if (setUpPairTests()) setUpPairTests();
   }
   if (!joined) return;
-  StepContext step = physicsStep();
-  step.dt = dt;
+  StepContext step = tick.physics;  // the tick's, for the joined bodies alone
   step.integrate_only = &levels_.joined();
   physics_.integrate(step);
 }
