@@ -282,12 +282,12 @@ WorldRow runWorld(std::size_t n, int ticks) {
     const double start = cpuMs();
     const stc::TickReport r = world.step(dt, budget);
     row.total_ms += cpuMs() - start;
-    row.integrate_ms += 1e3 * r.integrate_s;
-    row.broad_ms += 1e3 * r.broad_s;
-    row.narrow_ms += 1e3 * r.narrow_s;
-    row.response_ms += 1e3 * r.response_s;
-    row.broad_pairs += static_cast<double>(r.broad_pairs);
-    row.colliding += static_cast<double>(r.colliding + r.unresolved_accepted);
+    row.integrate_ms += 1e3 * r.phases.integrate_s;
+    row.broad_ms += 1e3 * r.phases.broad_s;
+    row.narrow_ms += 1e3 * r.phases.narrow_s;
+    row.response_ms += 1e3 * r.phases.response_s;
+    row.broad_pairs += static_cast<double>(r.detection.broad_pairs);
+    row.colliding += static_cast<double>(r.detection.colliding + r.detection.unresolved_accepted);
   }
   for (double* v : {&row.total_ms, &row.integrate_ms, &row.broad_ms, &row.narrow_ms, &row.response_ms,
                     &row.broad_pairs, &row.colliding})

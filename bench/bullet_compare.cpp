@@ -223,16 +223,18 @@ class PackageRun {
     const double wall0 = stc_bench::wallSeconds(), cpu0 = stc_bench::threadCpuSeconds();
     const TickReport r = world.step(scene_.spec.dt, Budget::unlimited());
     timeTick(run_, wall0, cpu0);
-    run_.integrate.push_back(r.integrate_s);
-    run_.broad.push_back(r.broad_s);
-    run_.sweep.push_back(r.sweep_s);
-    run_.narrow.push_back(r.narrow_s);
-    run_.building.push_back(r.contacts_s);
-    run_.detection.push_back(r.broad_s + r.sweep_s + r.narrow_s + r.contacts_s);
-    run_.solve.push_back(r.response_s - r.contacts_s);
-    run_.contacts.push_back(static_cast<double>(r.contacts));
-    run_.reused.push_back(r.colliding > 0 ? static_cast<double>(r.reused) / static_cast<double>(r.colliding) : 0.0);
-    run_.sleeping = static_cast<int>(r.sleeping);
+    run_.integrate.push_back(r.phases.integrate_s);
+    run_.broad.push_back(r.phases.broad_s);
+    run_.sweep.push_back(r.phases.sweep_s);
+    run_.narrow.push_back(r.phases.narrow_s);
+    run_.building.push_back(r.phases.contacts_s);
+    run_.detection.push_back(r.phases.broad_s + r.phases.sweep_s + r.phases.narrow_s + r.phases.contacts_s);
+    run_.solve.push_back(r.phases.response_s - r.phases.contacts_s);
+    run_.contacts.push_back(static_cast<double>(r.response.contacts));
+    run_.reused.push_back(r.detection.colliding > 0
+                              ? static_cast<double>(r.detection.reused) / static_cast<double>(r.detection.colliding)
+                              : 0.0);
+    run_.sleeping = static_cast<int>(r.bodies.sleeping);
     read();
     check_.tick(positions_, velocities_);
   }

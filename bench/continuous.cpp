@@ -53,11 +53,11 @@ void runScene(SceneKind kind, int count, double seconds) {  // count 0: the scen
     const double c0 = threadCpuSeconds();
     const TickReport r = world.step(dt, Budget::unlimited());
     cpu += threadCpuSeconds() - c0;
-    integrate += r.integrate_s;
-    sweep += r.sweep_s;
-    broad += r.broad_s;
-    narrow += r.narrow_s;
-    response += r.response_s;
+    integrate += r.phases.integrate_s;
+    sweep += r.phases.sweep_s;
+    broad += r.phases.broad_s;
+    narrow += r.phases.narrow_s;
+    response += r.phases.response_s;
     const SweepStats& st = world.physicsReport().sweep;
     fast += static_cast<double>(st.fast_bodies);
     pairs += static_cast<double>(st.pairs);

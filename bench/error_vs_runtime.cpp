@@ -187,8 +187,8 @@ class Evaluator {
     std::int64_t total_tests = 0;
     for (int r = 0; r < 5; ++r) {
       const TickReport rep = stepUndisturbed(*evals_[0], Budget::unlimited());
-      times.push_back(rep.narrow_s);
-      total_tests = rep.sphere_tests;
+      times.push_back(rep.phases.narrow_s);
+      total_tests = rep.detection.sphere_tests;
     }
     const double full_time = stc_bench::percentile(times, 0.5);
 
@@ -242,13 +242,13 @@ class Evaluator {
 
   TickErrors errorsOf(const World& world, const TickReport& rep) {
     TickErrors e;
-    e.narrow_s = rep.narrow_s;
-    e.overhead_s = rep.scheduling_overhead_s;
-    e.sphere_tests = static_cast<double>(rep.sphere_tests);
+    e.narrow_s = rep.phases.narrow_s;
+    e.overhead_s = rep.detection.scheduling_overhead_s;
+    e.sphere_tests = static_cast<double>(rep.detection.sphere_tests);
     e.pairs = static_cast<double>(world.pairCount());
-    e.unresolved = static_cast<double>(rep.unresolved);
-    e.est_nabla = rep.geometric_inaccuracy;
-    e.est_p = rep.perceived_inaccuracy;
+    e.unresolved = static_cast<double>(rep.detection.unresolved);
+    e.est_nabla = rep.accuracy.geometric_inaccuracy;
+    e.est_p = rep.accuracy.perceived_inaccuracy;
     const Perception& perception = world.perception();
     for (std::size_t i = 0; i < world.pairCount(); ++i) {
       const PairTest& test = world.pairTests()[i];

@@ -51,13 +51,15 @@ Run simulate(int rocks, double seconds, double strength, bool budgeted) {
   const int ticks = static_cast<int>(seconds / spec.dt);
   for (int i = 0; i < ticks; ++i) {
     const TickReport r = world.step(spec.dt, budget);
-    run.breaks += r.fractures;
-    run.trees += r.piece_trees;
-    run.fracture_s += r.fracture_s;
-    run.total_s += r.total_s;
-    run.most_waiting = std::max(run.most_waiting, r.fractures_deferred);
-    if (r.piece_trees > 0) run.tree_s.push_back(r.piece_tree_s / static_cast<double>(r.piece_trees));
-    (r.piece_trees > 0 || r.fractures > 0 ? run.piece_ticks_s : run.other_ticks_s).push_back(r.total_s);
+    run.breaks += r.fracture.fractures;
+    run.trees += r.fracture.piece_trees;
+    run.fracture_s += r.fracture.fracture_s;
+    run.total_s += r.phases.total_s;
+    run.most_waiting = std::max(run.most_waiting, r.fracture.fractures_deferred);
+    if (r.fracture.piece_trees > 0)
+      run.tree_s.push_back(r.fracture.piece_tree_s / static_cast<double>(r.fracture.piece_trees));
+    (r.fracture.piece_trees > 0 || r.fracture.fractures > 0 ? run.piece_ticks_s : run.other_ticks_s)
+        .push_back(r.phases.total_s);
   }
   run.entities = world.entityCount();
   run.shapes = world.shapeCount() - shapes_before;

@@ -216,16 +216,16 @@ BurstRun runBursts(int max_entities, int settle_ticks, double budget_ms) {
     band.cpu += threadCpuSeconds() - cpu0;
     band.wall += seconds(t0, Clock::now());
     ++band.ticks;
-    band.integrate += r.integrate_s;
-    band.broad += r.broad_s;
-    band.narrow += r.narrow_s;
-    band.response += r.response_s;
-    band.total += r.total_s;
-    band.broad_pairs += static_cast<double>(r.broad_pairs);
-    band.unresolved += static_cast<double>(r.unresolved);
-    band.contacts += static_cast<double>(r.contacts);
+    band.integrate += r.phases.integrate_s;
+    band.broad += r.phases.broad_s;
+    band.narrow += r.phases.narrow_s;
+    band.response += r.phases.response_s;
+    band.total += r.phases.total_s;
+    band.broad_pairs += static_cast<double>(r.detection.broad_pairs);
+    band.unresolved += static_cast<double>(r.detection.unresolved);
+    band.contacts += static_cast<double>(r.response.contacts);
     band.fast_bodies += static_cast<double>(world.physicsReport().sweep.fast_bodies);
-    band.interrupted += r.interrupted;
+    band.interrupted += r.detection.interrupted;
     ++tick;
     if (static_cast<int>(world.entityCount() - floor_count) >= max_entities) ++settle;
   }
@@ -337,15 +337,15 @@ Cost measure(const Variant& v, int entities, int warmup, int ticks) {
     const double cpu0 = threadCpuSeconds();
     const TickReport r = world.step(kDt, budget);
     c.cpu += threadCpuSeconds() - cpu0;
-    c.integrate += r.integrate_s;
-    c.broad += r.broad_s;
-    c.narrow += r.narrow_s;
-    c.response += r.response_s;
-    c.total += r.total_s;
-    c.overhead += r.scheduling_overhead_s;
-    c.broad_pairs += static_cast<double>(r.broad_pairs);
-    c.sphere_tests += static_cast<double>(r.sphere_tests);
-    c.perception_used = c.perception_used || r.perception_used;
+    c.integrate += r.phases.integrate_s;
+    c.broad += r.phases.broad_s;
+    c.narrow += r.phases.narrow_s;
+    c.response += r.phases.response_s;
+    c.total += r.phases.total_s;
+    c.overhead += r.detection.scheduling_overhead_s;
+    c.broad_pairs += static_cast<double>(r.detection.broad_pairs);
+    c.sphere_tests += static_cast<double>(r.detection.sphere_tests);
+    c.perception_used = c.perception_used || r.accuracy.perception_used;
   }
   for (double* x : {&c.integrate, &c.broad, &c.narrow, &c.response, &c.total, &c.overhead, &c.cpu}) {
     *x *= 1e3 / ticks;

@@ -94,16 +94,17 @@ void timedTicks(World& world, double dt, int ticks, Run& run) {
     const TickReport r = world.step(dt, Budget::unlimited());
     run.wall.push_back(wallSeconds() - wall0);
     run.cpu.push_back(processCpuSeconds() - cpu0);
-    run.integrate.push_back(r.integrate_s);
-    run.broad.push_back(r.broad_s);
-    run.sweep.push_back(r.sweep_s);
-    run.narrow.push_back(r.narrow_s);
-    run.response.push_back(r.response_s);
-    run.other.push_back(r.total_s - r.integrate_s - r.broad_s - r.sweep_s - r.narrow_s - r.response_s);
-    run.team_loop.push_back(r.team_loop_s);
-    run.team_wait.push_back(r.team_wait_s);
-    run.team_loops += static_cast<double>(r.team_loops);
-    run.contacts += static_cast<double>(r.contacts);
+    run.integrate.push_back(r.phases.integrate_s);
+    run.broad.push_back(r.phases.broad_s);
+    run.sweep.push_back(r.phases.sweep_s);
+    run.narrow.push_back(r.phases.narrow_s);
+    run.response.push_back(r.phases.response_s);
+    run.other.push_back(r.phases.total_s - r.phases.integrate_s - r.phases.broad_s - r.phases.sweep_s -
+                        r.phases.narrow_s - r.phases.response_s);
+    run.team_loop.push_back(r.phases.team_loop_s);
+    run.team_wait.push_back(r.phases.team_wait_s);
+    run.team_loops += static_cast<double>(r.phases.team_loops);
+    run.contacts += static_cast<double>(r.response.contacts);
     run.slabs += world.physicsReport().solve.slabs;
     run.crossing += static_cast<double>(world.physicsReport().solve.crossing_manifolds);
     run.manifolds += static_cast<double>(world.physicsReport().solve.manifolds);

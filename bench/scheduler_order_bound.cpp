@@ -348,7 +348,7 @@ int main(int argc, char** argv) {
     for (std::size_t x = 0; x < explores.size(); ++x) {
       for (std::size_t b = 0; b < shares.size(); ++b) {
         memoryTick(tick_facts, memories[x][b], tick, explores[x], eval.bodies().size(),
-                   std::llround(shares[b] * static_cast<double>(report.sphere_tests)), eval.perception());
+                   std::llround(shares[b] * static_cast<double>(report.detection.sphere_tests)), eval.perception());
       }
     }
     ++tick;
@@ -374,7 +374,7 @@ int main(int argc, char** argv) {
     for (std::size_t b = 0; b < shares.size(); ++b) {
       std::vector<PairTest> tests = freshTests(before);
       runQueues(before, eval.bodies().size(), eval.perception(),
-                std::llround(shares[b] * static_cast<double>(full_before.sphere_tests)), tests);
+                std::llround(shares[b] * static_cast<double>(full_before.detection.sphere_tests)), tests);
       for (std::size_t i = 0; i < before.size(); ++i) {
         if (tests[i].status() == PairStatus::Separate) separate_before[b][keyOf(before[i])] = &before[i];
       }
@@ -386,7 +386,7 @@ int main(int argc, char** argv) {
     std::vector<double> last_value, last_cost, sep_value, sep_cost;
     knownWorth(last_tick, facts, last_value, last_cost);
     for (std::size_t b = 0; b < shares.size(); ++b) {
-      const auto budget = std::llround(shares[b] * static_cast<double>(full.sphere_tests));
+      const auto budget = std::llround(shares[b] * static_cast<double>(full.detection.sphere_tests));
       left[0][b] += pLeft(facts, nullptr, budget, perception);
       left[1][b] += pLeft(facts, by_reach, budget, perception);
       left[2][b] += pLeft(facts, by_gap, budget, perception);

@@ -57,8 +57,8 @@ __attribute__((noinline)) std::vector<TickTimes> measureTicks(const std::vector<
         const TickReport report = worlds[w]->step(0.0, Budget::unlimited());
         const double lost = (stc_bench::wallSeconds() - wall0) - (stc_bench::threadCpuSeconds() - cpu0);
         if (lost > retry_s && attempt < 20) continue;  // descheduled: not this code's time
-        out[w].narrow_s.push_back(report.narrow_s);
-        out[w].overhead_share.push_back(report.scheduling_overhead_s / report.narrow_s);
+        out[w].narrow_s.push_back(report.phases.narrow_s);
+        out[w].overhead_share.push_back(report.detection.scheduling_overhead_s / report.phases.narrow_s);
         break;
       }
     }

@@ -180,13 +180,12 @@ class Diagnosis {
     std::printf(
         "t=%5.1f asleep=%5zu awake=%5d moving=%5d (v>%.2g: %d, w>%.2g: %d) islands=%d largest=%d"
         " |v| p50/max=%.3f/%.3f |w| p50/max=%.3f/%.3f drift/path=%.2f turned/turn=%.2f",
-        t, r.sleeping, awake, moving, kSpeed, lin, kSpin, ang, islands, largest,
-        stc_bench::percentile(v, 0.5), stc_bench::maxOf(v), stc_bench::percentile(w, 0.5),
-        stc_bench::maxOf(w), sum_path > 0.0 ? sum_drift / sum_path : 0.0,
-        sum_turn > 0.0 ? sum_turned / sum_turn : 0.0);
+        t, r.bodies.sleeping, awake, moving, kSpeed, lin, kSpin, ang, islands, largest, stc_bench::percentile(v, 0.5),
+        stc_bench::maxOf(v), stc_bench::percentile(w, 0.5), stc_bench::maxOf(w),
+        sum_path > 0.0 ? sum_drift / sum_path : 0.0, sum_turn > 0.0 ? sum_turned / sum_turn : 0.0);
     std::printf(" where:");
     for (int p = 0; p < kPlaces; ++p) std::printf(" %s=%d", kPlaceNames[p], places[p]);
-    std::printf(" pairs=%zu contacts=%zu\n", world_.pairCount(), r.contacts);
+    std::printf(" pairs=%zu contacts=%zu\n", world_.pairCount(), r.response.contacts);
     restlessLine();
     std::fflush(stdout);
     restart();
@@ -270,7 +269,7 @@ int main(int argc, char** argv) {
       ++t;
       diagnosis.tick(dt);
       if (t % every == 0) diagnosis.line(t * dt, r);
-      if (r.sleeping == spec.movers.size()) {
+      if (r.bodies.sleeping == spec.movers.size()) {
         asleep_at = t * dt;
         break;
       }
@@ -288,15 +287,15 @@ int main(int argc, char** argv) {
       r = world.step(dt, Budget::unlimited());
       cpu.push_back(1e3 * (stc_bench::threadCpuSeconds() - c0));
       pairs.push_back(static_cast<double>(world.pairCount()));
-      tests.push_back(static_cast<double>(r.sphere_tests));
-      contacts.push_back(static_cast<double>(r.contacts));
-      asleep_min = std::min(asleep_min, r.sleeping);
-      integrate += r.integrate_s;
-      broad += r.broad_s;
-      sweep += r.sweep_s;
-      narrow += r.narrow_s;
-      response += r.response_s;
-      total += r.total_s;
+      tests.push_back(static_cast<double>(r.detection.sphere_tests));
+      contacts.push_back(static_cast<double>(r.response.contacts));
+      asleep_min = std::min(asleep_min, r.bodies.sleeping);
+      integrate += r.phases.integrate_s;
+      broad += r.phases.broad_s;
+      sweep += r.phases.sweep_s;
+      narrow += r.phases.narrow_s;
+      response += r.phases.response_s;
+      total += r.phases.total_s;
     }
     const double ms = 1e3 / std::max(timed, 1);
     std::printf("phases, wall ms per tick: integrate %.3f broad %.3f sweep %.3f narrow %.3f response %.3f"

@@ -20,7 +20,7 @@
 // voxels), movers asleep, their mean height against the unbudgeted run's. And
 // movers that moved in the last second, how many contacts a tick came from
 // unresolved pairs and from their root spheres, and how many unresolved pairs
-// a tick kept a deeper frontier's contacts (TickReport::frontier_kept).
+// a tick kept a deeper frontier's contacts (TickReport::response.frontier_kept).
 //
 // The budget runs on the thread's CPU clock by default (World::setClock), so
 // the other processes of a shared machine do not eat it; --wall-clock runs it
@@ -90,7 +90,7 @@ struct Run {
   // (level 0). Per tick they swing with what the narrow phase got.
   double contacts = 0.0, unresolved_contacts = 0.0, root_contacts = 0.0;
   double frontier_kept = 0.0;  // pairs a tick (mean) that kept a deeper frontier's contacts
-  // Island levels (TickReport::levels), means a tick: islands stepped fully
+  // Island levels (TickReport::response.levels), means a tick: islands stepped fully
   // and held, of those held the ones a moving body joined to the tick, bodies
   // held; the longest wait (ticks); summed over the run, the held body-ticks
   // (each one tick of simulated time a body lags behind) and the held
@@ -140,28 +140,29 @@ Run simulate(const Case& c, double seconds, const Budget& budget, bool budgeted,
     run.wall.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count());
     run.cpu.push_back(threadCpuSeconds() - c0);
     check.tick(world, spec.dt);  // outside the timed part
-    run.cpu_but_integrate.push_back(run.cpu.back() - r.integrate_s);
-    run.integrate.push_back(r.integrate_s);
-    run.broad.push_back(r.broad_s);
-    run.narrow.push_back(r.narrow_s);
-    run.response.push_back(r.response_s);
-    if (std::isfinite(r.tick_budget_s)) {
-      run.narrow_got.push_back(r.narrow_budget_s);
-      run.reserve.push_back(r.reserve_s);
+    run.cpu_but_integrate.push_back(run.cpu.back() - r.phases.integrate_s);
+    run.integrate.push_back(r.phases.integrate_s);
+    run.broad.push_back(r.phases.broad_s);
+    run.narrow.push_back(r.phases.narrow_s);
+    run.response.push_back(r.phases.response_s);
+    if (std::isfinite(r.budget.tick_budget_s)) {
+      run.narrow_got.push_back(r.budget.narrow_budget_s);
+      run.reserve.push_back(r.budget.reserve_s);
     }
-    run.velocity_passes.push_back(r.velocity_passes);
-    run.position_passes.push_back(r.position_passes);
-    run.unresolved_share.push_back(r.broad_pairs ? double(r.unresolved) / double(r.broad_pairs) : 0.0);
-    run.interrupted += r.interrupted ? 1 : 0;
-    run.frontier_kept += static_cast<double>(r.frontier_kept);
-    run.islands_full += static_cast<double>(r.levels.islands_full);
-    run.islands_held += static_cast<double>(r.levels.islands_held);
-    run.islands_joined += static_cast<double>(r.levels.islands_joined);
-    run.bodies_held += static_cast<double>(r.levels.bodies_held);
-    run.held_body_ticks += static_cast<double>(r.levels.bodies_held);
-    run.held_priority += r.levels.held_priority;
-    run.most_ticks_held = std::max(run.most_ticks_held, r.levels.most_ticks_held);
-    if (r.levels.used) run.largest_island.push_back(static_cast<double>(r.levels.largest_island));
+    run.velocity_passes.push_back(r.response.velocity_passes);
+    run.position_passes.push_back(r.response.position_passes);
+    run.unresolved_share.push_back(
+        r.detection.broad_pairs ? double(r.detection.unresolved) / double(r.detection.broad_pairs) : 0.0);
+    run.interrupted += r.detection.interrupted ? 1 : 0;
+    run.frontier_kept += static_cast<double>(r.response.frontier_kept);
+    run.islands_full += static_cast<double>(r.response.levels.islands_full);
+    run.islands_held += static_cast<double>(r.response.levels.islands_held);
+    run.islands_joined += static_cast<double>(r.response.levels.islands_joined);
+    run.bodies_held += static_cast<double>(r.response.levels.bodies_held);
+    run.held_body_ticks += static_cast<double>(r.response.levels.bodies_held);
+    run.held_priority += r.response.levels.held_priority;
+    run.most_ticks_held = std::max(run.most_ticks_held, r.response.levels.most_ticks_held);
+    if (r.response.levels.used) run.largest_island.push_back(static_cast<double>(r.response.levels.largest_island));
     for (const Contact& contact : world.contacts()) {
       run.contacts += 1.0;
       if (contact.resolved) continue;
@@ -173,10 +174,13 @@ Run simulate(const Case& c, double seconds, const Budget& budget, bool budgeted,
       for (EntityId id : spec.movers) {
         const BodyState& b = world.bodies()[*world.indexOf(id)];
         if (!spec.bounds.contains(b.pose.position)) {
-          std::fprintf(stderr, "  ESCAPE tick %d entity %u at (%.3f, %.3f, %.3f) v (%.3f, %.3f, %.3f) passes %d/%d unresolved %zu contacts %zu\n",
+          std::fprintf(stderr,
+                       "  ESCAPE tick %d entity %u at (%.3f, %.3f, %.3f) v (%.3f, %.3f, %.3f) passes %d/%d unresolved "
+                       "%zu contacts %zu\n",
                        i, static_cast<unsigned>(id), b.pose.position.x(), b.pose.position.y(), b.pose.position.z(),
-                       b.linear_velocity.x(), b.linear_velocity.y(), b.linear_velocity.z(), r.velocity_passes,
-                       r.position_passes, static_cast<std::size_t>(r.unresolved), static_cast<std::size_t>(r.contacts));
+                       b.linear_velocity.x(), b.linear_velocity.y(), b.linear_velocity.z(), r.response.velocity_passes,
+                       r.response.position_passes, static_cast<std::size_t>(r.detection.unresolved),
+                       static_cast<std::size_t>(r.response.contacts));
         }
       }
     }
@@ -384,14 +388,15 @@ int main(int argc, char** argv) {
     }
     md += plausibilityRow(runs[i], ref);
   }
-  md += "\nIsland levels of the budgeted runs (TickReport::levels, island_levels.hpp): islands a tick stepped "
-        "fully / held still (mean), of the held ones joined to the tick by a moving body, bodies held a tick; "
-        "the longest wait, ticks; the lag: simulated time a mover lost by the end, mean over the movers, s; "
-        "the perceived cost: held island-ticks weighted by their gaze priority (exp(-e / 100)), a tick; "
-        "the largest island's bodies, p50 / max.\n\n"
-        "| scene | bodies | islands full / held | joined | bodies held | longest wait | mean lag | perceived cost "
-        "| largest island |\n"
-        "|---|---|---|---|---|---|---|---|---|\n";
+  md +=
+      "\nIsland levels of the budgeted runs (TickReport::response.levels, island_levels.hpp): islands a tick stepped "
+      "fully / held still (mean), of the held ones joined to the tick by a moving body, bodies held a tick; "
+      "the longest wait, ticks; the lag: simulated time a mover lost by the end, mean over the movers, s; "
+      "the perceived cost: held island-ticks weighted by their gaze priority (exp(-e / 100)), a tick; "
+      "the largest island's bodies, p50 / max.\n\n"
+      "| scene | bodies | islands full / held | joined | bodies held | longest wait | mean lag | perceived cost "
+      "| largest island |\n"
+      "|---|---|---|---|---|---|---|---|---|\n";
   for (const Run& r : runs) {
     if (!r.budgeted) continue;
     const double ticks = static_cast<double>(std::max<std::size_t>(r.cpu.size(), 1));

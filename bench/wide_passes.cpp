@@ -58,7 +58,7 @@ void timedTicks(World& world, double dt, int ticks, Run& run) {
     const double cpu0 = threadCpuSeconds();
     const TickReport r = world.step(dt, Budget::unlimited());
     run.tick_cpu.push_back(threadCpuSeconds() - cpu0);
-    run.response.push_back(r.response_s);
+    run.response.push_back(r.phases.response_s);
   }
 }
 

@@ -54,9 +54,11 @@ int main() {
     for (const Contact& c : world.contacts())
       floor_contact = floor_contact || (c.a == floor_id && c.b == stack[0]) || (c.a == stack[0] && c.b == floor_id);
     if (tick % 20 == 0)
-      std::printf("tick %3d: %zu pairs, %zu colliding, %zu unresolved, %zu contacts, %zu asleep; "
-                  "nabla %.3f m, P %.1f px\n", tick, r.broad_pairs, r.colliding, r.unresolved, r.contacts,
-                  r.sleeping, r.geometric_inaccuracy, r.perceived_inaccuracy);
+      std::printf(
+          "tick %3d: %zu pairs, %zu colliding, %zu unresolved, %zu contacts, %zu asleep; "
+          "nabla %.3f m, P %.1f px\n",
+          tick, r.detection.broad_pairs, r.detection.colliding, r.detection.unresolved, r.response.contacts,
+          r.bodies.sleeping, r.accuracy.geometric_inaccuracy, r.accuracy.perceived_inaccuracy);
     if (tick == 40)
       for (const Contact& c : world.contacts())
         std::printf("  contact %u-%u at (%.2f %.2f %.2f), normal (%.2f %.2f %.2f)%s\n", c.a, c.b, c.point.x(),

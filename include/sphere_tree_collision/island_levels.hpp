@@ -49,7 +49,7 @@ enum class ResponseLevel : std::uint8_t {
 };
 const char* responseLevelName(ResponseLevel level);  // "full" | "held" | "asleep" | "static"
 
-// What the island levels did in one tick (TickReport::levels).
+// What the island levels did in one tick (TickReport::response.levels).
 struct IslandLevelReport {
   bool used = false;                // the response was limited: islands were ranked
   double allowance = 0.0;           // cost the full islands could bring (contacts; inf: any)

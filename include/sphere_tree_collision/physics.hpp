@@ -19,10 +19,11 @@
 
 namespace stc {
 
-// One tick's view of the World, recreated at each physics phase (as Box2D's
-// step context): the tick's parameters and pointers to the World's flat
-// arrays, so that the phases share one seam instead of long argument lists.
-// Each phase reads what it names below; the pointers must outlive the call.
+// One tick's view of the World, made once a tick (World::beginTick, as
+// Box2D's step context): the tick's parameters and pointers to the World's
+// flat arrays, so that the phases share one seam instead of long argument
+// lists. Each phase reads what it names below; the pointers must outlive the
+// call.
 struct StepContext {
   double dt = 0.0;
   Vec3 gravity = Vec3::Zero();
@@ -32,10 +33,11 @@ struct StepContext {
   std::vector<BodyState>* bodies = nullptr;
   const std::vector<std::uint32_t>* body_shapes = nullptr;
   const std::deque<ShapeBounds>* shape_bounds = nullptr;
-  // The narrow phase's pairs: tests[0..pair_count), the dense indices of each
-  // test's bodies, and their perceptual priorities (sweep: pair_bodies only).
+  // The narrow phase's pairs: tests[0..*pair_count) (the count read when a
+  // phase runs: the broad phase sets it), the dense indices of each test's
+  // bodies, and their perceptual priorities (sweep: pair_bodies only).
   const std::vector<PairTest>* tests = nullptr;
-  std::size_t pair_count = 0;
+  const std::size_t* pair_count = nullptr;
   const std::vector<std::array<std::uint32_t, 2>>* pair_bodies = nullptr;
   const std::vector<double>* priorities = nullptr;
   // Per pair: its PairContactCache entry when its contacts are carried over

@@ -22,6 +22,7 @@
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/static_cover.hpp"
 #include "sphere_tree_collision/sweep_and_prune.hpp"
+#include "sphere_tree_collision/tick_report.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
 #include "sphere_tree_collision/workers.hpp"
 
@@ -95,66 +96,6 @@ struct EntitySpec {
   std::uint32_t sleep_group = 0;
 };
 
-struct TickReport {
-  // Phase wall times, seconds (on the World's clock, see World::setClock).
-  double integrate_s = 0.0, broad_s = 0.0, narrow_s = 0.0, response_s = 0.0, total_s = 0.0;
-  double sweep_s = 0.0;  // continuous collision of fast bodies, between broad and narrow phase
-  double contacts_s = 0.0;  // of response_s: building the contacts (the rest is the solve)
-  // With threads > 1 and World::timeTeamLoops on (else 0): the team's parallel
-  // loops this tick, the calling thread's wall time inside them and, of that,
-  // its wait for the other threads. total_s - team_loop_s ran on one thread.
-  std::uint64_t team_loops = 0;
-  double team_loop_s = 0.0, team_wait_s = 0.0;
-  // What each phase got of the budget. Integrate and the broad phase cannot be
-  // interrupted: they get what they use. The narrow phase gets Budget::seconds
-  // or what the tick budget leaves after them and the reserve, whichever is
-  // less; the response gets the rest of the tick (infinity: no limit).
-  double tick_budget_s = std::numeric_limits<double>::infinity();
-  double narrow_budget_s = std::numeric_limits<double>::infinity();
-  double response_budget_s = std::numeric_limits<double>::infinity();
-  // Kept back from the narrow phase (with a tick budget) for what cannot be
-  // cut after it: its own accounting and the response's mandatory part (the
-  // largest such cost of recent ticks, with a 25% margin: kReserveMargin in
-  // world.cpp).
-  double reserve_s = 0.0;
-  double response_refinement_s = 0.0;  // of response_s: iterations the deadline could have cut
-  int velocity_passes = 0;             // solver iterations run (>= 1 with contacts)
-  int position_passes = 0;             // split-impulse iterations run (>= 1 with penetration)
-  double scheduling_overhead_s = 0.0;  // part of narrow_s spent deciding, not testing
-  std::size_t entities = 0;
-  std::size_t broad_pairs = 0;
-  std::size_t colliding = 0;            // resolved colliding at the leaves
-  std::size_t reused = 0;               // of those, resumed with last tick's contacts (no sphere tested)
-  std::size_t separate = 0;             // resolved separate
-  std::size_t unresolved = 0;           // left unresolved at interruption
-  std::size_t unresolved_accepted = 0;  // of those, accepted as colliding (policy accept)
-  std::size_t frontier_kept = 0;        // of those, kept a deeper frontier's contacts (Physics::kFrontierTolerance)
-  std::int64_t sphere_tests = 0;
-  bool interrupted = false;
-  bool perception_used = false;         // false without a fixation: no projection work
-  double geometric_inaccuracy = 0.0;    // nabla: sum of 3D gap estimates of accepted unresolved pairs
-  double geometric_bound = 0.0;         // sum of rigorous bounds h_a + h_b over the same pairs
-  double perceived_inaccuracy = 0.0;    // P: sum of f(e, g) over the same pairs
-  std::size_t contacts = 0;
-  // Removed at the end of the tick (World::quarantined() names them): state
-  // non-finite or beyond the limits, and, apart, bodies that left the world.
-  std::size_t quarantined = 0;
-  std::size_t left_world = 0;
-  // Bodies broken this tick (their pieces replace them; the tick's contacts
-  // are then dropped, as with any removal) and the time spent splitting them
-  // and building the pieces' trees, deferred splits included.
-  std::size_t fractures = 0;
-  std::size_t fractures_deferred = 0;  // waiting for time: broken from the next tick's start
-  double fracture_s = 0.0;
-  std::size_t piece_trees = 0;  // new pieces' sphere-trees built this tick
-  double piece_tree_s = 0.0;    // of fracture_s: building them
-  std::size_t sleeping = 0;  // bodies asleep after the tick (islands.hpp)
-  // Under a limited response (a tick budget or Budget::response_contacts):
-  // which awake islands were stepped fully and which were held still
-  // (island_levels.hpp; World::responseLevel names each body's).
-  IslandLevelReport levels;
-};
-
 // One entity removed at the end of a tick, and why.
 struct QuarantinedEntity {
   EntityId id = kInvalidEntity;
@@ -172,6 +113,7 @@ struct BrokenEntity {
 };
 
 class WorldFracture;  // src/core/world_fracture.hpp
+struct TickContext;   // src/core/tick_context.hpp
 
 // The shapes are a ShapeLibrary (shape_library.hpp) and the entities' rows
 // an EntityTable (entity_table.hpp), private bases: what World adds to them
@@ -277,7 +219,7 @@ class World : private ShapeLibrary, private EntityTable {
   std::size_t narrowChunks() const { return narrow_chunks_used_; }
   // Threads the tick runs on (WorldConfig::threads resolved: 0 -> the cores).
   int threads() const { return workers_.threads(); }
-  // Times the team's loops into TickReport::team_* (Workers::timeLoops: three
+  // Times the team's loops into TickReport::phases.team_* (Workers::timeLoops: three
   // clock reads a loop, about 200 loops a tick of 500 bodies); off by default.
   void timeTeamLoops(bool on) { workers_.timeLoops(on); }
   const std::vector<Contact>& contacts() const { return contacts_; }
@@ -287,23 +229,22 @@ class World : private ShapeLibrary, private EntityTable {
   const PhysicsReport& physicsReport() const { return physics_.lastReport(); }
 
  private:
-  // Phases, in tick order.
-  void integrate(double dt, TickReport& report);
-  void broadPhase(double dt, TickReport& report);   // also sets up the pair tests of its pairs
-  void continuousCollision(TickReport& report);
-  // Returns the clock when the scheduler stopped (what follows is not interruptible).
-  double narrowPhase(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
-  void response(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report);
+  // The tick's context, made once at its start (tick_context.hpp), then the
+  // phases in tick order; each times itself into the report (PhaseTimer).
+  TickContext beginTick(double dt, const Budget& budget, TickReport& report);
+  void integrate(TickContext& tick);
+  void broadPhase(TickContext& tick);  // also sets up the pair tests of its pairs
+  void continuousCollision(TickContext& tick);
+  void narrowPhase(TickContext& tick);  // notes when the scheduler stopped (what follows is not interruptible)
+  void response(TickContext& tick);
   // First and last: removes bodies beyond the limits; bodies flagged in
   // `unchanged` (held through the tick) are not looked at again.
   void quarantine(TickReport& report, const std::vector<std::uint8_t>* unchanged = nullptr);
   // Fracture after the response, and the breaks that waited, at the tick's
-  // start (WorldFracture::fracture / breakPending, world_fracture.cpp).
-  double fracture(double now, const Deadline& tick_end, TickReport& report);
-  double breakPending(double now, const Deadline& tick_end, TickReport& report);
-  // What the physics phases read and write this tick (physics.hpp); each
-  // phase sets what is its own (dt, the solver's budget).
-  StepContext physicsStep();
+  // start (WorldFracture::fracture / breakPending, world_fracture.cpp); their
+  // time counts in TickFracture::fracture_s.
+  void fracture(TickContext& tick);
+  void breakPending(TickContext& tick);
   Aabb boxOf(std::size_t index) const;
   Aabb sweptBoxOf(std::size_t index) const;
   void invalidateLastTick();
@@ -314,7 +255,7 @@ class World : private ShapeLibrary, private EntityTable {
   // unit of cost took and what the phases that must run took, for the next.
   static bool responseLimited(const Budget& budget);
   void chooseLevels(const Budget& budget, TickReport& report);
-  void joinHeldIslands(double dt, TickReport& report);
+  void joinHeldIslands(TickContext& tick);
   void learnLevelCosts(double must_run_s, double response_mandatory_s, const TickReport& report);
   // The solver's "held" bodies: asleep or held by their level (for its warm-start store).
   const std::vector<std::uint8_t>& outOfStep();
@@ -362,7 +303,7 @@ class World : private ShapeLibrary, private EntityTable {
   std::vector<std::uint8_t> out_of_step_;  // outOfStep (pooled)
   SecondsClock clock_ = steadySeconds;
   std::int64_t clock_check_every_ = BudgetTracker::kDefaultCheckEvery;  // of clock_ (setClock)
-  double reserve_s_ = 0.0;  // TickReport::reserve_s of the next tick
+  double reserve_s_ = 0.0;  // TickReport::budget.reserve_s of the next tick
   std::vector<QuarantinedEntity> quarantined_;  // by the last step
   std::vector<std::uint8_t> held_through_tick_;  // step: Islands::held() before endTick (pooled)
   std::unique_ptr<WorldFracture> fracture_;  // its queue, tree costs and what broke

@@ -80,7 +80,7 @@ void Physics::sweep(const StepContext& step) {
   const ResponseOptions& options = *step.options;
   sweep_scratch_.clamped.clear();
   if (report_.sweep.fast_bodies == 0 || !options.continuous || !options.enabled) return;
-  report_.sweep = sweepFastBodies(*step.bodies, start_, body_bounds_, *step.pair_bodies, step.pair_count,
+  report_.sweep = sweepFastBodies(*step.bodies, start_, body_bounds_, *step.pair_bodies, *step.pair_count,
                                   options.sweep_threshold, sweep_scratch_, step.workers);
 }
 
@@ -290,7 +290,7 @@ void Physics::appendSweepHit(const StepContext& step, std::uint32_t ia, std::uin
 }
 
 void Physics::buildContacts(const StepContext& step) {
-  const std::size_t count = step.pair_count;
+  const std::size_t count = *step.pair_count;
   std::vector<Contact>& contacts = *step.contacts;
   // Room for last tick's count and an eighth more, made while the vector is
   // empty: a pile's contacts grow a little most ticks, and growing as they

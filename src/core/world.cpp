@@ -4,6 +4,7 @@
 
 #include "flat_hash_map.hpp"
 #include "grow_capacity.hpp"
+#include "tick_context.hpp"
 #include "world_fracture.hpp"
 
 #include <algorithm>
@@ -230,7 +231,7 @@ void World::setClock(SecondsClock clock) {
 TickReport World::step(double dt, const Budget& budget) {
   if (!(std::isfinite(dt) && dt >= 0.0)) throw InputError("dt", "must be finite and >= 0");
   TickReport report;
-  report.entities = ids_.size();
+  report.bodies.entities = ids_.size();
   quarantined_.clear();
   fracture_->newStep();
   quarantine(report);  // states edited through bodies() since the last step
@@ -239,85 +240,91 @@ TickReport World::step(double dt, const Budget& budget) {
   SleepOptions sleeping = config_.sleeping;
   sleeping.enabled = sleeping.enabled && config_.response.enabled;
   islands_.beginTick(bodies_, sleeping);  // sleepers held as static until endTick
-  const double t0 = clock_();
-  const bool timed_tick = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
-  const bool levelled = responseLimited(budget);
-  const Deadline tick_end = timed_tick ? Deadline(&clock_, t0 + std::max(budget.tick_seconds, 0.0)) : Deadline();
-  if (timed_tick) report.tick_budget_s = std::max(budget.tick_seconds, 0.0);
-  double t0i = 0.0, t1 = 0.0, t2 = 0.0, t2s = 0.0, t3 = 0.0, t4 = 0.0, t5 = 0.0, scheduled = 0.0;
+  TickContext tick = beginTick(dt, budget, report);
   // One team for the phases: the workers stay awake from loop to loop
   // (waking one costs more than many a loop here: docs/parallel.md).
   const LoopTimes loops_before = workers_.loopTimes();
   workers_.withTeam([&](Team&) {
-    t0i = breakPending(t0, tick_end, report);  // splits the last tick had no time for
-    if (levelled) chooseLevels(budget, report);  // held islands are static until released
-    integrate(dt, report);
-    t1 = clock_();
-    broadPhase(dt, report);
-    t2 = clock_();
-    continuousCollision(report);
-    t2s = clock_();
-    scheduled = narrowPhase(dt, budget, tick_end, t2s, report);
-    t3 = clock_();
-    if (timed_tick) report.response_budget_s = std::max(tick_end.at() - t3, 0.0);
-    response(dt, budget, tick_end, t3, report);
-    t4 = clock_();
-    t5 = fracture(t4, tick_end, report);
+    breakPending(tick);  // splits the last tick had no time for
+    integrate(tick);
+    broadPhase(tick);
+    continuousCollision(tick);
+    narrowPhase(tick);
+    response(tick);
+    tick.response_end = tick.time.now;  // from here on nothing is cut: fracture has its own limit
+    fracture(tick);
   });
   const LoopTimes loops_after = workers_.loopTimes();
-  report.team_loops = loops_after.loops - loops_before.loops;
-  report.team_loop_s = loops_after.loop_s - loops_before.loop_s;
-  report.team_wait_s = loops_after.wait_s - loops_before.wait_s;
-  report.integrate_s = t1 - t0i;
-  report.broad_s = t2 - t1;
-  report.sweep_s = t2s - t2;
-  report.narrow_s = t3 - t2s;
-  report.response_s = t4 - t3;
-  report.total_s = t5 - t0;
-  report.contacts = contacts_.size();
-  report.entities = ids_.size();
-  reserve_s_ = std::max(t4 - scheduled - report.response_refinement_s, kReserveDecay * reserve_s_);
+  report.phases.team_loops = loops_after.loops - loops_before.loops;
+  report.phases.team_loop_s = loops_after.loop_s - loops_before.loop_s;
+  report.phases.team_wait_s = loops_after.wait_s - loops_before.wait_s;
+  report.phases.total_s = tick.time.now - tick.time.start;
+  report.response.contacts = contacts_.size();
+  report.bodies.entities = ids_.size();
+  // What followed the scheduler could not be cut: the next ticks keep it in reserve.
+  const double mandatory_s = tick.response_end - tick.scheduled - report.response.response_refinement_s;
+  reserve_s_ = std::max(mandatory_s, kReserveDecay * reserve_s_);
   // Held through the tick, a sleeper was neither moved nor solved: its state
   // passed the first check unchanged (endTick releases the holds).
   held_through_tick_ = islands_.held();
   islands_.endTick(bodies_, contacts_, dt, sleeping);  // held islands are not movable: no rest, no sleep
-  if (levelled) {
-    levels_.release(bodies_, report.levels);
-    if (timed_tick) learnLevelCosts((t2s - t0) + (t5 - t4), t4 - scheduled - report.response_refinement_s, report);
+  if (tick.levelled) {
+    levels_.release(bodies_, report.response.levels);
+    const double must_run_s = (tick.narrow_start - tick.time.start) + (tick.time.now - tick.response_end);
+    if (tick.timed) learnLevelCosts(must_run_s, mandatory_s, report);
   } else {
     levels_.unused();
   }
   quarantine(report, &held_through_tick_);
-  report.sleeping = islands_.sleepingCount();
+  report.bodies.sleeping = islands_.sleepingCount();
   return report;
 }
 
-StepContext World::physicsStep() {
-  StepContext step;
+// Read once, at the tick's start: the clock, the deadline and the physics
+// phases' view of the World (its pointers hold for the tick; the pair count
+// is read where it stands when each phase runs).
+TickContext World::beginTick(double dt, const Budget& budget, TickReport& report) {
+  const double start = clock_();
+  const bool timed = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
+  const Deadline tick_end = timed ? Deadline(&clock_, start + std::max(budget.tick_seconds, 0.0)) : Deadline();
+  if (timed) report.budget.tick_budget_s = std::max(budget.tick_seconds, 0.0);
+  TickContext tick(report);
+  tick.dt = dt;
+  tick.budget = budget;
+  tick.tick_end = tick_end;
+  tick.timed = timed;
+  tick.levelled = responseLimited(budget);
+  tick.time = TickTime{&clock_, start, start};
+  StepContext& step = tick.physics;
+  step.dt = dt;
   step.gravity = config_.gravity;
   step.options = &config_.response;
   step.bodies = &bodies_;
   step.body_shapes = &body_shapes_;
   step.shape_bounds = &shape_bounds_;
   step.tests = &pair_tests_;
-  step.pair_count = pair_count_;
+  step.pair_count = &pair_count_;
   step.pair_bodies = &pair_bodies_;
   step.priorities = &pair_priority_;
   step.reused = Physics::reusesContacts(config_.response) ? &pair_reused_ : nullptr;
   step.accept_unresolved = config_.unresolved_policy == UnresolvedPolicy::Accept;
+  step.steady_frontier = narrowPhaseLimited(budget, tick_end);
+  step.budget.max_iterations = budget.solver_iterations;
+  step.budget.deadline = tick_end;
   step.contacts = &contacts_;
   step.workers = &workers_;
   step.ids = &ids_;
   step.held_asleep = &islands_.held();
   step.static_cover = &static_cover_;
-  return step;
+  return tick;
 }
 
-// Semi-implicit Euler; marks the fast bodies (physics.hpp).
-void World::integrate(double dt, TickReport& /*report*/) {
-  StepContext step = physicsStep();
-  step.dt = dt;
-  physics_.integrate(step);
+// The island levels first (held islands are static until released), then
+// semi-implicit Euler; marks the fast bodies (physics.hpp).
+void World::integrate(TickContext& tick) {
+  PhaseTimer timer(tick.time, tick.report.phases.integrate_s);
+  if (tick.levelled) chooseLevels(tick.budget, tick.report);
+  physics_.integrate(tick.physics);
 }
 
 Aabb World::boxOf(std::size_t index) const {
@@ -361,7 +368,9 @@ Aabb World::sweptBoxOf(std::size_t index) const {
   return box;
 }
 
-void World::broadPhase(double dt, TickReport& report) {
+void World::broadPhase(TickContext& tick) {
+  PhaseTimer timer(tick.time, tick.report.phases.broad_s);
+  const double dt = tick.dt;
   // The boxes in parallel (each body alone), then handed over in order. A
   // body held by its island's level gets the box of where it would go.
   const bool held = levels_.anyHeld();
@@ -379,7 +388,7 @@ void World::broadPhase(double dt, TickReport& report) {
     if (!bodies_[i].is_static || (held && levels_.isHeld(i))) broad_phase_.setBox(ids_[i], boxes_[i]);
   }
   broad_phase_.update();
-  report.broad_pairs = broad_phase_.pairs().size();
+  tick.report.detection.broad_pairs = broad_phase_.pairs().size();
 
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
   if (pair_tests_.size() < pairs.size()) {  // pool grows only; last tick's tests are not read again
@@ -390,7 +399,7 @@ void World::broadPhase(double dt, TickReport& report) {
   }
   // A moving body reached a sleeping island: it woke, its pairs are tested too.
   if (setUpPairTests()) setUpPairTests();
-  if (held) joinHeldIslands(dt, report);
+  if (held) joinHeldIslands(tick);
 }
 
 // The pairs' bodies; the tests themselves are reset by their chunk of the
@@ -435,20 +444,26 @@ bool World::setUpPairTests() {
 
 // Fast bodies put back at their first contact with a broad-phase partner
 // (continuous.hpp, sweepFastBodies); the pair tests read the poses when they run.
-void World::continuousCollision(TickReport& /*report*/) {
-  physics_.sweep(physicsStep());
+void World::continuousCollision(TickContext& tick) {
+  PhaseTimer timer(tick.time, tick.report.phases.sweep_s);
+  physics_.sweep(tick.physics);
 }
 
-double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_end, double start,
-                          TickReport& report) {
+void World::narrowPhase(TickContext& tick) {
+  PhaseTimer timer(tick.time, tick.report.phases.narrow_s);
+  tick.narrow_start = timer.start();
+  const double start = timer.start();
+  const Budget& budget = tick.budget;
+  const Deadline& tick_end = tick.tick_end;
+  TickReport& report = tick.report;
   // Its own limit, or what the tick leaves after the reserve for what follows.
   double end = std::numeric_limits<double>::infinity();
   if (budget.seconds < end) end = start + budget.seconds;
   if (tick_end.isSet()) {
-    report.reserve_s = kReserveMargin * reserve_s_;
-    end = std::min(end, tick_end.at() - report.reserve_s);
+    report.budget.reserve_s = kReserveMargin * reserve_s_;
+    end = std::min(end, tick_end.at() - report.budget.reserve_s);
   }
-  if (end < std::numeric_limits<double>::infinity()) report.narrow_budget_s = std::max(end - start, 0.0);
+  if (end < std::numeric_limits<double>::infinity()) report.budget.narrow_budget_s = std::max(end - start, 0.0);
   const bool gaze = perception_.hasFixation();
   // Each chunk: reset its tests into its arena, then its scheduler over them
   // under its share of the sphere tests; every chunk watches the deadline.
@@ -458,8 +473,7 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
   if (static_cover_.update(bodies_, body_shapes_, cover_shapes_)) physics_.forgetReuse();
   // A pair whose contacts last tick left valid resumes Colliding: no sphere
   // test, its contacts carried over (pair_contact_cache.hpp).
-  StepContext step = physicsStep();
-  step.dt = dt;
+  const StepContext& step = tick.physics;
   const bool limited = narrowPhaseLimited(budget, tick_end);
   const std::size_t chunks = narrowChunkCount(static_cast<std::size_t>(workers_.threads()), limited);
   assert(chunks <= narrow_chunks_.size());
@@ -488,11 +502,11 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
                                        gaze ? &perception_ : nullptr, tracker);
   }, limited ? Team::Claim::OwnShareWhole : Team::Claim::Balanced);
   const ScheduleStats stats = mergedStats(narrow_chunks_, chunks);
-  const double scheduled = clock_();
-  report.sphere_tests = stats.sphere_tests;
-  report.interrupted = stats.interrupted;
-  report.scheduling_overhead_s = stats.overhead_seconds;
-  report.perception_used = stats.used_perception;
+  tick.scheduled = clock_();
+  report.detection.sphere_tests = stats.sphere_tests;
+  report.detection.interrupted = stats.interrupted;
+  report.detection.scheduling_overhead_s = stats.overhead_seconds;
+  report.accuracy.perception_used = stats.used_perception;
 
   const bool accept = config_.unresolved_policy == UnresolvedPolicy::Accept;
   for (std::size_t i = 0; i < pair_count_; ++i) {
@@ -500,47 +514,46 @@ double World::narrowPhase(double dt, const Budget& budget, const Deadline& tick_
     pair_priority_[i] = 0.0;
     switch (test.status()) {
       case PairStatus::Colliding:
-        ++report.colliding;
-        if (pair_reused_[i] != PairContactCache::kNone) ++report.reused;
+        ++report.detection.colliding;
+        if (pair_reused_[i] != PairContactCache::kNone) ++report.detection.reused;
         break;
-      case PairStatus::Separate: ++report.separate; break;
-      case PairStatus::Unresolved: ++report.unresolved; break;
+      case PairStatus::Separate: ++report.detection.separate; break;
+      case PairStatus::Unresolved: ++report.detection.unresolved; break;
     }
     const bool accepted_unresolved = accept && test.status() == PairStatus::Unresolved;
     if (accepted_unresolved) {
-      ++report.unresolved_accepted;
-      report.geometric_inaccuracy += test.gapEstimate();
-      report.geometric_bound += test.gapBound();
+      ++report.detection.unresolved_accepted;
+      report.accuracy.geometric_inaccuracy += test.gapEstimate();
+      report.accuracy.geometric_bound += test.gapBound();
     }
     // Perceptual priority of every pair that becomes a contact; P sums the
     // accepted unresolved ones only (the artefacts a viewer could notice).
     if (gaze && (accepted_unresolved || test.status() == PairStatus::Colliding)) {
       pair_priority_[i] = perception_.measure(test).priority;
-      report.perception_used = true;
-      if (accepted_unresolved) report.perceived_inaccuracy += pair_priority_[i];
+      report.accuracy.perception_used = true;
+      if (accepted_unresolved) report.accuracy.perceived_inaccuracy += pair_priority_[i];
     }
   }
-  return scheduled;
 }
 
 // Contacts from the deepest sphere pairs of each colliding or accepted pair,
 // then impulses and position correction (contact_builder.hpp,
 // contact_solver.hpp), refined until the tick's deadline or the iteration budget.
-void World::response(double dt, const Budget& budget, const Deadline& tick_end, double start, TickReport& report) {
-  StepContext step = physicsStep();
-  step.dt = dt;
-  step.budget.max_iterations = budget.solver_iterations;
-  step.budget.deadline = tick_end;
-  step.steady_frontier = narrowPhaseLimited(budget, tick_end);
-  if (levels_.anyHeld()) step.held_asleep = &outOfStep();  // held pairs keep their warm start as sleepers'
-  physics_.buildContacts(step);
-  report.contacts_s = clock_() - start;
-  report.frontier_kept = physics_.lastReport().frontier_kept;
-  physics_.solve(step);
+void World::response(TickContext& tick) {
+  PhaseTimer timer(tick.time, tick.report.phases.response_s);
+  TickReport& report = tick.report;
+  if (tick.timed) report.budget.response_budget_s = std::max(tick.tick_end.at() - timer.start(), 0.0);
+  if (levels_.anyHeld()) tick.physics.held_asleep = &outOfStep();  // held pairs keep their warm start as sleepers'
+  {
+    PhaseTimer building(tick.time, report.phases.contacts_s);
+    physics_.buildContacts(tick.physics);
+  }
+  report.response.frontier_kept = physics_.lastReport().frontier_kept;
+  physics_.solve(tick.physics);
   const SolveStats& stats = physics_.lastReport().solve;
-  report.velocity_passes = stats.velocity_passes;
-  report.position_passes = stats.position_passes;
-  report.response_refinement_s = stats.refinement_seconds;
+  report.response.velocity_passes = stats.velocity_passes;
+  report.response.position_passes = stats.position_passes;
+  report.response.response_refinement_s = stats.refinement_seconds;
 }
 
 // A body the tick left non-finite or beyond the limits (an explosion, a
@@ -555,12 +568,12 @@ void World::quarantine(TickReport& report, const std::vector<std::uint8_t>* unch
     const Quarantine reason = quarantineReason(bodies_[i], config_.limits);
     if (reason == Quarantine::None) continue;
     quarantined_.push_back({ids_[i], names_[i], body_shapes_[i], reason});
-    ++(reason == Quarantine::LeftWorld ? report.left_world : report.quarantined);
+    ++(reason == Quarantine::LeftWorld ? report.bodies.left_world : report.bodies.quarantined);
   }
   if (quarantined_.size() == first) return;
   for (std::size_t q = first; q < quarantined_.size(); ++q) removeEntity(quarantined_[q].id);
-  report.entities = ids_.size();
-  report.contacts = contacts_.size();
+  report.bodies.entities = ids_.size();
+  report.response.contacts = contacts_.size();
 }
 
 }  // namespace stc

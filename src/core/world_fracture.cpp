@@ -3,6 +3,8 @@
 // placed, weighed and set moving as the parent was (fracture.hpp).
 #include "world_fracture.hpp"
 
+#include "tick_context.hpp"
+
 #include <algorithm>
 #include <string>
 
@@ -17,12 +19,12 @@ std::vector<EntityId> World::breakEntity(EntityId id, const Vec3& point, const V
 
 const std::vector<BrokenEntity>& World::broken() const { return fracture_->broken(); }
 
-double World::fracture(double now, const Deadline& tick_end, TickReport& report) {
-  return fracture_->fracture(*this, clock_, now, tick_end, report);
+void World::fracture(TickContext& tick) {
+  tick.time.now = fracture_->fracture(*this, clock_, tick.time.now, tick.tick_end, tick.report);
 }
 
-double World::breakPending(double now, const Deadline& tick_end, TickReport& report) {
-  return fracture_->breakPending(*this, clock_, now, tick_end, report);
+void World::breakPending(TickContext& tick) {
+  tick.time.now = fracture_->breakPending(*this, clock_, tick.time.now, tick.tick_end, tick.report);
 }
 
 // ---------------------------------------------------------------------------------
@@ -152,7 +154,7 @@ double WorldFracture::fracture(World& world, const SecondsClock& clock, double n
   }
   breakQueued(world, clock, tick_end, false, report);
   const double end = clock();
-  report.fracture_s += end - now;
+  report.fracture.fracture_s += end - now;
   return end;
 }
 
@@ -164,7 +166,7 @@ double WorldFracture::breakPending(World& world, const SecondsClock& clock, doub
   // trees wait for the tick's end, where the time left is known.
   breakQueued(world, clock, tick_end.isSet() ? Deadline(&clock, now) : tick_end, true, report);
   const double end = clock();
-  report.fracture_s += end - now;
+  report.fracture.fracture_s += end - now;
   return end;
 }
 
@@ -193,14 +195,14 @@ void WorldFracture::breakQueued(World& world, const SecondsClock& clock, const D
       world.addShape(key, piece.shape);
       const double seconds = clock() - start;
       tree_cost_.record(piece.voxels, seconds);
-      ++report.piece_trees;
-      report.piece_tree_s += seconds;
+      ++report.fracture.piece_trees;
+      report.fracture.piece_tree_s += seconds;
     }
     if (!ready) break;
-    if (!placePieces(world, *index, pieces).empty()) ++report.fractures;
+    if (!placePieces(world, *index, pieces).empty()) ++report.fracture.fractures;
   }
   pending_breaks_.erase(pending_breaks_.begin(), pending_breaks_.begin() + done);
-  report.fractures_deferred = pending_breaks_.size();
+  report.fracture.fractures_deferred = pending_breaks_.size();
 }
 
 }  // namespace stc

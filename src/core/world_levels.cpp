@@ -3,6 +3,8 @@
 // what a unit of cost took.
 #include "sphere_tree_collision/world.hpp"
 
+#include "tick_context.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -55,7 +57,7 @@ void World::chooseLevels(const Budget& budget, TickReport& report) {
   in.contacts = &contacts_;  // last tick's (emptied when entities came or went)
   in.perception = &perception_;
   in.allowance = allowance;
-  levels_.choose(in, report.levels);
+  levels_.choose(in, report.response.levels);
 }
 
 // After the broad phase's pairs are set up: a held island that a moving
@@ -64,7 +66,8 @@ void World::chooseLevels(const Budget& budget, TickReport& report) {
 // sleeper, which moves from now on too: until nothing more joins. Then the
 // joined bodies are integrated, from where they were held; their boxes
 // (IslandLevels::heldBox) already cover where that takes them.
-void World::joinHeldIslands(double dt, TickReport& report) {
+void World::joinHeldIslands(TickContext& tick) {
+  const double dt = tick.dt;
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
   const auto pair_at = [&](std::size_t k) { return pairs_seen_[k].indices; };
   // Each body's path this tick as a segment of its centre: a held body's
@@ -89,20 +92,19 @@ void World::joinHeldIslands(double dt, TickReport& report) {
     return (ma - mb).squaredNorm() <= reach * reach;
   };
   bool joined = false;
-  while (levels_.join(bodies_, pairs.size(), pair_at, near, report.levels)) {
+  while (levels_.join(bodies_, pairs.size(), pair_at, near, tick.report.response.levels)) {
     joined = true;
     if (setUpPairTests()) setUpPairTests();
   }
   if (!joined) return;
-  StepContext step = physicsStep();
-  step.dt = dt;
+  StepContext step = tick.physics;  // the tick's, for the joined bodies alone
   step.integrate_only = &levels_.joined();
   physics_.integrate(step);
 }
 
 void World::learnLevelCosts(double must_run_s, double response_mandatory_s, const TickReport& report) {
   must_run_s_ = must_run_s_ > 0.0 ? must_run_s_ + kCostUnitWeight * (must_run_s - must_run_s_) : must_run_s;
-  const double units = static_cast<double>(contacts_.size() + report.levels.bodies_full);
+  const double units = static_cast<double>(contacts_.size() + report.response.levels.bodies_full);
   if (!(units > 0.0)) return;
   const double measured = response_mandatory_s / units;
   cost_unit_s_ = cost_unit_s_ > 0.0 ? cost_unit_s_ + kCostUnitWeight * (measured - cost_unit_s_) : measured;

@@ -76,9 +76,10 @@ void ErrorBoundMarkers::build(const stc::World& world, const stc::TickReport& re
   // nabla is the paper's estimate (distance between the last intersecting
   // centres), not bounded by the bound sum: both are shown, with what they are.
   char line[200];
-  std::snprintf(line, sizeof line, "%zu of %zu pairs accepted unresolved\nbound sum (h_a+h_b) %.3f m\nnabla %.3f m   P %.3f",
-                report.unresolved_accepted, report.broad_pairs, report.geometric_bound, report.geometric_inaccuracy,
-                report.perceived_inaccuracy);
+  std::snprintf(line, sizeof line,
+                "%zu of %zu pairs accepted unresolved\nbound sum (h_a+h_b) %.3f m\nnabla %.3f m   P %.3f",
+                report.detection.unresolved_accepted, report.detection.broad_pairs, report.accuracy.geometric_bound,
+                report.accuracy.geometric_inaccuracy, report.accuracy.perceived_inaccuracy);
   text.text = line;
   text.color = toColorMsg(1.0f, 1.0f, 1.0f, 0.95f);
   const stc::Perception& perception = world.perception();

@@ -307,9 +307,10 @@ void WorldNode::runTick() {
   ROS_INFO_THROTTLE(1.0,
                     "tick %llu: %zu entities, %zu broad pairs, %zu colliding, %zu unresolved (%zu accepted), "
                     "%lld sphere tests, %zu contacts, %.2f ms, gaze %s, %llu rejected inputs",
-                    static_cast<unsigned long long>(tick_), report.entities, report.broad_pairs, report.colliding,
-                    report.unresolved, report.unresolved_accepted, static_cast<long long>(report.sphere_tests),
-                    report.contacts, report.total_s * 1e3, world_.perception().hasFixation() ? "on" : "off",
+                    static_cast<unsigned long long>(tick_), report.bodies.entities, report.detection.broad_pairs,
+                    report.detection.colliding, report.detection.unresolved, report.detection.unresolved_accepted,
+                    static_cast<long long>(report.detection.sphere_tests), report.response.contacts,
+                    report.phases.total_s * 1e3, world_.perception().hasFixation() ? "on" : "off",
                     static_cast<unsigned long long>(rejected_[0] + rejected_[1] + rejected_[2] + rejected_[3]));
   // Everything of the tick but the step is the node's own work (mostly publishing).
   publish_cost_.add(std::chrono::duration<double>((step_start - start) + (Clock::now() - step_end)).count(), dt_);

@@ -310,7 +310,7 @@ TEST(Continuous, AHitWithoutANarrowPhaseContactIsTheContact) {
   int clamped = 0;
   for (int s = 0; s < 30; ++s) {
     const TickReport r = w.step(scene.dt, Budget::ofSphereTests(0));
-    EXPECT_EQ(r.colliding, 0u);
+    EXPECT_EQ(r.detection.colliding, 0u);
     clamped += static_cast<int>(w.physicsReport().sweep.clamped);
     lowest = std::min(lowest, w.bodies()[ball].pose.position.z());
   }

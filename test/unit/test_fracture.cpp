@@ -244,7 +244,7 @@ TEST(FractureWorld, SiblingsTouchButDoNotPenetrateAtBirth) {
   // Siblings share the cut's faces: the narrow phase finds them in contact,
   // but the voxel surfaces meet with no penetration beyond rounding, and
   // moving as one rigid body they do not push each other.
-  EXPECT_GT(r.contacts, 0u);
+  EXPECT_GT(r.response.contacts, 0u);
   for (const Contact& c : w.contacts()) EXPECT_GE(c.separation, -1e-9);
   EXPECT_LE(w.physicsReport().solve.max_penetration, 1e-9);
   EXPECT_LE(totalEnergy(w.bodies(), Vec3::Zero()), e0 * (1.0 + 1e-9));
@@ -273,14 +273,14 @@ World dropScene(double strength, SmallPieces small = SmallPieces::Attach, int mi
 // Ticks until one breaks a body (the tick's index), or -1 within `ticks`.
 int stepUntilBreak(World& w, int ticks) {
   for (int i = 0; i < ticks; ++i) {
-    if (w.step(kDt, Budget::unlimited()).fractures > 0) return i;
+    if (w.step(kDt, Budget::unlimited()).fracture.fractures > 0) return i;
   }
   return -1;
 }
 
 TEST(FractureWorld, StrengthZeroNeverBreaks) {
   World w = dropScene(0.0);
-  for (int i = 0; i < 240; ++i) EXPECT_EQ(w.step(kDt, Budget::unlimited()).fractures, 0u);
+  for (int i = 0; i < 240; ++i) EXPECT_EQ(w.step(kDt, Budget::unlimited()).fracture.fractures, 0u);
   EXPECT_EQ(w.entityCount(), 2u);
   EXPECT_TRUE(w.findByName("rock").has_value());
 }
@@ -330,7 +330,7 @@ TEST(FractureWorld, VanishedPiecesTakeTheirMassAway) {
   EXPECT_LT(1.0 / w.bodies()[piece].inv_mass, mass0);
 
   World attached = dropScene(1.0, SmallPieces::Attach, 100000);
-  for (int i = 0; i < 120; ++i) EXPECT_EQ(attached.step(kDt, Budget::unlimited()).fractures, 0u);
+  for (int i = 0; i < 120; ++i) EXPECT_EQ(attached.step(kDt, Budget::unlimited()).fracture.fractures, 0u);
   EXPECT_TRUE(attached.findByName("rock").has_value());  // all pieces went back: it stayed whole
 }
 
@@ -342,8 +342,8 @@ TEST(FractureWorld, BreaksAfterTheDeadlineWaitForTheNextTick) {
   int deferred_tick = -1;
   for (int i = 0; i < 120 && deferred_tick < 0; ++i) {
     const TickReport r = w.step(kDt, Budget::ofTickSeconds(1e-4));
-    if (r.fractures_deferred > 0) {
-      EXPECT_EQ(r.fractures, 0u);
+    if (r.fracture.fractures_deferred > 0) {
+      EXPECT_EQ(r.fracture.fractures, 0u);
       EXPECT_TRUE(w.findByName("rock").has_value());
       deferred_tick = i;
     }
@@ -356,11 +356,11 @@ TEST(FractureWorld, BreaksAfterTheDeadlineWaitForTheNextTick) {
   do {
     next = w.step(kDt, Budget::ofTickSeconds(1e-4));
     ++ticks;
-    EXPECT_EQ(next.piece_trees, 1u) << "tick " << ticks;
-    EXPECT_GT(next.fracture_s, 0.0);
-  } while (next.fractures == 0 && ticks < 10);
-  EXPECT_EQ(next.fractures, 1u);
-  EXPECT_EQ(next.fractures_deferred, 0u);
+    EXPECT_EQ(next.fracture.piece_trees, 1u) << "tick " << ticks;
+    EXPECT_GT(next.fracture.fracture_s, 0.0);
+  } while (next.fracture.fractures == 0 && ticks < 10);
+  EXPECT_EQ(next.fracture.fractures, 1u);
+  EXPECT_EQ(next.fracture.fractures_deferred, 0u);
   EXPECT_FALSE(w.findByName("rock").has_value());
   ASSERT_TRUE(w.findByName("rock/piece0").has_value());
   ASSERT_EQ(w.broken().size(), 1u);
@@ -436,17 +436,17 @@ TEST(FractureWorld, PieceTreesKeepTheTickDeadlineAndEveryBreakIsMadeWithMomentum
   for (int i = 0; i < 120; ++i) {
     r = w.step(kDt, Budget::ofTickSeconds(budget));
     // Stamps of the World's clock: the tick ends by its deadline.
-    EXPECT_LE(r.total_s, budget * (1.0 + 1e-12)) << "tick " << i << ": " << r.piece_trees << " trees";
+    EXPECT_LE(r.phases.total_s, budget * (1.0 + 1e-12)) << "tick " << i << ": " << r.fracture.piece_trees << " trees";
     EXPECT_LE((linearMomentum(w.bodies()) - p0).norm(), 1e-9 * scale) << "tick " << i;
-    breaks += r.fractures;
-    trees += r.piece_trees;
-    most_deferred = std::max(most_deferred, r.fractures_deferred);
-    trees_of_one_tick = std::max(trees_of_one_tick, r.piece_trees);
+    breaks += r.fracture.fractures;
+    trees += r.fracture.piece_trees;
+    most_deferred = std::max(most_deferred, r.fracture.fractures_deferred);
+    trees_of_one_tick = std::max(trees_of_one_tick, r.fracture.piece_trees);
   }
   EXPECT_GE(breaks, 3u);
   EXPECT_GE(most_deferred, 1u) << "every break fitted: the test does not load the budget";
   EXPECT_LT(trees_of_one_tick, trees) << "the trees were not spread over ticks";
-  EXPECT_EQ(r.fractures_deferred, 0u) << "a deferred break was never made";
+  EXPECT_EQ(r.fracture.fractures_deferred, 0u) << "a deferred break was never made";
   for (const char* name : {"rock0", "rock1", "rock2", "rock3"}) EXPECT_FALSE(w.findByName(name).has_value()) << name;
 }
 
@@ -494,10 +494,10 @@ TEST(FractureWorld, OverBudgetTicksBuildOneTreeEach) {
   std::size_t breaks = 0, most_deferred = 0, trees = 0;
   for (int i = 0; i < 120; ++i) {
     const TickReport r = w.step(kDt, Budget::ofTickSeconds(1e-4));
-    EXPECT_LE(r.piece_trees, 1u) << "tick " << i;
-    breaks += r.fractures;
-    trees += r.piece_trees;
-    most_deferred = std::max(most_deferred, r.fractures_deferred);
+    EXPECT_LE(r.fracture.piece_trees, 1u) << "tick " << i;
+    breaks += r.fracture.fractures;
+    trees += r.fracture.piece_trees;
+    most_deferred = std::max(most_deferred, r.fracture.fractures_deferred);
   }
   EXPECT_GE(breaks, 3u);
   EXPECT_GE(trees, 2u);

@@ -82,8 +82,8 @@ const Budget kOneIsland = Budget::ofResponseContacts(0);
 TEST(IslandLevels, UnlimitedTicksApplyNoLevel) {
   Row row = makeRow();
   const TickReport r = row.world.step(kDt, Budget::unlimited());
-  EXPECT_FALSE(r.levels.used);
-  EXPECT_EQ(r.levels.bodies_held, 0u);
+  EXPECT_FALSE(r.response.levels.used);
+  EXPECT_EQ(r.response.levels.bodies_held, 0u);
   for (int s = 0; s < kStacks; ++s) EXPECT_EQ(levelOf(row, s), ResponseLevel::Full);
 }
 
@@ -93,11 +93,11 @@ TEST(IslandLevels, HeldIslandKeepsPoseVelocitiesAndMomentumExactly) {
   std::vector<std::vector<BodyState>> before;
   for (int s = 0; s < kStacks; ++s) before.push_back(stackBodies(row, s));
   const TickReport r = row.world.step(kDt, kOneIsland);
-  ASSERT_TRUE(r.levels.used);
-  EXPECT_EQ(r.levels.islands_full, 1u);
-  EXPECT_EQ(r.levels.islands_held, static_cast<std::size_t>(kStacks - 1));
-  EXPECT_EQ(r.levels.bodies_held, static_cast<std::size_t>(2 * (kStacks - 1)));
-  EXPECT_EQ(r.levels.islands_joined, 0u);
+  ASSERT_TRUE(r.response.levels.used);
+  EXPECT_EQ(r.response.levels.islands_full, 1u);
+  EXPECT_EQ(r.response.levels.islands_held, static_cast<std::size_t>(kStacks - 1));
+  EXPECT_EQ(r.response.levels.bodies_held, static_cast<std::size_t>(2 * (kStacks - 1)));
+  EXPECT_EQ(r.response.levels.islands_joined, 0u);
   int held = 0;
   for (int s = 0; s < kStacks; ++s) {
     if (levelOf(row, s) != ResponseLevel::Held) continue;
@@ -130,7 +130,7 @@ TEST(IslandLevels, TheIslandNearestTheGazeRunsFirst) {
     Row row = makeRow();
     lookAt(row, gazed);
     const TickReport r = row.world.step(kDt, kOneIsland);
-    EXPECT_GT(r.levels.held_priority, 0.0);
+    EXPECT_GT(r.response.levels.held_priority, 0.0);
     for (int s = 0; s < kStacks; ++s) {
       EXPECT_EQ(levelOf(row, s), s == gazed ? ResponseLevel::Full : ResponseLevel::Held) << "stack " << s;
     }
@@ -144,7 +144,7 @@ TEST(IslandLevels, EveryIslandGetsItsTurn) {
   constexpr int kTicks = 120;
   for (int t = 1; t <= kTicks; ++t) {
     const TickReport r = row.world.step(kDt, kOneIsland);
-    EXPECT_LE(r.levels.most_ticks_held, IslandLevels::kMostTicksHeld);
+    EXPECT_LE(r.response.levels.most_ticks_held, IslandLevels::kMostTicksHeld);
     for (int s = 0; s < kStacks; ++s) {
       if (levelOf(row, s) != ResponseLevel::Full) continue;
       longest[s] = std::max(longest[s], t - last_run[s]);
@@ -182,8 +182,8 @@ TEST(IslandLevels, AMovingBodyThatReachesAHeldIslandJoinsIt) {
   const TickReport r = w.step(kDt, kOneIsland);
   EXPECT_EQ(w.responseLevel(id), ResponseLevel::Full);
   EXPECT_EQ(levelOf(row, 3), ResponseLevel::Full);
-  EXPECT_EQ(r.levels.islands_joined, 1u);
-  EXPECT_EQ(r.levels.islands_full, 2u);
+  EXPECT_EQ(r.response.levels.islands_joined, 1u);
+  EXPECT_EQ(r.response.levels.islands_full, 2u);
   // Joined, it was integrated and solved with the thrown cube: it moved.
   EXPECT_NE(w.bodies()[*w.indexOf(row.stacks[3][1])].pose.position, stack_pose.position);
   // The far stacks stayed held.
@@ -203,7 +203,7 @@ TEST(IslandLevels, ARockfallThatCannotFitEveryIslandStaysPlausible) {
   std::size_t held_ticks = 0, walls = 0;
   for (int t = 0; t < 600; ++t) {
     const TickReport r = scene.world.step(scene.spec.dt, Budget::ofResponseContacts(150));
-    held_ticks += r.levels.bodies_held;
+    held_ticks += r.response.levels.bodies_held;
     // No held body is in a contact: none was met as a wall.
     for (const Contact& c : scene.world.contacts()) {
       walls += scene.world.responseLevel(c.a) == ResponseLevel::Held || scene.world.responseLevel(c.b) == ResponseLevel::Held;

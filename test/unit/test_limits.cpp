@@ -113,9 +113,9 @@ TEST(Limits, ARunawayBodyIsQuarantinedByNameAndTheRestGoesOnUntouched) {
   EXPECT_EQ(a.world.quarantined()[0].name, "runaway");
   EXPECT_EQ(a.world.quarantined()[0].reason, Quarantine::NonFinite);
   EXPECT_STREQ(toString(Quarantine::NonFinite), "non-finite state");
-  EXPECT_EQ(report.quarantined, 1u);
-  EXPECT_EQ(report.left_world, 0u);
-  EXPECT_EQ(report.entities, 1u);
+  EXPECT_EQ(report.bodies.quarantined, 1u);
+  EXPECT_EQ(report.bodies.left_world, 0u);
+  EXPECT_EQ(report.bodies.entities, 1u);
   EXPECT_FALSE(a.world.findByName("runaway"));
   // The calm body moved exactly as in the world that never had a runaway.
   const BodyState& calm_a = a.world.bodies()[*a.world.indexOf(*a.world.findByName("calm"))];
@@ -135,7 +135,7 @@ TEST(Limits, SpeedAndSpinBeyondTheLimitsAreQuarantined) {
   f.world.bodies()[*f.world.indexOf(fast)].linear_velocity = Vec3(2000, 0, 0);
   f.world.bodies()[*f.world.indexOf(spun)].angular_velocity = Vec3(0, 0, 2000);
   const TickReport report = f.world.step(1e-4, Budget{});
-  EXPECT_EQ(report.quarantined, 2u);
+  EXPECT_EQ(report.bodies.quarantined, 2u);
   EXPECT_EQ(f.world.entityCount(), 0u);
   for (const QuarantinedEntity& q : f.world.quarantined()) {
     EXPECT_EQ(q.reason, q.id == fast ? Quarantine::TooFast : Quarantine::TooSpun);
@@ -155,8 +155,8 @@ TEST(Limits, ABodyFallingOutOfTheWorldIsRemovedAsLeftTheWorld) {
   std::size_t left = 0;
   for (int tick = 0; tick < 300; ++tick) {
     const TickReport r = f.world.step(0.01, Budget{});
-    left += r.left_world;
-    EXPECT_EQ(r.quarantined, 0u);
+    left += r.bodies.left_world;
+    EXPECT_EQ(r.bodies.quarantined, 0u);
     for (const QuarantinedEntity& q : f.world.quarantined()) {
       EXPECT_EQ(q.name, "faller");
       EXPECT_EQ(q.reason, Quarantine::LeftWorld);

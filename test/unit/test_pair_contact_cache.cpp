@@ -328,13 +328,13 @@ TEST(PairContactCache, ARestingCubeReusesItsContactsAndRestsWhereItWouldHave) {
   for (int t = 0; t < 180; ++t) {
     const TickReport r = reusing.step(kDt, Budget::unlimited());
     const TickReport b = building.step(kDt, Budget::unlimited());
-    ASSERT_EQ(r.colliding + r.separate + r.unresolved, reusing.pairCount());
+    ASSERT_EQ(r.detection.colliding + r.detection.separate + r.detection.unresolved, reusing.pairCount());
     if (t < 120) continue;
-    reused += r.reused;
-    built_reused += b.reused;
-    reused_tests += r.sphere_tests;
-    built_tests += b.sphere_tests;
-    if (r.reused > 0) {
+    reused += r.detection.reused;
+    built_reused += b.detection.reused;
+    reused_tests += r.detection.sphere_tests;
+    built_tests += b.detection.sphere_tests;
+    if (r.detection.reused > 0) {
       // The solver matched every carried point to last tick's impulse.
       EXPECT_EQ(reusing.physicsReport().solve.warm_started, reusing.physicsReport().solve.contacts);
     }
@@ -365,15 +365,15 @@ TEST(SteadyFrontier, AnUnresolvedPairKeepsItsDeepestContactsWhileItStaysPut) {
   World w = cubeOnPlate(0.0);
   for (int t = 0; t < 120; ++t) w.step(kDt, Budget::unlimited());  // at rest on the plate
   const TickReport leaves = w.step(kDt, Budget::ofSphereTests(std::int64_t{1} << 40));  // limited, never reached
-  ASSERT_EQ(leaves.unresolved, 0u);
-  EXPECT_EQ(leaves.frontier_kept, 0u);
+  ASSERT_EQ(leaves.detection.unresolved, 0u);
+  EXPECT_EQ(leaves.response.frontier_kept, 0u);
   const std::vector<Contact> resolved = w.contacts();
   ASSERT_FALSE(resolved.empty());
   ASSERT_GT(resolved.front().level, 0);
 
   const TickReport roots = w.step(kDt, Budget::ofSphereTests(0));
-  ASSERT_EQ(roots.unresolved, 1u);
-  EXPECT_EQ(roots.frontier_kept, 1u);
+  ASSERT_EQ(roots.detection.unresolved, 1u);
+  EXPECT_EQ(roots.response.frontier_kept, 1u);
   ASSERT_EQ(w.contacts().size(), resolved.size());
   for (std::size_t k = 0; k < resolved.size(); ++k) {
     const Contact& c = w.contacts()[k];
@@ -386,7 +386,7 @@ TEST(SteadyFrontier, AnUnresolvedPairKeepsItsDeepestContactsWhileItStaysPut) {
     EXPECT_NEAR(c.separation, resolved[k].separation, 1e-3);
     // Its gap bound is this tick's roots', the one the report sums (the
     // error_bounds markers draw it); the solver's scale stays the leaves'.
-    EXPECT_EQ(c.gap_bound, roots.geometric_bound);
+    EXPECT_EQ(c.gap_bound, roots.accuracy.geometric_bound);
     EXPECT_EQ(c.sphere_bound, resolved[k].gap_bound);
     EXPECT_GT(c.gap_bound, c.sphere_bound);
   }
@@ -394,7 +394,7 @@ TEST(SteadyFrontier, AnUnresolvedPairKeepsItsDeepestContactsWhileItStaysPut) {
 
   // Moved by more than the tolerance, the pair is taken at its roots.
   w.bodies()[1].pose.position += Vec3(0.05, 0.0, 0.0);
-  EXPECT_EQ(w.step(kDt, Budget::ofSphereTests(0)).frontier_kept, 0u);
+  EXPECT_EQ(w.step(kDt, Budget::ofSphereTests(0)).response.frontier_kept, 0u);
   ASSERT_FALSE(w.contacts().empty());
   for (const Contact& c : w.contacts()) {
     EXPECT_EQ(c.node_a, 0) << "the roots' contact";
@@ -410,34 +410,34 @@ TEST(SteadyFrontier, AnUnresolvedPairKeepsItsDeepestContactsWhileItStaysPut) {
 TEST(PairContactCache, AMovedBodyNewOptionsOrANewStaticBodyRebuild) {
   World w = cubeOnPlate(0.05);
   for (int t = 0; t < 150; ++t) w.step(kDt, Budget::unlimited());
-  ASSERT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
+  ASSERT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 1u);
   w.bodies()[1].pose.position.x() += 0.01;  // an edit: 1 cm aside
-  EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
-  ASSERT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
+  EXPECT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 0u);
+  ASSERT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 1u);
   w.setResponse(w.config().response);
-  EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
-  ASSERT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
+  EXPECT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 0u);
+  ASSERT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 1u);
   EntitySpec far;  // a static body far away: covered faces may change anywhere
   far.shape = w.bodyShapes()[1];
   far.is_static = true;
   far.pose.position = Vec3(10.0, 0.0, 0.0);
   const EntityId far_id = w.addEntity(far);
-  EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
-  ASSERT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
+  EXPECT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 0u);
+  ASSERT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 1u);
   w.bodies()[*w.indexOf(far_id)].pose.position.y() += 1.0;  // a static body moved: the same
-  EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
-  EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 1u);
+  EXPECT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 0u);
+  EXPECT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 1u);
   // Off: built every tick.
   ResponseOptions off = w.config().response;
   off.reuse_tolerance = 0.0;
   w.setResponse(off);
-  for (int t = 0; t < 10; ++t) EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
+  for (int t = 0; t < 10; ++t) EXPECT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 0u);
   // Detection alone: nothing is carried, the test answers every tick.
   ResponseOptions detect = w.config().response;
   detect.reuse_tolerance = 0.05;
   detect.enabled = false;
   w.setResponse(detect);
-  for (int t = 0; t < 10; ++t) EXPECT_EQ(w.step(kDt, Budget::unlimited()).reused, 0u);
+  for (int t = 0; t < 10; ++t) EXPECT_EQ(w.step(kDt, Budget::unlimited()).detection.reused, 0u);
 }
 
 TEST(PairContactCache, ThreadCountDoesNotChangeTheResult) {
@@ -451,7 +451,7 @@ TEST(PairContactCache, ThreadCountDoesNotChangeTheResult) {
     config.threads = threads;
     config.response.reuse_tolerance = 0.05;
     SceneWorld scene = makeSceneWorld(SceneKind::CubeBox, params, config);
-    for (int t = 0; t < 300; ++t) reused += scene.world.step(scene.spec.dt, Budget::unlimited()).reused;
+    for (int t = 0; t < 300; ++t) reused += scene.world.step(scene.spec.dt, Budget::unlimited()).detection.reused;
     finals.push_back(scene.world.bodies());
   }
   EXPECT_GT(reused, 0u);
@@ -490,7 +490,7 @@ TEST(PairContactCache, ABallRollingDownASlopeIsNotHeldBack) {
   ball.pose.position = Vec3(0.0, 0.0, 0.2);
   w.addEntity(ball);
   std::size_t reused = 0;
-  for (int i = 0; i < 120; ++i) reused += w.step(dt, Budget::unlimited()).reused;
+  for (int i = 0; i < 120; ++i) reused += w.step(dt, Budget::unlimited()).detection.reused;
   const double a = 5.0 * 9.81 * (std::sin(slope) - c * std::cos(slope)) / 7.0;
   EXPECT_GT(reused, 0u);  // while it starts, slowly
   EXPECT_NEAR(w.bodies()[1].pose.position.x(), 0.5 * a, 0.1 * 0.5 * a);
@@ -536,8 +536,10 @@ TEST(PairContactCache, APileSettlesTheSameWithAndWithoutRecycling) {
         const int ticks = static_cast<int>(std::lround(8.0 / scene.spec.dt));
         for (int t = 0; t < ticks; ++t) {
           const TickReport r = scene.world.step(scene.spec.dt, Budget::unlimited());
-          if (recycled) reused += r.reused;
-          else ASSERT_EQ(r.reused, 0u);
+          if (recycled)
+            reused += r.detection.reused;
+          else
+            ASSERT_EQ(r.detection.reused, 0u);
         }
         const double floor = scene.spec.bounds.min.z();
         for (const EntityId id : scene.spec.movers) {

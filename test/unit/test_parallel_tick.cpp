@@ -79,9 +79,9 @@ TEST(ParallelTick, UnlimitedBudgetGivesTheSameBitsWhateverTheThreadCount) {
       const TickReport r4 = four.step(1.0 / 60.0, Budget::unlimited());
       ASSERT_TRUE(sameState(one, two)) << toString(kind) << " 1 vs 2 threads, tick " << t;
       ASSERT_TRUE(sameState(one, four)) << toString(kind) << " 1 vs 4 threads, tick " << t;
-      ASSERT_EQ(r1.sphere_tests, r2.sphere_tests) << toString(kind) << " tick " << t;
-      ASSERT_EQ(r1.sphere_tests, r4.sphere_tests) << toString(kind) << " tick " << t;
-      contacts += r1.contacts;
+      ASSERT_EQ(r1.detection.sphere_tests, r2.detection.sphere_tests) << toString(kind) << " tick " << t;
+      ASSERT_EQ(r1.detection.sphere_tests, r4.detection.sphere_tests) << toString(kind) << " tick " << t;
+      contacts += r1.response.contacts;
     }
     EXPECT_GT(contacts, 0u) << toString(kind);  // the bodies did touch
     // Restitution waves big enough for the team (16 rows a stage at 4
@@ -109,15 +109,15 @@ TEST(ParallelTick, TimedTeamLoopsAddUpWithinTheTickAndChangeNoBits) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const TickReport one = alone.step(1.0 / 60.0, Budget::unlimited());
     ASSERT_TRUE(sameState(plain, timed)) << "tick " << t;
-    EXPECT_EQ(off.team_loops, 0u);
-    EXPECT_EQ(off.team_loop_s, 0.0);
-    EXPECT_EQ(one.team_loops, 0u);
-    EXPECT_EQ(one.team_loop_s, 0.0);
-    EXPECT_GE(on.team_wait_s, 0.0) << "tick " << t;
-    EXPECT_LE(on.team_wait_s, on.team_loop_s) << "tick " << t;
-    EXPECT_LE(on.team_loop_s, wall) << "tick " << t;
-    EXPECT_EQ(on.team_loops == 0, on.team_loop_s == 0.0) << "tick " << t;
-    loops += on.team_loops;
+    EXPECT_EQ(off.phases.team_loops, 0u);
+    EXPECT_EQ(off.phases.team_loop_s, 0.0);
+    EXPECT_EQ(one.phases.team_loops, 0u);
+    EXPECT_EQ(one.phases.team_loop_s, 0.0);
+    EXPECT_GE(on.phases.team_wait_s, 0.0) << "tick " << t;
+    EXPECT_LE(on.phases.team_wait_s, on.phases.team_loop_s) << "tick " << t;
+    EXPECT_LE(on.phases.team_loop_s, wall) << "tick " << t;
+    EXPECT_EQ(on.phases.team_loops == 0, on.phases.team_loop_s == 0.0) << "tick " << t;
+    loops += on.phases.team_loops;
   }
   EXPECT_GT(loops, 120u);  // more than one a tick (the narrow phase alone runs chunks on the team)
 }
@@ -134,7 +134,7 @@ TEST(ParallelTick, SphereTestBudgetGivesTheSameBitsRunAfterRun) {
       for (int t = 0; t < kTicks; ++t) {
         const TickReport r = first.step(1.0 / 60.0, budget);
         again.step(1.0 / 60.0, budget);
-        interrupted = interrupted || r.interrupted;
+        interrupted = interrupted || r.detection.interrupted;
         ASSERT_TRUE(sameState(first, again)) << toString(kind) << " " << threads << " threads, tick " << t;
       }
       EXPECT_TRUE(interrupted) << toString(kind) << ": the budget never bit";
@@ -187,11 +187,11 @@ TEST(ParallelTick, EachChunkRunsTheSchedulerOverItsPairsWithinItsShare) {
       overshoot_bound += largest;
       if (stats.interrupted) checked_interrupted = true;
     }
-    EXPECT_EQ(r.sphere_tests, total) << "tick " << t;
+    EXPECT_EQ(r.detection.sphere_tests, total) << "tick " << t;
     // The shares sum to the budget. As with one thread, a chunk stops at the
     // first step that finds its share spent; the step that crosses it
     // finishes, so a chunk passes its share by less than one step.
-    EXPECT_LE(r.sphere_tests, budget + overshoot_bound) << "tick " << t;
+    EXPECT_LE(r.detection.sphere_tests, budget + overshoot_bound) << "tick " << t;
   }
   EXPECT_TRUE(checked_interrupted);
 }
@@ -205,19 +205,19 @@ SecondsClock atomicSteppingClock(double step) {
 TEST(ParallelTick, TheDeadlineStopsEveryWorker) {
   World w = sceneWorld(SceneKind::CornerDrift, 2);
   for (int t = 0; t < 60; ++t) w.step(1.0 / 60.0, Budget::unlimited());
-  const std::int64_t unlimited = w.step(1.0 / 60.0, Budget::unlimited()).sphere_tests;
+  const std::int64_t unlimited = w.step(1.0 / 60.0, Budget::unlimited()).detection.sphere_tests;
   w.setClock(atomicSteppingClock(1e-6));
   // Spent as the narrow phase starts: no chunk tests anything.
   TickReport r = w.step(1.0 / 60.0, Budget::ofSeconds(0.0));
-  EXPECT_TRUE(r.interrupted);
-  EXPECT_EQ(r.sphere_tests, 0);
+  EXPECT_TRUE(r.detection.interrupted);
+  EXPECT_EQ(r.detection.sphere_tests, 0);
   // Every pair is left unresolved but those whose contacts are carried over
   // (reuse_tolerance, on by default): they need no sphere test.
-  EXPECT_EQ(r.unresolved + r.reused, w.pairCount());
+  EXPECT_EQ(r.detection.unresolved + r.detection.reused, w.pairCount());
   // Passed a few clock reads in: every chunk stops with pairs left.
   r = w.step(1.0 / 60.0, Budget::ofSeconds(2e-5));
-  EXPECT_TRUE(r.interrupted);
-  EXPECT_LT(r.sphere_tests, unlimited / 2);
+  EXPECT_TRUE(r.detection.interrupted);
+  EXPECT_LT(r.detection.sphere_tests, unlimited / 2);
   for (std::size_t k = 0; k < w.narrowChunks(); ++k) {
     const auto [first, last] = chunkRange(w.pairCount(), k, w.narrowChunks());
     std::size_t unresolved = 0;

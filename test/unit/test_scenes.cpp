@@ -80,8 +80,8 @@ TEST(Scenes, PackedBoxIsTightlyPackedAndMoving) {
   EXPECT_GT(min_speed, 0.4);
   // Tightly packed: on average every mover's box overlaps several others.
   const TickReport report = world.step(0.0, Budget::unlimited());
-  EXPECT_GT(report.broad_pairs, 3 * spec.movers.size());
-  EXPECT_GT(report.colliding, 0u);
+  EXPECT_GT(report.detection.broad_pairs, 3 * spec.movers.size());
+  EXPECT_GT(report.detection.colliding, 0u);
 }
 
 TEST(Scenes, CornerDriftGravityPointsIntoABoxCorner) {
@@ -110,8 +110,8 @@ TEST(Scenes, RockfallUsesSeveralRockShapesAboveTheRavineFloor) {
   EXPECT_GT(lowest, 0.0);  // every rock starts above the run-out floor (z = 0)
   // Nothing starts in contact, rock on rock or rock on wall (full depth).
   const TickReport report = world.step(0.0, Budget::unlimited());
-  EXPECT_GT(report.broad_pairs, 0u);
-  EXPECT_EQ(report.colliding, 0u);
+  EXPECT_GT(report.detection.broad_pairs, 0u);
+  EXPECT_EQ(report.detection.colliding, 0u);
 }
 
 TEST(Scenes, RockfallRavineGrowsWithTheRockCountSoTheColumnStartsInside) {
@@ -173,8 +173,8 @@ TEST(Scenes, CubeBoxIsOneCubeShapeUnderGravityStartingApart) {
   EXPECT_EQ(voxels.nx(), voxels.nz());
   for (EntityId id : spec.movers) EXPECT_EQ(world.bodyShapes()[*world.indexOf(id)], shape);
   const TickReport report = world.step(0.0, Budget::unlimited());
-  EXPECT_GT(report.broad_pairs, 0u);
-  EXPECT_EQ(report.colliding, 0u);
+  EXPECT_GT(report.detection.broad_pairs, 0u);
+  EXPECT_EQ(report.detection.colliding, 0u);
 }
 
 // Box2D's large_pyramid: a base of 100 cubes, each row one shorter and half a

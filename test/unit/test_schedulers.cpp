@@ -513,7 +513,7 @@ TEST(SchedulerSceneTest, UnlimitedBudgetGivesRoundRobinsResultsOnBothScenes) {
       options.kind = scheduler;
       eval.setScheduler(options);
       const TickReport report = eval.step(0.0, Budget::unlimited());
-      EXPECT_FALSE(report.interrupted);
+      EXPECT_FALSE(report.detection.interrupted);
       std::vector<PairStatus> statuses;
       std::vector<std::int64_t> tests;
       for (std::size_t i = 0; i < eval.pairCount(); ++i) {
@@ -546,7 +546,7 @@ TEST(SchedulerSceneTest, PriorityQueuesBinAlikeByExponentAndByEdges) {
   const auto fixation = eval.perception().project(eval.bodies()[eval.entityCount() / 2].pose.position);
   ASSERT_TRUE(fixation && eval.perception().onScreen(*fixation));
   eval.perception().setFixation(*fixation);
-  const std::int64_t total = eval.step(0.0, Budget::unlimited()).sphere_tests;
+  const std::int64_t total = eval.step(0.0, Budget::unlimited()).detection.sphere_tests;
 
   auto stepsUnder = [&](double ratio, std::int64_t budget) {
     SchedulerOptions options;  // priority queues, 16 queues, cost exponent 1

@@ -36,7 +36,7 @@ Pile cubePile(bool sleeping = true, int count = 27) {
 // Steps until every mover sleeps; returns the ticks it took (-1: never).
 int settle(World& world, std::size_t movers, int max_ticks = kSettleTicks) {
   for (int t = 1; t <= max_ticks; ++t) {
-    if (world.step(kDt, Budget::unlimited()).sleeping == movers) return t;
+    if (world.step(kDt, Budget::unlimited()).bodies.sleeping == movers) return t;
   }
   return -1;
 }
@@ -74,9 +74,9 @@ TEST(Sleeping, WithoutAResponseNothingSleepsAndEveryPairReportsItsContacts) {
   std::size_t contacts = 0;
   for (int t = 0; t < 120; ++t) {
     const TickReport r = world.step(kDt, Budget::unlimited());
-    EXPECT_EQ(r.sleeping, 0u);
-    if (t == 0) contacts = r.contacts;
-    EXPECT_EQ(r.contacts, contacts);  // nothing moves: the same contacts every tick
+    EXPECT_EQ(r.bodies.sleeping, 0u);
+    if (t == 0) contacts = r.response.contacts;
+    EXPECT_EQ(r.response.contacts, contacts);  // nothing moves: the same contacts every tick
   }
   EXPECT_GT(contacts, 0u);
 }
@@ -88,7 +88,7 @@ TEST(Sleeping, TurningTheResponseOffWakesEveryIsland) {
   off.enabled = false;
   world.setResponse(off);
   for (EntityId id : pile.spec.movers) EXPECT_FALSE(world.isSleeping(id));
-  EXPECT_EQ(world.step(kDt, Budget::unlimited()).sleeping, 0u);
+  EXPECT_EQ(world.step(kDt, Budget::unlimited()).bodies.sleeping, 0u);
 }
 
 TEST(Sleeping, PileComesToRestSleepsAndCostsNoSphereTest) {
@@ -98,9 +98,9 @@ TEST(Sleeping, PileComesToRestSleepsAndCostsNoSphereTest) {
   for (const BodyState& b : world.bodies()) poses.push_back(b.pose);
   for (int t = 0; t < 120; ++t) {
     const TickReport r = world.step(kDt, Budget::unlimited());
-    EXPECT_EQ(r.sleeping, pile.spec.movers.size());
-    EXPECT_EQ(r.sphere_tests, 0);  // sleeping-sleeping and sleeping-static pairs are not tested
-    EXPECT_EQ(r.contacts, 0u);     // nor solved
+    EXPECT_EQ(r.bodies.sleeping, pile.spec.movers.size());
+    EXPECT_EQ(r.detection.sphere_tests, 0);  // sleeping-sleeping and sleeping-static pairs are not tested
+    EXPECT_EQ(r.response.contacts, 0u);      // nor solved
   }
   for (std::size_t i = 0; i < world.bodies().size(); ++i) {
     const BodyState& b = world.bodies()[i];
@@ -119,8 +119,8 @@ TEST(Sleeping, OffChangesNothingAndOnIsBitIdenticalUntilTheFirstSleep) {
   for (int t = 0; t < kSettleTicks; ++t) {
     const TickReport r_on = on.world.step(kDt, Budget::unlimited());
     const TickReport r_off = off.world.step(kDt, Budget::unlimited());
-    EXPECT_EQ(r_off.sleeping, 0u);
-    if (r_on.sleeping != 0) break;
+    EXPECT_EQ(r_off.bodies.sleeping, 0u);
+    if (r_on.bodies.sleeping != 0) break;
     ++compared;
     for (std::size_t i = 0; i < on.world.bodies().size(); ++i) {
       ASSERT_EQ(on.world.bodies()[i].pose.position, off.world.bodies()[i].pose.position) << "tick " << t;
@@ -129,7 +129,7 @@ TEST(Sleeping, OffChangesNothingAndOnIsBitIdenticalUntilTheFirstSleep) {
   }
   EXPECT_GT(compared, 30);  // the pile fell and moved before anything slept
   // Off: the settled pile still tests its pairs every tick.
-  EXPECT_GT(off.world.step(kDt, Budget::unlimited()).sphere_tests, 0);
+  EXPECT_GT(off.world.step(kDt, Budget::unlimited()).detection.sphere_tests, 0);
 }
 
 // A heavy ball 1 m above the pile's last mover, falling at `speed`.
@@ -152,7 +152,8 @@ TEST(Sleeping, BallDroppedOnTheSleepingPileWakesItAndEverythingRestsSupported) {
   World& world = pile.world;
   const EntityId ball_id = dropBall(pile, 3.0);
   std::size_t fewest_asleep = pile.spec.movers.size();
-  for (int t = 0; t < 60; ++t) fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).sleeping);
+  for (int t = 0; t < 60; ++t)
+    fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).bodies.sleeping);
   EXPECT_LT(fewest_asleep, pile.spec.movers.size());  // the hit woke the island it hit
   // Everything comes to rest again, the ball on the pile, nothing through the floor.
   EXPECT_GT(settle(world, pile.spec.movers.size() + 1), 0);
@@ -163,7 +164,7 @@ TEST(Sleeping, BallDroppedOnTheSleepingPileWakesItAndEverythingRestsSupported) {
   std::vector<Vec3> rest;
   for (const BodyState& b : world.bodies()) rest.push_back(b.pose.position);
   world.setGravity(world.config().gravity);
-  EXPECT_EQ(world.step(kDt, Budget::unlimited()).sleeping, 0u);
+  EXPECT_EQ(world.step(kDt, Budget::unlimited()).bodies.sleeping, 0u);
   for (int t = 0; t < 30; ++t) world.step(kDt, Budget::unlimited());
   // In half a second of free fall a floating body drops 1.2 m. A body that
   // fell asleep on a slope, held by a neighbour that slept before it (held
@@ -185,7 +186,7 @@ TEST(Sleeping, FastBallDoesNotTunnelThroughTheSleepingPile) {
   double lowest = 1e9;
   std::size_t fewest_asleep = pile.spec.movers.size();
   for (int t = 0; t < 60; ++t) {
-    fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).sleeping);
+    fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).bodies.sleeping);
     lowest = std::min(lowest, world.bodies()[indexOf(world, ball_id)].pose.position.z());
   }
   EXPECT_LT(fewest_asleep, pile.spec.movers.size());
@@ -219,12 +220,12 @@ TEST(Sleeping, DespawnWakesItsIslandAndWhatItTouched) {
   for (EntityId id : pile.spec.movers) {
     if (world.bodies()[indexOf(world, id)].pose.position.z() < world.bodies()[indexOf(world, lowest)].pose.position.z()) lowest = id;
   }
-  const std::size_t before = world.step(kDt, Budget::unlimited()).sleeping;
+  const std::size_t before = world.step(kDt, Budget::unlimited()).bodies.sleeping;
   ASSERT_TRUE(world.removeEntity(lowest));
   std::size_t awake = 0;
   for (EntityId id : pile.spec.movers) awake += id != lowest && !world.isSleeping(id) ? 1 : 0;
   EXPECT_GT(awake, 0u);
-  EXPECT_LT(world.step(kDt, Budget::unlimited()).sleeping, before - 1);
+  EXPECT_LT(world.step(kDt, Budget::unlimited()).bodies.sleeping, before - 1);
 }
 
 TEST(Sleeping, ChangeOfGravityWakesAllAndBadGravityChangesNothing) {
@@ -266,7 +267,7 @@ TEST(Sleeping, SleeperEditedToANonFiniteStateIsQuarantinedBeforeItTouchesAnythin
   const EntityId id = pile.spec.movers.front();
   world.bodies()[indexOf(world, id)].linear_velocity.x() = std::numeric_limits<double>::quiet_NaN();
   const TickReport report = world.step(kDt, Budget::unlimited());
-  EXPECT_EQ(report.quarantined, 1u);
+  EXPECT_EQ(report.bodies.quarantined, 1u);
   EXPECT_FALSE(world.indexOf(id).has_value());
   for (const BodyState& body : world.bodies()) {
     ASSERT_TRUE(body.pose.position.allFinite() && body.linear_velocity.allFinite());
@@ -301,7 +302,8 @@ TEST(Sleeping, WokenPileStartsFromTheImpulsesItFellAsleepWith) {
 
 // Work a tick does, counted: pair tests set up, sphere tests run, contacts solved.
 double workOf(const World& world, const TickReport& r) {
-  return static_cast<double>(world.pairCount()) + static_cast<double>(r.sphere_tests) + static_cast<double>(r.contacts);
+  return static_cast<double>(world.pairCount()) + static_cast<double>(r.detection.sphere_tests) +
+         static_cast<double>(r.response.contacts);
 }
 
 TEST(Sleeping, RockPileSettlesSleepsWholeAndThenCostsAlmostNothing) {
@@ -319,7 +321,7 @@ TEST(Sleeping, RockPileSettlesSleepsWholeAndThenCostsAlmostNothing) {
   int asleep_at = -1;
   for (int t = 1; t <= 1800 && asleep_at < 0; ++t) {  // 30 s
     const TickReport r = world.step(kDt, Budget::unlimited());
-    if (r.sleeping == spec.movers.size()) {
+    if (r.bodies.sleeping == spec.movers.size()) {
       asleep_at = t;
       break;
     }
@@ -344,7 +346,7 @@ TEST(Sleeping, RockPileSettlesSleepsWholeAndThenCostsAlmostNothing) {
   for (const BodyState& b : world.bodies()) poses.push_back(b.pose);
   for (int t = 0; t < 60; ++t) {
     const TickReport r = world.step(kDt, Budget::unlimited());
-    EXPECT_EQ(r.sleeping, spec.movers.size());
+    EXPECT_EQ(r.bodies.sleeping, spec.movers.size());
     EXPECT_LE(workOf(world, r), 0.01 * awake_work);
   }
   for (std::size_t i = 0; i < poses.size(); ++i) {
@@ -387,7 +389,7 @@ TEST(Sleeping, PileUnderASphereTestBudgetHoldsTogetherAndStartsToSleep) {
       for (EntityId id : spec.movers) second_before_end.push_back(world.bodies()[*world.indexOf(id)].pose.position);
     }
     world.perception().setFixation(gaze.fixationAt(t * kDt, world));
-    unresolved += world.step(kDt, budget).unresolved_accepted;
+    unresolved += world.step(kDt, budget).detection.unresolved_accepted;
   }
   EXPECT_GT(unresolved, 100u * kTicks) << "the budget leaves pairs unresolved";
   std::size_t moving = 0, asleep = 0;
@@ -410,7 +412,8 @@ TEST(Sleeping, BigPileThatAFewRocksKeepAwakeSleepsAlmostWholeAndStaysPut) {
   auto [world, spec] = makeSceneWorld(SceneKind::Rockfall, params);
   const std::size_t most = spec.movers.size() * 95 / 100;
   std::size_t asleep = 0;
-  for (int t = 0; t < 1500 && asleep < most; ++t) asleep = world.step(kDt, Budget::unlimited()).sleeping;  // 25 s
+  for (int t = 0; t < 1500 && asleep < most; ++t)
+    asleep = world.step(kDt, Budget::unlimited()).bodies.sleeping;  // 25 s
   ASSERT_GE(asleep, most);
   // It stays put: a second later the rocks asleep now are where they were
   // (awake or not: a woken one settles again, at most a few of them, one in
@@ -424,7 +427,8 @@ TEST(Sleeping, BigPileThatAFewRocksKeepAwakeSleepsAlmostWholeAndStaysPut) {
   }
   const double energy = totalEnergy(world.bodies(), spec.gravity, kDt);
   std::size_t fewest_asleep = asleep;
-  for (int t = 0; t < 60; ++t) fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).sleeping);
+  for (int t = 0; t < 60; ++t)
+    fewest_asleep = std::min(fewest_asleep, world.step(kDt, Budget::unlimited()).bodies.sleeping);
   EXPECT_GE(fewest_asleep, spec.movers.size() * 90 / 100);
   double moved = 0.0;
   std::size_t slipped = 0;  // moved more than 1 cm

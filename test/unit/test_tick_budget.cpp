@@ -169,13 +169,13 @@ TEST(TickBudget, BudgetsThatAreNeverReachedChangeNothing) {
   for (int i = 0; i < 60; ++i) {
     const TickReport a = unlimited.step(kDt, Budget::unlimited());
     const TickReport b = roomy.step(kDt, far);
-    if (a.contacts > 0) {
+    if (a.response.contacts > 0) {
       contacts = true;
-      EXPECT_EQ(a.velocity_passes, ResponseOptions{}.iterations);
-      EXPECT_EQ(b.velocity_passes, a.velocity_passes);
-      EXPECT_EQ(b.position_passes, a.position_passes);
+      EXPECT_EQ(a.response.velocity_passes, ResponseOptions{}.iterations);
+      EXPECT_EQ(b.response.velocity_passes, a.response.velocity_passes);
+      EXPECT_EQ(b.response.position_passes, a.response.position_passes);
     }
-    EXPECT_FALSE(b.interrupted);
+    EXPECT_FALSE(b.detection.interrupted);
   }
   ASSERT_TRUE(contacts);
   for (std::size_t i = 0; i < unlimited.bodies().size(); ++i) {  // bit for bit
@@ -192,24 +192,27 @@ TEST(TickBudget, NarrowPhaseGetsWhatTheFixedPhasesAndTheReserveLeave) {
   bool interrupted_with_time = false;
   for (int i = 0; i < 30; ++i) {
     const TickReport r = w.step(kDt, Budget::ofTickSeconds(tick));
-    EXPECT_EQ(r.tick_budget_s, tick);
-    EXPECT_GE(r.reserve_s, 0.0);
-    EXPECT_NEAR(r.narrow_budget_s, std::max(0.0, tick - r.integrate_s - r.broad_s - r.sweep_s - r.reserve_s), 1e-12);
-    EXPECT_NEAR(r.response_budget_s,
-                std::max(0.0, tick - r.integrate_s - r.broad_s - r.sweep_s - r.narrow_s), 1e-12);
-    if (i == 0) EXPECT_GT(r.reserve_s, 0.0);  // measured by the unlimited ticks before
-    if (r.interrupted && r.narrow_budget_s > 0.0) {
+    EXPECT_EQ(r.budget.tick_budget_s, tick);
+    EXPECT_GE(r.budget.reserve_s, 0.0);
+    EXPECT_NEAR(r.budget.narrow_budget_s,
+                std::max(0.0, tick - r.phases.integrate_s - r.phases.broad_s - r.phases.sweep_s - r.budget.reserve_s),
+                1e-12);
+    EXPECT_NEAR(r.budget.response_budget_s,
+                std::max(0.0, tick - r.phases.integrate_s - r.phases.broad_s - r.phases.sweep_s - r.phases.narrow_s),
+                1e-12);
+    if (i == 0) EXPECT_GT(r.budget.reserve_s, 0.0);  // measured by the unlimited ticks before
+    if (r.detection.interrupted && r.budget.narrow_budget_s > 0.0) {
       interrupted_with_time = true;
-      EXPECT_GT(r.sphere_tests, 0);
+      EXPECT_GT(r.detection.sphere_tests, 0);
     }
-    EXPECT_GE(r.velocity_passes, 1);
+    EXPECT_GE(r.response.velocity_passes, 1);
   }
   EXPECT_TRUE(interrupted_with_time);
 
   // A narrow-phase limit of its own still applies when it is the smaller.
   Budget both = Budget::ofTickSeconds(tick);
   both.seconds = 1e-4;
-  EXPECT_NEAR(w.step(kDt, both).narrow_budget_s, 1e-4, 1e-15);
+  EXPECT_NEAR(w.step(kDt, both).budget.narrow_budget_s, 1e-4, 1e-15);
 }
 
 // A clock whose read costs real time (a thread CPU clock is a system call,
@@ -238,12 +241,12 @@ TEST(TickBudget, ACostlyClockIsReadOncePerManySphereTests) {
     // Every read is kStep of fake time: the narrow phase's reads, less its
     // stamps and the read that saw the deadline, came one per 320 sphere
     // tests or fewer (with a cheap clock, one per 32).
-    const auto narrow_reads = static_cast<std::int64_t>(std::lround(r.narrow_s / kStep));
-    EXPECT_GE(r.sphere_tests, 10 * BudgetTracker::kDefaultCheckEvery * (narrow_reads - 3)) << "tick " << i;
+    const auto narrow_reads = static_cast<std::int64_t>(std::lround(r.phases.narrow_s / kStep));
+    EXPECT_GE(r.detection.sphere_tests, 10 * BudgetTracker::kDefaultCheckEvery * (narrow_reads - 3)) << "tick " << i;
     // Ended by the first read past the deadline; two stamps follow it
     // (scheduling done, and the phase's end).
-    EXPECT_LE(r.narrow_s, r.narrow_budget_s + 3 * kStep + 1e-12) << "tick " << i;
-    interrupted = interrupted || r.interrupted;
+    EXPECT_LE(r.phases.narrow_s, r.budget.narrow_budget_s + 3 * kStep + 1e-12) << "tick " << i;
+    interrupted = interrupted || r.detection.interrupted;
   }
   EXPECT_TRUE(interrupted) << "the deadline, not the pairs running out, ended the narrow phase";
 }
@@ -254,9 +257,9 @@ TEST(TickBudget, ResponseTimeIsBuildingTheContactsAndTheSolve) {
   World w = pile(60);
   for (int i = 0; i < 3; ++i) {
     const TickReport r = w.step(kDt, Budget::unlimited());
-    ASSERT_GT(r.contacts, 0u);
-    EXPECT_GT(r.contacts_s, 0.0);
-    EXPECT_LT(r.contacts_s, r.response_s) << "the solve after it is timed in response_s too";
+    ASSERT_GT(r.response.contacts, 0u);
+    EXPECT_GT(r.phases.contacts_s, 0.0);
+    EXPECT_LT(r.phases.contacts_s, r.phases.response_s) << "the solve after it is timed in response_s too";
   }
 }
 
@@ -266,9 +269,9 @@ TEST(TickBudget, SpentTickStillRespondsAndStaysFiniteAndInTheBox) {
   auto [w, spec] = corner125();
   for (int i = 0; i < 240; ++i) {
     const TickReport r = w.step(kDt, Budget::ofTickSeconds(0.0));
-    ASSERT_EQ(r.narrow_budget_s, 0.0);
-    ASSERT_EQ(r.sphere_tests, 0);
-    if (r.contacts > 0) ASSERT_EQ(r.velocity_passes, 1);
+    ASSERT_EQ(r.budget.narrow_budget_s, 0.0);
+    ASSERT_EQ(r.detection.sphere_tests, 0);
+    if (r.response.contacts > 0) ASSERT_EQ(r.response.velocity_passes, 1);
   }
   const Vec3 margin = Vec3::Constant(0.5 * SceneParams{}.entity_size);
   for (const EntityId id : spec.movers) {

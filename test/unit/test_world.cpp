@@ -226,8 +226,8 @@ TEST(World, RemoveSwapsTheLastIntoTheHoleAndClearKeepsShapes) {
   const EntityId d = w.addEntity(specAt(cube, Vec3::Zero(), "a"));
   EXPECT_GT(d, b2);
   const TickReport r = w.step(0.01, Budget::unlimited());
-  EXPECT_EQ(r.entities, 1u);
-  EXPECT_EQ(r.broad_pairs, 0u);
+  EXPECT_EQ(r.bodies.entities, 1u);
+  EXPECT_EQ(r.detection.broad_pairs, 0u);
 }
 
 // The broad phase's pairs keep their dense indices from tick to tick
@@ -438,9 +438,10 @@ std::set<std::pair<EntityId, EntityId>> pairsThatShouldTouch(const World& w, boo
 }
 
 void expectCountsAddUp(const TickReport& r, std::size_t static_pairs) {
-  EXPECT_EQ(r.colliding + r.separate + r.unresolved, r.broad_pairs - static_pairs);
-  EXPECT_LE(r.unresolved_accepted, r.unresolved);
-  EXPECT_GE(r.total_s, r.narrow_s);
+  EXPECT_EQ(r.detection.colliding + r.detection.separate + r.detection.unresolved,
+            r.detection.broad_pairs - static_pairs);
+  EXPECT_LE(r.detection.unresolved_accepted, r.detection.unresolved);
+  EXPECT_GE(r.phases.total_s, r.phases.narrow_s);
 }
 
 TEST(World, ZeroBudgetAcceptsEveryPairUnresolved) {
@@ -448,21 +449,21 @@ TEST(World, ZeroBudgetAcceptsEveryPairUnresolved) {
   const std::size_t static_pairs = staticStaticPairs(w);
   ASSERT_GT(static_pairs, 0u);
   const TickReport r = w.step(0.01, Budget::ofSphereTests(0));
-  ASSERT_GT(r.broad_pairs, static_pairs);
+  ASSERT_GT(r.detection.broad_pairs, static_pairs);
   expectCountsAddUp(r, static_pairs);
-  EXPECT_EQ(r.sphere_tests, 0);
-  EXPECT_TRUE(r.interrupted);
-  EXPECT_EQ(r.unresolved, r.broad_pairs - static_pairs);
-  EXPECT_EQ(r.unresolved_accepted, r.unresolved);
-  EXPECT_EQ(r.contacts, w.contacts().size());
+  EXPECT_EQ(r.detection.sphere_tests, 0);
+  EXPECT_TRUE(r.detection.interrupted);
+  EXPECT_EQ(r.detection.unresolved, r.detection.broad_pairs - static_pairs);
+  EXPECT_EQ(r.detection.unresolved_accepted, r.detection.unresolved);
+  EXPECT_EQ(r.response.contacts, w.contacts().size());
   EXPECT_EQ(pairsWithContacts(w), pairsThatShouldTouch(w, true));
-  EXPECT_EQ(pairsWithContacts(w).size(), r.unresolved);
-  EXPECT_EQ(w.pairCount(), r.unresolved);
-  EXPECT_GT(r.geometric_inaccuracy, 0.0);
+  EXPECT_EQ(pairsWithContacts(w).size(), r.detection.unresolved);
+  EXPECT_EQ(w.pairCount(), r.detection.unresolved);
+  EXPECT_GT(r.accuracy.geometric_inaccuracy, 0.0);
   // Before any test the bound is |cA - cB| + h_A + h_B, never below the estimate.
-  EXPECT_GE(r.geometric_bound, r.geometric_inaccuracy);
-  EXPECT_FALSE(r.perception_used);
-  EXPECT_EQ(r.perceived_inaccuracy, 0.0);
+  EXPECT_GE(r.accuracy.geometric_bound, r.accuracy.geometric_inaccuracy);
+  EXPECT_FALSE(r.accuracy.perception_used);
+  EXPECT_EQ(r.accuracy.perceived_inaccuracy, 0.0);
   for (const Contact& c : w.contacts()) {
     EXPECT_FALSE(c.resolved);
     EXPECT_TRUE(c.normal.allFinite());
@@ -478,11 +479,11 @@ TEST(World, ZeroBudgetRejectsEveryPairUnresolved) {
   const std::size_t static_pairs = staticStaticPairs(w);
   const TickReport r = w.step(0.01, Budget::ofSphereTests(0));
   expectCountsAddUp(r, static_pairs);
-  EXPECT_EQ(r.unresolved, r.broad_pairs - static_pairs);
-  EXPECT_EQ(r.unresolved_accepted, 0u);
-  EXPECT_EQ(r.contacts, 0u);
-  EXPECT_EQ(r.geometric_inaccuracy, 0.0);
-  EXPECT_EQ(r.geometric_bound, 0.0);
+  EXPECT_EQ(r.detection.unresolved, r.detection.broad_pairs - static_pairs);
+  EXPECT_EQ(r.detection.unresolved_accepted, 0u);
+  EXPECT_EQ(r.response.contacts, 0u);
+  EXPECT_EQ(r.accuracy.geometric_inaccuracy, 0.0);
+  EXPECT_EQ(r.accuracy.geometric_bound, 0.0);
 }
 
 TEST(World, UnlimitedBudgetResolvesEveryPair) {
@@ -491,16 +492,16 @@ TEST(World, UnlimitedBudgetResolvesEveryPair) {
   for (int tick = 0; tick < 3; ++tick) {
     const TickReport r = w.step(0.01, Budget::unlimited());
     expectCountsAddUp(r, static_pairs);
-    EXPECT_EQ(r.unresolved, 0u);
-    EXPECT_FALSE(r.interrupted);
-    EXPECT_GT(r.colliding, 0u);
-    EXPECT_GT(r.separate, 0u);
+    EXPECT_EQ(r.detection.unresolved, 0u);
+    EXPECT_FALSE(r.detection.interrupted);
+    EXPECT_GT(r.detection.colliding, 0u);
+    EXPECT_GT(r.detection.separate, 0u);
     EXPECT_EQ(pairsWithContacts(w), pairsThatShouldTouch(w, true));
-    EXPECT_EQ(pairsWithContacts(w).size(), r.colliding);
-    EXPECT_EQ(r.geometric_inaccuracy, 0.0);
+    EXPECT_EQ(pairsWithContacts(w).size(), r.detection.colliding);
+    EXPECT_EQ(r.accuracy.geometric_inaccuracy, 0.0);
     std::int64_t tests = 0;
     for (std::size_t i = 0; i < w.pairCount(); ++i) tests += w.pairTests()[i].sphereTests();
-    EXPECT_EQ(r.sphere_tests, tests);
+    EXPECT_EQ(r.detection.sphere_tests, tests);
     for (const Contact& c : w.contacts()) {
       EXPECT_TRUE(c.resolved);
       const int levels = std::max(w.shape(w.bodyShapes()[c.index_a]).tree.levelCount(),
@@ -514,17 +515,17 @@ TEST(World, PartialBudgetSplitsPairsAndStaysWithinTheCount) {
   World w = packedWorld(4, UnresolvedPolicy::Accept);
   const std::size_t static_pairs = staticStaticPairs(w);
   const TickReport full = World(packedWorld(4, UnresolvedPolicy::Accept)).step(0.01, Budget::unlimited());
-  const std::int64_t budget = full.sphere_tests / 3;
+  const std::int64_t budget = full.detection.sphere_tests / 3;
   const TickReport r = w.step(0.01, Budget::ofSphereTests(budget));
   expectCountsAddUp(r, static_pairs);
-  EXPECT_TRUE(r.interrupted);
-  EXPECT_GT(r.unresolved, 0u);
-  EXPECT_EQ(r.unresolved_accepted, r.unresolved);
+  EXPECT_TRUE(r.detection.interrupted);
+  EXPECT_GT(r.detection.unresolved, 0u);
+  EXPECT_EQ(r.detection.unresolved_accepted, r.detection.unresolved);
   EXPECT_EQ(pairsWithContacts(w), pairsThatShouldTouch(w, true));
-  EXPECT_EQ(pairsWithContacts(w).size(), r.colliding + r.unresolved);
-  EXPECT_GE(r.geometric_bound, 0.0);
+  EXPECT_EQ(pairsWithContacts(w).size(), r.detection.colliding + r.detection.unresolved);
+  EXPECT_GE(r.accuracy.geometric_bound, 0.0);
   // The budget is checked before each step: at most one step past it.
-  EXPECT_GE(r.sphere_tests, budget);
+  EXPECT_GE(r.detection.sphere_tests, budget);
 }
 
 TEST(World, ContactFollowsTheLineOfCentresFromAToB) {
@@ -533,7 +534,7 @@ TEST(World, ContactFollowsTheLineOfCentresFromAToB) {
   const EntityId a = w.addEntity(specAt(cube, Vec3(0, 0, 0)));
   const EntityId b = w.addEntity(specAt(cube, Vec3(0.39, 0, 0)));  // 1 cm overlap along x
   const TickReport r = w.step(0.0, Budget::unlimited());
-  ASSERT_EQ(r.colliding, 1u);
+  ASSERT_EQ(r.detection.colliding, 1u);
   ASSERT_GE(w.contacts().size(), 1u);
   const Contact& c = w.contacts()[0];
   EXPECT_EQ(c.a, a);
@@ -571,12 +572,12 @@ TEST(World, PerceivedInaccuracyOnlyWithAFixation) {
   cam.camera_to_world.position = Vec3(0.4, -3.0, 0.4);
   w.perception().setCamera(cam);
   TickReport r0 = w.step(0.0, Budget::ofSphereTests(0));
-  EXPECT_FALSE(r0.perception_used);
-  EXPECT_EQ(r0.perceived_inaccuracy, 0.0);
+  EXPECT_FALSE(r0.accuracy.perception_used);
+  EXPECT_EQ(r0.accuracy.perceived_inaccuracy, 0.0);
   w.perception().setFixation(Vec2(cam.width / 2.0, cam.height / 2.0));
   const TickReport r1 = w.step(0.0, Budget::ofSphereTests(0));
-  EXPECT_TRUE(r1.perception_used);
-  EXPECT_GT(r1.perceived_inaccuracy, 0.0);
+  EXPECT_TRUE(r1.accuracy.perception_used);
+  EXPECT_GT(r1.accuracy.perceived_inaccuracy, 0.0);
   // P is the sum of f(e, g) over the accepted pairs; contacts carry their pair's f.
   double sum = 0.0;
   std::map<std::pair<EntityId, EntityId>, double> priority;
@@ -585,7 +586,7 @@ TEST(World, PerceivedInaccuracyOnlyWithAFixation) {
     priority[{t.bodyA().id, t.bodyB().id}] = w.perception().measure(t).priority;
     sum += priority[{t.bodyA().id, t.bodyB().id}];
   }
-  EXPECT_NEAR(sum, r1.perceived_inaccuracy, 1e-9 * sum);
+  EXPECT_NEAR(sum, r1.accuracy.perceived_inaccuracy, 1e-9 * sum);
   ASSERT_FALSE(w.contacts().empty());
   for (const Contact& c : w.contacts()) EXPECT_DOUBLE_EQ(c.priority, (priority[{c.a, c.b}]));
 }
@@ -599,7 +600,7 @@ TEST(World, AutoBoxModeUsesDynamicBoxesForElongatedShapes) {
   w.addEntity(s);
   s.pose.position = Vec3(0, 0.3, 0);
   w.addEntity(s);
-  EXPECT_EQ(w.step(0.0, Budget::unlimited()).broad_pairs, 0u);
+  EXPECT_EQ(w.step(0.0, Budget::unlimited()).detection.broad_pairs, 0u);
   World fixed;
   const ShapeId rod2 = addPreset(fixed, "rod");
   s.shape = rod2;
@@ -608,7 +609,7 @@ TEST(World, AutoBoxModeUsesDynamicBoxesForElongatedShapes) {
   fixed.addEntity(s);
   s.pose.position = Vec3(0, 0.3, 0);
   fixed.addEntity(s);
-  EXPECT_EQ(fixed.step(0.0, Budget::unlimited()).broad_pairs, 1u);
+  EXPECT_EQ(fixed.step(0.0, Budget::unlimited()).detection.broad_pairs, 1u);
 }
 
 }  // namespace

@@ -88,9 +88,9 @@ TickTotals countAllocations(World& w, const Budget& budget, int warm_ticks, int 
     }
     const TickReport r = w.step(0.01, budget);
     if (run) {
-      run->broad_pairs += r.broad_pairs;
-      run->unresolved += r.unresolved;
-      run->colliding += r.colliding;
+      run->broad_pairs += r.detection.broad_pairs;
+      run->unresolved += r.detection.unresolved;
+      run->colliding += r.detection.colliding;
     }
   };
   TickTotals run;
@@ -201,11 +201,11 @@ TEST(WorldAllocations, AFormingPileAllocatesInFewTicks) {
     g_counting = true;
     const TickReport r = scene.world.step(scene.spec.dt, Budget::unlimited());
     g_counting = false;
-    if (t < 30 || r.contacts <= high) {  // the first ticks: every pool's first growth
-      high = std::max(high, r.contacts);
+    if (t < 30 || r.response.contacts <= high) {  // the first ticks: every pool's first growth
+      high = std::max(high, r.response.contacts);
       continue;
     }
-    high = r.contacts;
+    high = r.response.contacts;
     ++new_highs;
     allocating += g_allocations > 0 ? 1 : 0;
   }
@@ -241,8 +241,8 @@ TEST(WorldAllocations, ReusedContactsDoNotAllocate) {
     for (int t = 0; t < 60; ++t) {
       if (t % 10 == 0) scene.world.bodies()[top].angular_velocity = Vec3(0.0, 0.0, 2.0);
       const TickReport r = scene.world.step(scene.spec.dt, Budget::unlimited());
-      reused += r.reused;
-      colliding += r.colliding;
+      reused += r.detection.reused;
+      colliding += r.detection.colliding;
     }
     g_counting = false;
     EXPECT_EQ(g_allocations, 0) << threads << " threads";

@@ -12,47 +12,47 @@
 #include <cstdint>
 
 // X(field, value from r): in TickStats.msg's order.
-#define STC_TICK_REPORT_FIELDS(X)                                                                       \
-  X(integrate_ms, (r.integrate_s + r.sweep_s) * 1e3) /* the swept test runs after the broad phase */     \
-  X(sweep_ms, r.sweep_s * 1e3)                                                                           \
-  X(broad_ms, r.broad_s * 1e3)                                                                           \
-  X(narrow_ms, r.narrow_s * 1e3)                                                                         \
-  X(response_ms, r.response_s * 1e3)                                                                     \
-  X(contacts_ms, r.contacts_s * 1e3)                                                                     \
-  X(total_ms, r.total_s * 1e3)                                                                           \
-  X(scheduling_overhead_ms, r.scheduling_overhead_s * 1e3)                                               \
-  X(perception_used, r.perception_used)                                                                  \
-  X(entities, r.entities)                                                                                \
-  X(broad_pairs, r.broad_pairs)                                                                          \
-  X(colliding, r.colliding)                                                                              \
-  X(reused, r.reused)                                                                                    \
-  X(separate, r.separate)                                                                                \
-  X(unresolved, r.unresolved)                                                                            \
-  X(unresolved_accepted, r.unresolved_accepted)                                                          \
-  X(frontier_kept, r.frontier_kept)                                                                      \
-  X(sphere_tests, r.sphere_tests)                                                                        \
-  X(interrupted, r.interrupted)                                                                          \
-  X(geometric_inaccuracy, r.geometric_inaccuracy)                                                        \
-  X(geometric_bound, r.geometric_bound)                                                                  \
-  X(perceived_inaccuracy, r.perceived_inaccuracy)                                                        \
-  X(contacts, r.contacts)                                                                                \
-  X(tick_budget_ms, r.tick_budget_s * 1e3)                                                               \
-  X(narrow_budget_ms, r.narrow_budget_s * 1e3)                                                           \
-  X(response_budget_ms, r.response_budget_s * 1e3)                                                       \
-  X(reserve_ms, r.reserve_s * 1e3)                                                                       \
-  X(velocity_passes, r.velocity_passes)                                                                  \
-  X(position_passes, r.position_passes)                                                                  \
-  X(quarantined, r.quarantined)                                                                          \
-  X(left_world, r.left_world)                                                                            \
-  X(sleeping, r.sleeping)                                                                                \
-  X(fractures, r.fractures)                                                                              \
-  X(fractures_waiting, r.fractures_deferred)                                                             \
-  X(piece_trees, r.piece_trees)                                                                          \
-  X(fracture_ms, r.fracture_s * 1e3)                                                                     \
-  X(islands_full, r.levels.islands_full)                                                                 \
-  X(islands_held, r.levels.islands_held)                                                                 \
-  X(bodies_held, r.levels.bodies_held)                                                                   \
-  X(islands_joined, r.levels.islands_joined)
+#define STC_TICK_REPORT_FIELDS(X)                                                                                  \
+  X(integrate_ms, (r.phases.integrate_s + r.phases.sweep_s) * 1e3) /* the swept test runs after the broad phase */ \
+  X(sweep_ms, r.phases.sweep_s * 1e3)                                                                              \
+  X(broad_ms, r.phases.broad_s * 1e3)                                                                              \
+  X(narrow_ms, r.phases.narrow_s * 1e3)                                                                            \
+  X(response_ms, r.phases.response_s * 1e3)                                                                        \
+  X(contacts_ms, r.phases.contacts_s * 1e3)                                                                        \
+  X(total_ms, r.phases.total_s * 1e3)                                                                              \
+  X(scheduling_overhead_ms, r.detection.scheduling_overhead_s * 1e3)                                               \
+  X(perception_used, r.accuracy.perception_used)                                                                   \
+  X(entities, r.bodies.entities)                                                                                   \
+  X(broad_pairs, r.detection.broad_pairs)                                                                          \
+  X(colliding, r.detection.colliding)                                                                              \
+  X(reused, r.detection.reused)                                                                                    \
+  X(separate, r.detection.separate)                                                                                \
+  X(unresolved, r.detection.unresolved)                                                                            \
+  X(unresolved_accepted, r.detection.unresolved_accepted)                                                          \
+  X(frontier_kept, r.response.frontier_kept)                                                                       \
+  X(sphere_tests, r.detection.sphere_tests)                                                                        \
+  X(interrupted, r.detection.interrupted)                                                                          \
+  X(geometric_inaccuracy, r.accuracy.geometric_inaccuracy)                                                         \
+  X(geometric_bound, r.accuracy.geometric_bound)                                                                   \
+  X(perceived_inaccuracy, r.accuracy.perceived_inaccuracy)                                                         \
+  X(contacts, r.response.contacts)                                                                                 \
+  X(tick_budget_ms, r.budget.tick_budget_s * 1e3)                                                                  \
+  X(narrow_budget_ms, r.budget.narrow_budget_s * 1e3)                                                              \
+  X(response_budget_ms, r.budget.response_budget_s * 1e3)                                                          \
+  X(reserve_ms, r.budget.reserve_s * 1e3)                                                                          \
+  X(velocity_passes, r.response.velocity_passes)                                                                   \
+  X(position_passes, r.response.position_passes)                                                                   \
+  X(quarantined, r.bodies.quarantined)                                                                             \
+  X(left_world, r.bodies.left_world)                                                                               \
+  X(sleeping, r.bodies.sleeping)                                                                                   \
+  X(fractures, r.fracture.fractures)                                                                               \
+  X(fractures_waiting, r.fracture.fractures_deferred)                                                              \
+  X(piece_trees, r.fracture.piece_trees)                                                                           \
+  X(fracture_ms, r.fracture.fracture_s * 1e3)                                                                      \
+  X(islands_full, r.response.levels.islands_full)                                                                  \
+  X(islands_held, r.response.levels.islands_held)                                                                  \
+  X(bodies_held, r.response.levels.bodies_held)                                                                    \
+  X(islands_joined, r.response.levels.islands_joined)
 
 namespace stc_ros {
 
