@@ -261,9 +261,9 @@ TEST(SavedWorld, ASleepingWorldLoadsAsleepAndStaysTheSame) {
     for (const BodyState& body : world.bodies()) movable += body.is_static ? 0 : 1;
     for (int t = 0; t < 1800; ++t) {
       const TickReport r = world.step(1.0 / 60.0, Budget::unlimited());
-      if (r.sleeping == movable) break;
+      if (r.bodies.sleeping == movable) break;
     }
-    ASSERT_EQ(world.step(1.0 / 60.0, Budget::unlimited()).sleeping, movable) << "the pile never slept";
+    ASSERT_EQ(world.step(1.0 / 60.0, Budget::unlimited()).bodies.sleeping, movable) << "the pile never slept";
     const std::string yaml = writeSceneYaml(world);
     EXPECT_NE(yaml.find("sleep: 1"), std::string::npos);
     World loaded = loadSaved(yaml, meshConfig(threads));
@@ -273,7 +273,7 @@ TEST(SavedWorld, ASleepingWorldLoadsAsleepAndStaysTheSame) {
       EXPECT_EQ(loaded.isSleeping(loaded.entityIds()[i]), world.isSleeping(world.entityIds()[i])) << i;
     }
     EXPECT_EQ(firstDifferentTick(world, loaded, 1.0 / 60.0, 300), -1) << threads << " threads";
-    EXPECT_EQ(loaded.step(1.0 / 60.0, Budget::unlimited()).sleeping, movable);
+    EXPECT_EQ(loaded.step(1.0 / 60.0, Budget::unlimited()).bodies.sleeping, movable);
     // A group wakes whole, as it would have: wake one of its bodies.
     const std::uint32_t group = loaded.sleepGroup(1);
     ASSERT_NE(group, 0u);
