@@ -64,7 +64,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   const stc::TickReport report = world.step(0.0, stc::Budget::ofSphereTests(in.ConsumeIntegralInRange<int>(0, 5000)));
   stc_fuzz::checkWorldAfterStep(world, report);
-  stc_fuzz::require(std::isfinite(report.perceived_inaccuracy) && std::isfinite(report.geometric_inaccuracy),
+  stc_fuzz::require(std::isfinite(report.accuracy.perceived_inaccuracy) && std::isfinite(report.accuracy.geometric_inaccuracy),
                     "non-finite inaccuracy");
   for (const stc::Contact& c : world.contacts()) stc_fuzz::require(std::isfinite(c.priority), "non-finite priority");
   return 0;

@@ -74,7 +74,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                                                     : stc::Budget::ofSphereTests(in.ConsumeIntegralInRange<int>(0, 3000));
         const stc::TickReport report = world.step(dt, budget);
         expected -= world.quarantined().size();
-        stc_fuzz::require(report.quarantined + report.left_world == world.quarantined().size(),
+        stc_fuzz::require(report.bodies.quarantined + report.bodies.left_world == world.quarantined().size(),
                           "quarantine counts differ from the list");
         stc_fuzz::require(world.entityCount() == expected, "entity count differs from spawns - removals");
         stc_fuzz::checkWorldAfterStep(world, report);

@@ -77,7 +77,7 @@ inline void checkWorldAfterStep(const stc::World& world, const stc::TickReport& 
   for (const stc::Contact& c : world.contacts()) {
     require(c.point.allFinite() && c.normal.allFinite() && std::isfinite(c.depth), "non-finite contact");
   }
-  require(report.entities == world.entityCount(), "report.entities differs from entityCount()");
+  require(report.bodies.entities == world.entityCount(), "report.bodies.entities differs from entityCount()");
 
   std::set<stc::EntityId> removed;
   for (const stc::QuarantinedEntity& q : world.quarantined()) {
