@@ -74,6 +74,23 @@ void validateScale(const Vec3& scale) {
 // - a <p> (a primitive's indices) holding anything but integers: assimp's
 //   reader does not move past a character it cannot read and appends an index
 //   for ever (fuzz_mesh found it: the node would hang, its memory growing).
+// An OBJ's `mtllib` lines made comments: assimp is given no file system, so a
+// material library is never read, and its OBJ reader, after an unread
+// `mtllib`, writes through a null material at a texture statement (`map_Kd`,
+// `bump`): fuzz_mesh found it, a crash of the node. Only geometry is used.
+std::string withoutMaterialLibraries(std::string_view obj) {
+  std::string text(obj);
+  std::size_t line = 0;
+  while (line < text.size()) {
+    std::size_t first = text.find_first_not_of(" \t", line);
+    if (first != std::string::npos && text.compare(first, 6, "mtllib") == 0) text[first] = '#';
+    const std::size_t end = text.find('\n', line);
+    if (end == std::string::npos) break;
+    line = end + 1;
+  }
+  return text;
+}
+
 void refuseWhatAssimpMishandles(std::string_view dae, const std::string& source) {
   if (dae.find("instance_node") != std::string_view::npos) {
     throw InputError("mesh_resource", source + ": <instance_node> is not read (assimp copies instanced nodes "
@@ -278,6 +295,11 @@ TriangleMesh parseTriangleMesh(const void* bytes, std::size_t size, const std::s
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, !to_z_up);
   // No welding or normal fixing: the voxeliser copes with duplicated vertices
   // and reports them. Node transforms are applied by SceneFlattener.
+  std::string obj;
+  if (format == "obj") {
+    obj = withoutMaterialLibraries(std::string_view(static_cast<const char*>(bytes), size));
+    bytes = obj.data();
+  }
   const aiScene* scene = importer.ReadFileFromMemory(bytes, size, aiProcess_Triangulate, format.c_str());
   if (scene == nullptr) {
     throw InputError("mesh_resource", source + ": cannot be read: " + importer.GetErrorString());

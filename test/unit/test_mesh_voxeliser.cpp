@@ -379,6 +379,17 @@ TEST_F(MeshFiles, AnObjMaterialLibraryIsNotOpened) {
   ::close(watch);
 }
 
+// assimp's OBJ reader wrote through a null material at a texture statement
+// after an unread `mtllib` (fuzz_mesh found it; seed obj_mtllib_then_texture_crash):
+// the mtllib lines are comments to it now, and the geometry loads.
+TEST(MeshBytes, AnObjTextureAfterAnUnreadMaterialLibraryLoadsItsGeometry) {
+  for (const std::string texture : {"map_Kd red.png", "bump b.png", "map_Kds off"}) {
+    const std::string obj = "mtllib cube.mtl\n  mtllib other.mtl\n" + texture +
+                            "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    EXPECT_EQ(parseTriangleMesh(obj.data(), obj.size(), "obj", "tetra.obj").triangles.size(), 4u) << texture;
+  }
+}
+
 // What assimp 5.2 mishandles is refused before it sees it. A DAE's <instance_node>: assimp copies the
 // instanced nodes first, so 5 KB nesting ten instances nine deep asked for
 // gigabytes, and a node instancing its own ancestor recursed without end.
