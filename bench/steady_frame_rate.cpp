@@ -29,7 +29,8 @@
 // Usage: bench_steady_frame_rate [--scene all|NAME[:N][,NAME[:N]...]] [--entities N]
 //          [--tick-budget-ms 16.7] [--seconds 60] [--budget-off] [--no-reference] [--wall-clock]
 //          [--trace-escape] [--sphere-tests N] [--solver-iterations N]
-//          [--position-correction F] [--reuse-tolerance T] [--markdown FILE] [--smoke]
+//          [--position-correction F] [--reuse-tolerance T] [--solver sequential|jacobi|soft]
+//          [--markdown FILE] [--smoke]
 //   --scene: a bare NAME picks that scene's default cases (rockfall: 1,000 and 5,000)
 //   --entities N: every chosen scene at N movers instead
 //   --budget-off: the unbudgeted run alone; --no-reference: the budgeted run alone
@@ -105,18 +106,29 @@ struct Run {
 
 constexpr double kMovedMetres = 0.02;
 
-Run simulate(const Case& c, double seconds, const Budget& budget, bool budgeted, double position_correction,
-             double reuse_tolerance, bool wall_clock, bool trace_escape) {
+// What every run of the bench shares, from the command line.
+struct RunSettings {
+  double seconds = 60.0;
+  double position_correction = NAN;  // NaN: the World's default
+  double reuse_tolerance = NAN;      // NaN: the World's default
+  SolverKind solver = ResponseOptions{}.solver;
+  bool wall_clock = false;
+  bool trace_escape = false;
+};
+
+Run simulate(const Case& c, const RunSettings& settings, const Budget& budget, bool budgeted) {
+  const double seconds = settings.seconds;
   WorldConfig config;
   config.scheduler.kind = SchedulerKind::PriorityQueues;
-  if (std::isfinite(position_correction)) config.response.position_correction = position_correction;
-  if (std::isfinite(reuse_tolerance)) config.response.reuse_tolerance = reuse_tolerance;
+  config.response.solver = settings.solver;
+  if (std::isfinite(settings.position_correction)) config.response.position_correction = settings.position_correction;
+  if (std::isfinite(settings.reuse_tolerance)) config.response.reuse_tolerance = settings.reuse_tolerance;
   SceneParams params;
   params.entities = c.bodies;
   SceneWorld scene = makeSceneWorld(c.kind, params, config);
   World& world = scene.world;
   const SceneSpec& spec = scene.spec;
-  if (!wall_clock) world.setClock(threadCpuSeconds);
+  if (!settings.wall_clock) world.setClock(threadCpuSeconds);
   GazeParams gp;
   gp.mode = GazeMode::Saccades;
   gp.seed = 3;
@@ -170,7 +182,7 @@ Run simulate(const Case& c, double seconds, const Budget& budget, bool budgeted,
       run.root_contacts += contact.level == 0 ? 1.0 : 0.0;
     }
     if (i % 600 == 599) std::fprintf(stderr, "  %s: %d / %d ticks\n", run.scene.c_str(), i + 1, ticks);
-    if (trace_escape) {  // every tick a mover is outside: where, how fast, what the tick did
+    if (settings.trace_escape) {  // every tick a mover is outside: where, how fast, what the tick did
       for (EntityId id : spec.movers) {
         const BodyState& b = world.bodies()[*world.indexOf(id)];
         if (!spec.bounds.contains(b.pose.position)) {
@@ -252,12 +264,11 @@ int main(int argc, char** argv) {
   std::string scene = "all";
   int entities = 0;
   double budget_ms = 16.7;
-  double seconds = 60.0;
-  bool budget_off = false, reference = true, wall_clock = false, trace_escape = false, smoke = false;
+  RunSettings settings;
+  double& seconds = settings.seconds;
+  bool budget_off = false, reference = true, smoke = false;
   std::int64_t sphere_tests = std::numeric_limits<std::int64_t>::max();
   int solver_iterations = std::numeric_limits<int>::max();
-  double position_correction = NAN;  // the World's default
-  double reuse_tolerance = NAN;      // the World's default
   bool reuse_set = false;
   std::string markdown;
   std::vector<Case> cases;
@@ -272,19 +283,20 @@ int main(int argc, char** argv) {
       else if (a == "--no-reference") reference = false;
       else if (a == "--sphere-tests") sphere_tests = std::stoll(args.required());
       else if (a == "--solver-iterations") solver_iterations = std::stoi(args.required());
-      else if (a == "--position-correction") position_correction = std::stod(args.required());
+      else if (a == "--position-correction") settings.position_correction = std::stod(args.required());
       else if (a == "--reuse-tolerance") {
-        reuse_tolerance = std::stod(args.required());
+        settings.reuse_tolerance = std::stod(args.required());
         reuse_set = true;
       }
-      else if (a == "--wall-clock") wall_clock = true;
-      else if (a == "--trace-escape") trace_escape = true;
+      else if (a == "--solver") settings.solver = parseSolverKind(args.required());
+      else if (a == "--wall-clock") settings.wall_clock = true;
+      else if (a == "--trace-escape") settings.trace_escape = true;
       else if (a == "--markdown") markdown = args.required();
       else if (a == "--smoke") smoke = true;
       else return args.unknown();
     }
     if (entities < 0) throw InputError("--entities", "must be >= 0 (0: each scene's default cases)");
-    if (reuse_set && !(reuse_tolerance >= 0.0 && reuse_tolerance <= 1.0)) {
+    if (reuse_set && !(settings.reuse_tolerance >= 0.0 && settings.reuse_tolerance <= 1.0)) {
       throw InputError("--reuse-tolerance", "must be in [0, 1]");
     }
     if (budget_off && !reference) throw InputError("--no-reference", "with --budget-off nothing would run");
@@ -313,12 +325,11 @@ int main(int argc, char** argv) {
   for (const Case& c : cases) {
     if (!budget_off) {
       std::fprintf(stderr, "%s %d under the budget: %.0f s simulated ...\n", toString(c.kind), c.bodies, seconds);
-      runs.push_back(simulate(c, seconds, budget, true, position_correction, reuse_tolerance, wall_clock, trace_escape));
+      runs.push_back(simulate(c, settings, budget, true));
     }
     if (reference) {
       std::fprintf(stderr, "%s %d unbudgeted: %.0f s simulated ...\n", toString(c.kind), c.bodies, seconds);
-      runs.push_back(simulate(c, seconds, Budget::unlimited(), false, position_correction, reuse_tolerance,
-                              wall_clock, trace_escape));
+      runs.push_back(simulate(c, settings, Budget::unlimited(), false));
     }
   }
 
@@ -327,7 +338,7 @@ int main(int argc, char** argv) {
   std::snprintf(buf, sizeof buf,
                 "%.0f s at 60 Hz per scene and run; tick budget %.1f ms (%s clock)%s; priority queues, "
                 "saccadic gaze, policy accept. ms as p50 / p99 / max.",
-                seconds, budget_ms, wall_clock ? "steady" : "thread-CPU",
+                seconds, budget_ms, settings.wall_clock ? "steady" : "thread-CPU",
                 budget_off ? ", unbudgeted runs only" : reference ? ", each scene also unbudgeted" : "");
   md += buf;
   if (sphere_tests < std::numeric_limits<std::int64_t>::max()) {
@@ -336,14 +347,15 @@ int main(int argc, char** argv) {
   if (solver_iterations < std::numeric_limits<int>::max()) {
     md += " Solver iterations a budgeted tick: " + std::to_string(solver_iterations) + ".";
   }
-  if (std::isfinite(position_correction)) {
-    std::snprintf(buf, sizeof buf, " Position correction: %.2f.", position_correction);
+  if (std::isfinite(settings.position_correction)) {
+    std::snprintf(buf, sizeof buf, " Position correction: %.2f.", settings.position_correction);
     md += buf;
   }
-  if (std::isfinite(reuse_tolerance)) {
-    std::snprintf(buf, sizeof buf, " Reuse tolerance: %.3g.", reuse_tolerance);
+  if (std::isfinite(settings.reuse_tolerance)) {
+    std::snprintf(buf, sizeof buf, " Reuse tolerance: %.3g.", settings.reuse_tolerance);
     md += buf;
   }
+  if (settings.solver != ResponseOptions{}.solver) md += std::string(" Solver: ") + toString(settings.solver) + ".";
   md += "\n\n";
   md += "| scene | bodies | run | whole tick CPU | whole tick wall | p99 CPU / budget | ticks > 1.1 budget "
         "| CPU less integrate | integrate | broad | narrow "

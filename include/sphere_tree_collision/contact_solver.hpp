@@ -93,9 +93,24 @@ class ContactSolver {
   // poses (anchors fixed in the bodies). Restitution comes first, as the
   // default's waves. Stores the velocities and the poses; the contacts get
   // the tick's impulses; the warm start keeps the last substep's.
+  // A body in `start.held` (the swept test put it back at its first hit)
+  // goes no further along its path from the start than the hit in any
+  // substep, and keeps no speed onward along it there: the substeps would
+  // otherwise move it through what it hit, as the swept test's discrete step
+  // was stopped from doing.
+  // Refineable by `budget`: the first substep is timed and prices the rest;
+  // those that do not fit before the deadline merge into fewer, longer ones
+  // (softer contacts, the same tick), one alone once the deadline has passed;
+  // budget.max_iterations caps the substeps.
+  struct TickStart {
+    const std::vector<Pose>* poses = nullptr;  // per body, the tick's start
+    const std::vector<Vec3>* v = nullptr;
+    const std::vector<Vec3>* w = nullptr;
+    const std::vector<std::uint32_t>* held = nullptr;  // bodies the swept test put back (may be null)
+  };
   SolveStats solveSoft(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
-                       const ResponseOptions& options, double dt, const std::vector<Pose>& start_poses,
-                       const std::vector<Vec3>& start_v, const std::vector<Vec3>& start_w);
+                       const ResponseOptions& options, double dt, const TickStart& start,
+                       const SolveBudget& budget = SolveBudget{});
   void forget() {  // drop warm-start impulses
     cache_.clear();
     cache_manifolds_.clear();
@@ -332,9 +347,22 @@ class ContactSolver {
   void prepareSoft(const std::vector<Contact>& contacts, const ResponseOptions& options, double dt);
   // A substep's shock sweep (contact_solver_soft.cpp), substep length h.
   void holdSupports(const ResponseOptions& options, double h);
-  // The substeps after the restitution and the warm start; `hold`: with a
-  // shock sweep in each (holdSupports).
-  void substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt, bool hold);
+  // What the substeps run on besides the rows: `hold`: a shock sweep in
+  // each (holdSupports); `count`: the substeps the tick asks for.
+  struct SoftRun {
+    bool hold = false;
+    int count = 1;
+    const SolveBudget* budget = nullptr;
+  };
+  // The substeps after the restitution and the warm start; returns how many ran.
+  int substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt, const SoftRun& run);
+  // One substep of length h, `share` of the tick's gain, the first or not.
+  void substep(std::vector<BodyState>& bodies, const ResponseOptions& options, double h, double share, bool first,
+               bool hold);
+  // A held body back within its reach (solveSoft's `start.held`) after a
+  // substep's move, its speed onward along its path dropped there.
+  struct SoftReach;
+  static void keepWithinReach(const SoftReach& reach, BodyState& body, Motion& motion);
   // The soft step sweeps shock propagation in each substep only when some
   // body rests on one at least this much lighter than itself (10:1 holds
   // without it; a pile of like bodies does not pay for it).
@@ -342,6 +370,15 @@ class ContactSolver {
   std::vector<SoftMove> soft_move_;
   std::vector<Pose> soft_found_;   // per body: the poses its contacts were found at
   std::vector<Motion> soft_gain_;  // per body: what the integration added to v and w this tick
+  // Per body the swept test put back: its path's direction from the tick's
+  // start and how far along it the hit is (length < 0: not held).
+  struct SoftReach {
+    Vec3 origin = Vec3::Zero();
+    Vec3 direction = Vec3::Zero();
+    double length = -1.0;
+  };
+  std::vector<SoftReach> soft_reach_;
+  bool any_reach_ = false;
 
   // The sequential passes (velocity, shock, position, position shock),
   // kLanes manifolds side by side (contact_solver_wide.cpp): a block's manifolds in batches that share no

@@ -122,20 +122,26 @@ void ContactSolver::prepareSoft(const std::vector<Contact>& contacts, const Resp
   });
 }
 
-void ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt, bool hold) {
-  const int count = options.substeps;
-  const double h = dt / count;
+void ContactSolver::keepWithinReach(const SoftReach& reach, BodyState& body, Motion& motion) {
+  const double along = (body.pose.position - reach.origin).dot(reach.direction);
+  if (along <= reach.length) return;
+  body.pose.position -= (along - reach.length) * reach.direction;
+  const double onward = motion.v.dot(reach.direction);
+  if (onward > 0.0) motion.v -= onward * reach.direction;
+}
+
+void ContactSolver::substep(std::vector<BodyState>& bodies, const ResponseOptions& options, double h, double share,
+                            bool first, bool hold) {
   SoftPass pass;
   // A quarter of the substep rate (the stiffest a soft contact stays stable
   // at, Box2D v3's bound), or contact_hertz below it: the stiffness follows
-  // the tick, so a resting body's give (|g| / omega^2) shrinks with dt.
+  // the substep, so a resting body's give (|g| / omega^2) shrinks with h.
   const double quarter_rate = 0.25 / h;
   const double hertz = options.contact_hertz > 0.0 ? std::min(options.contact_hertz, quarter_rate) : quarter_rate;
   pass.moving = makeSoftness(hertz, options.contact_damping_ratio, h);
   pass.immovable = makeSoftness(2.0 * hertz, options.contact_damping_ratio, h);
   pass.inv_h = 1.0 / h;
   pass.max_push = options.max_push_speed;
-  const double share = 1.0 / count;
   const std::size_t body_count = bodies.size();
   const auto softStep = [&](std::size_t r, Motion& a, Motion& b) { softRow(rows_[r], separationNow(rows_[r]), pass, a, b); };
   const auto relaxStep = [&](std::size_t r, Motion& a, Motion& b) {
@@ -160,63 +166,93 @@ void ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptio
     b.w += rl.inv_ib * rl.lambda;
   };
   const auto pass_over = [&](auto& step) {
-    forEachStage([&](std::size_t first, std::size_t end) {
+    forEachStage([&](std::size_t first_m, std::size_t end) {
       if (any_rolling_) {
-        overManifolds(first, end, motion_, step, roll);
+        overManifolds(first_m, end, motion_, step, roll);
       } else {
-        overManifolds(first, end, motion_, step);
+        overManifolds(first_m, end, motion_, step);
       }
     });
   };
-  for (int sub = 0; sub < count; ++sub) {
-    // Each body alone: its share of the integration's gain, then (after the
-    // biased pass) its move by h.
-    forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        if (bodies[i].is_static) continue;
-        motion_[i].v += share * soft_gain_[i].v;
-        motion_[i].w += share * soft_gain_[i].w;
-      }
-    });
-    if (sub > 0 && !rows_.empty()) {
-      forEachStage([&](std::size_t first, std::size_t end) {
-        if (any_rolling_) {
-          overManifolds(first, end, motion_, warmStep, warmRoll);
-        } else {
-          overManifolds(first, end, motion_, warmStep);
-        }
-      });
+  // Each body alone: its share of the integration's gain, then (after the
+  // biased pass) its move by h.
+  forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (bodies[i].is_static) continue;
+      motion_[i].v += share * soft_gain_[i].v;
+      motion_[i].w += share * soft_gain_[i].w;
     }
-    pass.bias = true;
-    if (!rows_.empty()) pass_over(softStep);
-    if (hold) holdSupports(options, h);
-    forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        BodyState& body = bodies[i];
-        if (body.is_static) continue;
-        body.pose.position += motion_[i].v * h;
-        if (!motion_[i].w.isZero(0.0)) {  // the torque-free turn of h (the gyroscopic term's, energy kept)
-          body.angular_velocity = motion_[i].w;
-          const FreeRotation turned = rotateFreely(body, h, options.gyroscopic);
-          body.pose.orientation = turned.orientation;
-          motion_[i].w = turned.angular_velocity;
-        }
-        soft_move_[i].p = body.pose.position - soft_found_[i].position;
-        soft_move_[i].q = body.pose.orientation * soft_found_[i].orientation.conjugate();
+  });
+  if (!first && !rows_.empty()) {
+    forEachStage([&](std::size_t first_m, std::size_t end) {
+      if (any_rolling_) {
+        overManifolds(first_m, end, motion_, warmStep, warmRoll);
+      } else {
+        overManifolds(first_m, end, motion_, warmStep);
       }
     });
-    pass.bias = false;
-    if (!rows_.empty()) pass_over(relaxStep);
-    if (sub == 0 && !rows_.empty()) {
-      // The bounce bounds friction in the first substep only: it acted once.
-      forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t r = begin; r < end; ++r) {
-          info_[r].soft_bounce = rows_[r].bounce_impulse;
-          rows_[r].bounce_impulse = 0.0;
-        }
-      });
+  }
+  pass.bias = true;
+  if (!rows_.empty()) pass_over(softStep);
+  if (hold) holdSupports(options, h);
+  forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      BodyState& body = bodies[i];
+      if (body.is_static) continue;
+      body.pose.position += motion_[i].v * h;
+      if (!motion_[i].w.isZero(0.0)) {  // the torque-free turn of h (the gyroscopic term's, energy kept)
+        body.angular_velocity = motion_[i].w;
+        const FreeRotation turned = rotateFreely(body, h, options.gyroscopic);
+        body.pose.orientation = turned.orientation;
+        motion_[i].w = turned.angular_velocity;
+      }
+      if (any_reach_ && soft_reach_[i].length >= 0.0) keepWithinReach(soft_reach_[i], body, motion_[i]);
+      soft_move_[i].p = body.pose.position - soft_found_[i].position;
+      soft_move_[i].q = body.pose.orientation * soft_found_[i].orientation.conjugate();
+    }
+  });
+  pass.bias = false;
+  if (!rows_.empty()) pass_over(relaxStep);
+  if (first && !rows_.empty()) {
+    // The bounce bounds friction in the first substep only: it acted once.
+    forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t r = begin; r < end; ++r) {
+        info_[r].soft_bounce = rows_[r].bounce_impulse;
+        rows_[r].bounce_impulse = 0.0;
+      }
+    });
+  }
+}
+
+int ContactSolver::substeps(std::vector<BodyState>& bodies, const ResponseOptions& options, double dt,
+                            const SoftRun& run) {
+  const SolveBudget unlimited;
+  const SolveBudget& budget = run.budget != nullptr ? *run.budget : unlimited;
+  const Deadline& deadline = budget.deadline;
+  // A spent tick moves its bodies the whole tick in one substep: the
+  // cheapest level of the response (two passes), never a standstill.
+  int count = std::max(1, std::min(run.count, budget.max_iterations));
+  if (deadline.passed()) count = 1;
+  const double first_share = 1.0 / count;
+  const double t_first = deadline.isSet() ? deadline.now() : 0.0;
+  substep(bodies, options, dt * first_share, first_share, true, run.hold);
+  if (count == 1) return 1;
+  int more = count - 1;
+  double share = first_share;
+  if (deadline.isSet()) {
+    // The first substep prices the others; what does not fit merges into
+    // fewer, longer substeps over the rest of the tick (at least one). As
+    // doubles: a far deadline over a cheap substep is past any int.
+    const double t_more = deadline.now();
+    const double each = t_more - t_first;
+    const double left = deadline.at() - t_more;
+    if (each > 0.0 && left < each * static_cast<double>(more)) {
+      more = static_cast<int>(std::max(1.0, std::floor(left / each)));
+      share = (1.0 - first_share) / more;
     }
   }
+  for (int sub = 0; sub < more; ++sub) substep(bodies, options, dt * share, share, false, run.hold);
+  return 1 + more;
 }
 
 // Shock propagation inside the substep, before the move: one sweep up the
@@ -246,10 +282,14 @@ void ContactSolver::holdSupports(const ResponseOptions& options, double h) {
 }
 
 SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
-                                    const ResponseOptions& options, double dt, const std::vector<Pose>& start_poses,
-                                    const std::vector<Vec3>& start_v, const std::vector<Vec3>& start_w) {
+                                    const ResponseOptions& options, double dt, const TickStart& start,
+                                    const SolveBudget& budget) {
   SolveStats stats;
   if (!(dt > 0.0) || bodies.empty()) return stats;
+  assert(start.poses != nullptr && start.v != nullptr && start.w != nullptr);
+  const std::vector<Pose>& start_poses = *start.poses;
+  const std::vector<Vec3>& start_v = *start.v;
+  const std::vector<Vec3>& start_w = *start.w;
   assert(start_poses.size() >= bodies.size() && start_v.size() >= bodies.size() && start_w.size() >= bodies.size());
   for (Contact& c : contacts) {
     c.normal_impulse = 0.0;
@@ -259,6 +299,31 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
   soft_gain_.resize(body_count);
   soft_move_.resize(body_count);
   soft_found_.resize(body_count);
+  // Each held body's reach: from its start to where the swept test put it
+  // (its pose now), along that path (or, put back at the start itself,
+  // along the velocity it was to move with).
+  any_reach_ = start.held != nullptr && !start.held->empty();
+  if (any_reach_) {
+    soft_reach_.assign(body_count, SoftReach{});
+    for (const std::uint32_t i : *start.held) {
+      assert(i < body_count);
+      const BodyState& body = bodies[i];
+      if (body.is_static) continue;
+      SoftReach& reach = soft_reach_[i];
+      const Vec3 path = body.pose.position - start_poses[i].position;
+      const double length = path.norm();
+      const double speed = body.linear_velocity.norm();
+      if (length > 0.0) {
+        reach.direction = path / length;
+      } else if (speed > 0.0) {
+        reach.direction = body.linear_velocity / speed;
+      } else {
+        continue;  // nowhere to go: nothing to keep it from
+      }
+      reach.origin = start_poses[i].position;
+      reach.length = length;
+    }
+  }
   // Velocities back to the tick's start (the rows' approach is measured from
   // them); the poses stay where the contacts were found until prepared.
   forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
@@ -330,14 +395,19 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
       stepped.substeps = static_cast<int>(std::min<double>(kMaxSubsteps, std::max<double>(options.substeps, needed)));
     }
   }
+  SoftRun run;
+  run.hold = hold;
+  run.count = stepped.substeps;
+  run.budget = &budget;
+  int ran = 0;
   onTeam([&] {
     if (!rows_.empty()) {
       collide(sequential, stats);
       if (options.warm_starting) warmStart(contacts, bodies, stats);
     }
-    substeps(bodies, stepped, dt, hold);
+    ran = substeps(bodies, stepped, dt, run);
   });
-  stats.velocity_passes = rows_.empty() ? 0 : 2 * stepped.substeps;
+  stats.velocity_passes = rows_.empty() ? 0 : 2 * ran;
   // The warm start keeps the last substep's impulses; the contacts report the tick's.
   forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {

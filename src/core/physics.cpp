@@ -377,7 +377,8 @@ void Physics::solve(const StepContext& step) {
   solver_.setWorkers(step.workers, static_cast<std::size_t>(options.solver_task_manifolds));
   solver_.keepWhileHeld(step.ids, step.held_asleep);
   if (options.solver == SolverKind::Soft) {
-    report_.solve = solver_.solveSoft(*step.bodies, contacts, run, step.dt, start_, start_v_, start_w_);
+    ContactSolver::TickStart start{&start_, &start_v_, &start_w_, &sweep_scratch_.clamped};
+    report_.solve = solver_.solveSoft(*step.bodies, contacts, run, step.dt, start, step.budget);
   } else {
     report_.solve = solver_.solve(*step.bodies, contacts, run, step.dt, step.budget);
   }

@@ -2,6 +2,7 @@
 // bodies that would pass through or sink into another, the response of the
 // same tick turns them, so the stored velocity always agrees with the real
 // motion; it sweeps only the broad phase's pairs.
+#include "cube_overlap.hpp"
 #include "stability_scenes.hpp"
 
 #include "sphere_tree_collision/continuous.hpp"
@@ -206,27 +207,6 @@ TEST(Continuous, CubeGrazingAFrictionlessWallKeepsFalling) {
   EXPECT_GT(b.pose.position.x(), 0.2 - 0.25 * kVoxel);  // and not through it (a quarter voxel, as the fast sphere of test_stability)
   const double fallen = -20.0 * steps * kDt - kG * kDt * kDt * steps * (steps - 1) / 2.0;
   EXPECT_NEAR(b.pose.position.z() - 1.0, fallen, 1e-9);
-}
-
-// How deep two cubes of half side h overlap (true shapes, by the separating
-// axes of two boxes): the least overlap over the 15 axes; < 0 when apart.
-double cubeOverlap(const Pose& a, const Pose& b, double h) {
-  const Mat3 ra = a.orientation.toRotationMatrix(), rb = b.orientation.toRotationMatrix();
-  const Vec3 d = b.position - a.position;
-  double least = std::numeric_limits<double>::infinity();
-  const auto along = [&](const Vec3& axis) {
-    const double length = axis.norm();
-    if (length < 1e-9) return;
-    const Vec3 u = axis / length;
-    const double reach = h * ((ra.transpose() * u).cwiseAbs().sum() + (rb.transpose() * u).cwiseAbs().sum());
-    least = std::min(least, reach - std::abs(d.dot(u)));
-  };
-  for (int i = 0; i < 3; ++i) {
-    along(ra.col(i));
-    along(rb.col(i));
-    for (int j = 0; j < 3; ++j) along(ra.col(i).cross(rb.col(j)));
-  }
-  return least;
 }
 
 // A column of cubes falling together onto a floor (as cube_box's lattice

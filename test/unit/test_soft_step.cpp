@@ -2,15 +2,20 @@
 // the stiff scenes of the default solver's suite (stability_scenes.hpp) with
 // the soft step, stored velocity against real motion, momentum, the cradle's
 // energy, the same bits at 1 and 2 threads.
-#include "stability_scenes.hpp"
+#include "cube_overlap.hpp"
 #include "same_state.hpp"
+#include "stability_scenes.hpp"
+#include "stepping_clock.hpp"
 
+#include "sphere_tree_collision/contact_solver.hpp"
 #include "sphere_tree_collision/dynamics.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace stc::stability {
 namespace {
@@ -213,6 +218,193 @@ TEST(SoftStep, SameBitsAtOneAndTwoThreads) {
     }
     EXPECT_GT(contacts, 0u);
   }
+}
+
+// corner_drift's 40 rocks on their way into the corner (45 ticks in), and a
+// ball falling free high above them, with the soft step.
+World cornerWithAFreeBall() {
+  WorldConfig config;
+  config.response = soft();
+  SceneParams params;
+  params.entities = 40;
+  World w = std::move(makeSceneWorld(SceneKind::CornerDrift, params, config).world);
+  PresetParams p;
+  p.resolution = 8;
+  p.voxel_size = 0.05;
+  EntitySpec ball;
+  ball.shape = w.addShape("free_sphere", makePreset("sphere", p));
+  ball.pose.position = Vec3(0.0, 0.0, 40.0);
+  w.addEntity(ball);
+  for (int t = 0; t < 45; ++t) w.step(1.0 / 60.0, Budget::unlimited());
+  return w;
+}
+
+// A body with no contact moved the whole tick: it stores v0 + g dt, and its
+// fall beyond v0 dt is along g, between a half and a whole g dt^2 (one
+// substep falls g dt^2, many nearly g dt^2 / 2). One moved only part of the
+// tick falls short.
+void expectMovedTheWholeTick(const BodyState& before, const BodyState& after, const Vec3& gravity, double dt) {
+  EXPECT_LE((after.linear_velocity - (before.linear_velocity + gravity * dt)).norm(), 1e-9);
+  const Vec3 down = gravity.normalized();
+  const Vec3 fall = after.pose.position - before.pose.position - before.linear_velocity * dt;
+  EXPECT_GE(fall.dot(down), 0.5 * gravity.norm() * dt * dt - 1e-12);
+  EXPECT_LE(fall.dot(down), gravity.norm() * dt * dt + 1e-12);
+  EXPECT_LE((fall - fall.dot(down) * down).norm(), 1e-12);
+}
+
+// The soft step under a deadline on a fake clock (every read costs 1 ms, so
+// the first substep is priced at 1 ms and the cut is the same on any machine
+// under any load), on the rocks' contacts of one tick: a spent deadline gives
+// one substep (two passes), more time never fewer, the substeps that do not
+// fit merge into fewer, longer ones, a far deadline gives every one (a
+// deadline of 1e12 s included: left / each is past any int), and
+// max_iterations caps them. Whatever the cut, the rocks' state stays finite
+// and the free ball moves the whole tick.
+TEST(SoftStep, TheSolveBudgetCutsSubstepsAndTheBodiesStillMoveTheWholeTick) {
+  constexpr double kDt = 1.0 / 60.0;
+  World w = cornerWithAFreeBall();
+  const Vec3 gravity = sceneGravity(SceneKind::CornerDrift);
+  const std::vector<BodyState> start = w.bodies();
+  w.step(kDt, Budget::unlimited());
+  ASSERT_GT(w.contacts().size(), 20u);
+  // The poses the tick's contacts were found at: integrate's prediction.
+  std::vector<BodyState> predicted = start;
+  IntegrationOptions integration;
+  integration.gravity = gravity;
+  integration.gyroscopic = soft().gyroscopic;
+  std::vector<Pose> start_poses;
+  std::vector<Vec3> start_v, start_w;
+  for (BodyState& b : predicted) {
+    start_poses.push_back(b.pose);
+    start_v.push_back(b.linear_velocity);
+    start_w.push_back(b.angular_velocity);
+    if (b.is_static) continue;
+    integratePosition(b, integration, kDt);
+    integrateVelocity(b, integration, kDt);
+  }
+  const ContactSolver::TickStart tick_start{&start_poses, &start_v, &start_w, nullptr};
+  const auto solveWithin = [&](const SolveBudget& budget) {
+    std::vector<BodyState> bodies = predicted;
+    std::vector<Contact> contacts = w.contacts();
+    ContactSolver solver;
+    const SolveStats stats = solver.solveSoft(bodies, contacts, soft(), kDt, tick_start, budget);
+    for (const BodyState& b : bodies) {
+      EXPECT_TRUE(allFinite(b.pose.position) && allFinite(b.linear_velocity) && allFinite(b.angular_velocity));
+    }
+    expectMovedTheWholeTick(start.back(), bodies.back(), gravity, kDt);
+    return stats.velocity_passes;
+  };
+  const int full = solveWithin(SolveBudget{});
+  EXPECT_EQ(full, 2 * soft().substeps);
+  int previous = 0;
+  for (const double seconds_left : {0.0, 0.0025, 0.0045, 0.0065, 1000.0, 1e12}) {
+    SCOPED_TRACE(seconds_left);
+    const SecondsClock clock = steppingClock(1e-3);
+    SolveBudget budget;
+    budget.deadline = Deadline(&clock, seconds_left);
+    const int passes = solveWithin(budget);
+    EXPECT_GE(passes, previous);
+    previous = passes;
+    // Read at 0 ms (passed?), 1 (the first substep's start) and 2 (its end):
+    // what is left at 2 ms buys a substep a millisecond, the rest of the tick
+    // in at least one more.
+    if (seconds_left == 0.0) EXPECT_EQ(passes, 2);
+    if (seconds_left == 0.0025) EXPECT_EQ(passes, 4);
+    if (seconds_left == 0.0045) EXPECT_EQ(passes, 6);
+    if (seconds_left >= 0.0065) EXPECT_EQ(passes, full);
+  }
+  for (const int cap : {0, 1, 2, 3}) {
+    SolveBudget budget;
+    budget.max_iterations = cap;
+    EXPECT_EQ(solveWithin(budget), 2 * std::max(cap, 1)) << cap;
+  }
+}
+
+// Through the World: a tick whose budget is spent before the solve runs one
+// substep, a far budget all of them, and the free ball moves the whole tick
+// (or, held by its island's level, stays where it was).
+TEST(SoftStep, ATickBudgetReachesTheSoftStep) {
+  constexpr double kDt = 1.0 / 60.0;
+  const Vec3 gravity = sceneGravity(SceneKind::CornerDrift);
+  int passes[2] = {0, 0};
+  for (const int far : {0, 1}) {
+    World w = cornerWithAFreeBall();
+    w.setClock(steppingClock(1e-4));
+    const BodyState before = w.bodies().back();
+    const TickReport report = w.step(kDt, Budget::ofTickSeconds(far ? 1e6 : 0.0));
+    ASSERT_GT(report.response.contacts, 0u);
+    passes[far] = report.response.velocity_passes;
+    if (w.responseLevel(w.entityIds().back()) == ResponseLevel::Full) {
+      expectMovedTheWholeTick(before, w.bodies().back(), gravity, kDt);
+    } else {
+      EXPECT_EQ(w.bodies().back().pose.position, before.pose.position);
+    }
+  }
+  EXPECT_EQ(passes[0], 2);
+  EXPECT_EQ(passes[1], 2 * soft().substeps);
+}
+
+// The swept test put a body back at its first hit; nothing else stops it
+// this tick (no contact at all), yet in no substep does it go further along
+// its path than the hit, and it keeps no speed onward along it. Sideways it
+// is free: a hit holds back only what would pass through.
+TEST(SoftStep, ABodyTheSweepPutBackGoesNoFurtherAlongItsPath) {
+  constexpr double kDt = 1.0 / 60.0;
+  BodyState body;
+  body.inv_mass = 1.0;
+  body.inv_inertia_body = Mat3::Identity();
+  refreshWorldInertia(body);
+  const Vec3 start(0.0, 0.0, 1.0);
+  const Vec3 velocity(-30.0, 0.0, -30.0);       // along the path, towards what it hit
+  const Vec3 hit = start + 0.25 * kDt * velocity;  // put back a quarter of the tick along it
+  body.pose.position = hit;
+  body.linear_velocity = velocity + Vec3(0.0, 5.0, 0.0);  // and sideways, which no hit stops
+  std::vector<BodyState> bodies{body};
+  std::vector<Contact> contacts;
+  const std::vector<Pose> start_poses{Pose{start, Quat::Identity()}};
+  const std::vector<Vec3> start_v{body.linear_velocity}, start_w{Vec3::Zero()};
+  const std::vector<std::uint32_t> held{0};
+  ContactSolver solver;
+  const ResponseOptions options = soft();
+  solver.solveSoft(bodies, contacts, options, kDt, ContactSolver::TickStart{&start_poses, &start_v, &start_w, &held});
+  const Vec3 direction = velocity.normalized();
+  const BodyState& b = bodies[0];
+  EXPECT_NEAR((b.pose.position - start).dot(direction), (hit - start).norm(), 1e-12);
+  EXPECT_NEAR(b.linear_velocity.dot(direction), 0.0, 1e-12);
+  EXPECT_NEAR(b.linear_velocity.y(), 5.0, 1e-12);
+  EXPECT_GT(b.pose.position.y(), 0.0);  // it moved sideways
+  // Not held, the same body flies the whole tick.
+  std::vector<BodyState> free{body};
+  solver.solveSoft(free, contacts, options, kDt, ContactSolver::TickStart{&start_poses, &start_v, &start_w, nullptr});
+  EXPECT_NEAR((free[0].pose.position - start).dot(direction), kDt * velocity.norm(), 1e-9);
+}
+
+// cube_box as built (1,000 cubes falling onto a floor into a pile), with the
+// soft step, its first 2 s: the swept test holds back cubes landing on
+// others, and the substeps then keep them near where it put them: at the
+// end of every tick no two cubes overlap by more than a voxel (test_continuous
+// asks the same of the default solver). Before a held cube was kept from
+// going further, the substeps took it on through the cube it hit: 0.38 m,
+// nearly a cube's half side, of overlap.
+TEST(SoftStep, CubeBoxCubesStayNearlyWhereTheSweepPutThem) {
+  constexpr double kVoxel = 0.05;
+  WorldConfig config;
+  config.response = soft();
+  SceneWorld scene = makeSceneWorld(SceneKind::CubeBox, SceneParams{}, config);
+  World& w = scene.world;
+  double deepest = -1.0;
+  int held_back = 0;
+  for (int s = 0; s < 120; ++s) {
+    w.step(1.0 / 60.0, Budget::unlimited());
+    held_back += static_cast<int>(w.physicsReport().sweep.clamped);
+    const std::vector<BodyState>& b = w.bodies();
+    for (const Contact& c : w.contacts()) {
+      if (b[c.index_a].is_static || b[c.index_b].is_static) continue;
+      deepest = std::max(deepest, cubeOverlap(b[c.index_a].pose, b[c.index_b].pose, 0.2));
+    }
+  }
+  EXPECT_GT(held_back, 0);
+  EXPECT_LT(deepest, 1.5 * kVoxel);
 }
 
 }  // namespace

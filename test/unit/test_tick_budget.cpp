@@ -3,6 +3,8 @@
 // budget allows, and stops in a consistent state; the narrow phase gets what
 // integrate, the broad phase and the reserve leave; budgets that are never
 // reached change nothing. Deterministic: iteration counts and a fake clock.
+#include "stepping_clock.hpp"
+
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
@@ -16,16 +18,6 @@ namespace stc {
 namespace {
 
 constexpr double kDt = 1.0 / 60.0;
-
-// Reads 0, step, 2 step, ...: every clock read costs `step` seconds of fake time.
-SecondsClock steppingClock(double step) {
-  auto now = std::make_shared<double>(0.0);
-  return [now, step] {
-    const double t = *now;
-    *now += step;
-    return t;
-  };
-}
 
 // corner_drift with 125 rocks, as built.
 SceneWorld corner125() {
