@@ -1,8 +1,9 @@
 // How deep two cubes of half side h overlap, by the separating axes of two
-// boxes (their true shapes, not their spheres).
+// boxes (their true shapes, not their spheres), and the deepest overlap of
+// a world of cubes over its ticks.
 #pragma once
 
-#include "sphere_tree_collision/types.hpp"
+#include "sphere_tree_collision/world.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -28,6 +29,27 @@ inline double cubeOverlap(const Pose& a, const Pose& b, double h) {
     for (int j = 0; j < 3; ++j) along(ra.col(i).cross(rb.col(j)));
   }
   return least;
+}
+
+// `ticks` unlimited ticks of a world of cubes of half side h: the deepest
+// overlap of two movable cubes in contact at the end of any tick, and how
+// many times the swept test held a body back.
+struct CubeOverlapRun {
+  double deepest = -1.0;
+  int held_back = 0;
+};
+inline CubeOverlapRun deepestCubeOverlap(World& w, int ticks, double dt, double h) {
+  CubeOverlapRun run;
+  for (int s = 0; s < ticks; ++s) {
+    w.step(dt, Budget::unlimited());
+    run.held_back += static_cast<int>(w.physicsReport().sweep.clamped);
+    const std::vector<BodyState>& b = w.bodies();
+    for (const Contact& c : w.contacts()) {
+      if (b[c.index_a].is_static || b[c.index_b].is_static) continue;
+      run.deepest = std::max(run.deepest, cubeOverlap(b[c.index_a].pose, b[c.index_b].pose, h));
+    }
+  }
+  return run;
 }
 
 }  // namespace stc

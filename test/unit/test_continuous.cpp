@@ -263,19 +263,9 @@ TEST(Continuous, ACubeColumnLandingTogetherStaysStacked) {
 TEST(Continuous, CubeBoxCubesNeverSinkIntoEachOther) {
   SceneWorld scene = makeSceneWorld(SceneKind::CubeBox);
   World& w = scene.world;
-  double deepest = -1.0;
-  int held_back = 0;
-  for (int s = 0; s < static_cast<int>(3.0 / kDt); ++s) {
-    w.step(kDt, Budget::unlimited());
-    held_back += static_cast<int>(w.physicsReport().sweep.clamped);
-    const std::vector<BodyState>& b = w.bodies();
-    for (const Contact& c : w.contacts()) {
-      if (b[c.index_a].is_static || b[c.index_b].is_static) continue;
-      deepest = std::max(deepest, cubeOverlap(b[c.index_a].pose, b[c.index_b].pose, 0.2));
-    }
-  }
-  EXPECT_GT(held_back, 0);
-  EXPECT_LT(deepest, kVoxel);
+  const CubeOverlapRun run = deepestCubeOverlap(w, static_cast<int>(3.0 / kDt), kDt, 0.2);
+  EXPECT_GT(run.held_back, 0);
+  EXPECT_LT(run.deepest, kVoxel);
 }
 
 // With no detection budget and unresolved pairs rejected, the narrow phase

@@ -392,19 +392,9 @@ TEST(SoftStep, CubeBoxCubesStayNearlyWhereTheSweepPutThem) {
   config.response = soft();
   SceneWorld scene = makeSceneWorld(SceneKind::CubeBox, SceneParams{}, config);
   World& w = scene.world;
-  double deepest = -1.0;
-  int held_back = 0;
-  for (int s = 0; s < 120; ++s) {
-    w.step(1.0 / 60.0, Budget::unlimited());
-    held_back += static_cast<int>(w.physicsReport().sweep.clamped);
-    const std::vector<BodyState>& b = w.bodies();
-    for (const Contact& c : w.contacts()) {
-      if (b[c.index_a].is_static || b[c.index_b].is_static) continue;
-      deepest = std::max(deepest, cubeOverlap(b[c.index_a].pose, b[c.index_b].pose, 0.2));
-    }
-  }
-  EXPECT_GT(held_back, 0);
-  EXPECT_LT(deepest, 1.5 * kVoxel);
+  const CubeOverlapRun run = deepestCubeOverlap(w, 120, 1.0 / 60.0, 0.2);
+  EXPECT_GT(run.held_back, 0);
+  EXPECT_LT(run.deepest, 1.5 * kVoxel);
 }
 
 }  // namespace
