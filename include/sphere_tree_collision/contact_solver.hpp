@@ -138,6 +138,37 @@ class ContactSolver {
     held_ = held;
   }
 
+  // Last tick's manifold of a body pair: its points' impulses, by feature id
+  // (the leaf sphere pair a point was built from) and position in A's frame.
+  struct CachedPoint {
+    std::int32_t node_a = 0, node_b = 0;
+    Vec3 local_a = Vec3::Zero();
+    double normal = 0.0;
+    Vec3 friction = Vec3::Zero();  // world frame
+  };
+  struct CachedManifold {
+    std::uint64_t pair = 0;              // entity ids a, b packed: the sort key
+    std::uint32_t first = 0, count = 0;  // its points in cache_
+    std::uint32_t index_a = 0, index_b = 0;  // the bodies' dense indices when it was solved
+    Vec3 rolling = Vec3::Zero();             // its rolling-resistance impulse, world frame
+  };
+  // At most this many points of a manifold are kept for the warm start.
+  static constexpr std::uint32_t kMaxCachedPoints = 32;
+  // The warm start the next solve starts from, for a saved world
+  // (CarriedState): last solve's manifolds and the held store's (sorted by
+  // pair), each with its points [first, first + count) of the points given.
+  struct WarmStart {
+    const std::vector<CachedManifold>* manifolds = nullptr;
+    const std::vector<CachedPoint>* points = nullptr;
+  };
+  WarmStart solved() const { return {&cache_manifolds_, &cache_}; }
+  WarmStart held() const { return {&held_manifolds_, &held_points_}; }
+  // Both put back: pairs and indices as the loaded world's ids and dense
+  // indices give them, sorted here; counts of at most kMaxCachedPoints
+  // (checked by the caller).
+  void restore(std::vector<CachedManifold> solved, std::vector<CachedPoint> solved_points,
+               std::vector<CachedManifold> held, std::vector<CachedPoint> held_points);
+
   // A body's velocities as the solver sees them: one cache line per body.
   // A cache line each: bodies next to each other in the array may belong to
   // blocks that two threads solve at once.
@@ -243,20 +274,6 @@ class ContactSolver {
     double soft_total[3] = {0.0, 0.0, 0.0};
     double soft_bounce = 0.0;
     double soft_kept[3] = {0.0, 0.0, 0.0};  // its impulses before a substep's shock sweep
-  };
-  // Last tick's manifold of a body pair: its points' impulses, by feature id
-  // (the leaf sphere pair a point was built from) and position in A's frame.
-  struct CachedPoint {
-    std::int32_t node_a = 0, node_b = 0;
-    Vec3 local_a = Vec3::Zero();
-    double normal = 0.0;
-    Vec3 friction = Vec3::Zero();  // world frame
-  };
-  struct CachedManifold {
-    std::uint64_t pair = 0;              // entity ids a, b packed: the sort key
-    std::uint32_t first = 0, count = 0;  // its points in cache_
-    std::uint32_t index_a = 0, index_b = 0;  // the bodies' dense indices when it was solved
-    Vec3 rolling = Vec3::Zero();             // its rolling-resistance impulse, world frame
   };
   static bool byPair(const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; }
   // The held store (keepWhileHeld) keeps what still sleeps and gains last

@@ -27,6 +27,7 @@
 #include "sphere_tree_collision/contact.hpp"
 #include "sphere_tree_collision/rest_test.hpp"
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -45,6 +46,14 @@ struct SleepOptions {
 // "sleeping.time_to_sleep"): each finite and >= 0.
 void validateSleepOptions(const SleepOptions& options);
 
+// An awake body's rest test and timer (a saved world's: CarriedState).
+struct BodyRest {
+  bool moving = true;      // not resting at the last tick
+  double rest_time = 0.0;  // seconds resting
+  double age = 0.0;        // seconds since its rest test's window began
+  std::array<Sphere, 3> balls;  // balls[0].radius < 0: the test starts afresh
+};
+
 class Islands {
  public:
   // Mirror the World's dense arrays: a body appended (awake; its box
@@ -56,6 +65,17 @@ class Islands {
   // fresh, and asleep in `group` (> 0) at `pose`, or awake (0).
   void restore(std::size_t body, std::uint32_t group, const Pose& pose);
   std::uint32_t group(std::size_t body) const { return group_[body]; }
+  BodyRest rest(std::size_t body) const {
+    return {moving_[body] != 0, rest_time_[body], rest_test_.age(body), rest_test_.balls(body)};
+  }
+  void restoreRest(std::size_t body, const BodyRest& rest) {
+    moving_[body] = rest.moving ? 1 : 0;
+    rest_time_[body] = rest.rest_time;
+    rest_test_.restore(body, rest.balls, rest.age);
+  }
+  // The group the next island to fall asleep takes (> 0).
+  std::uint32_t nextGroup() const { return next_group_; }
+  void setNextGroup(std::uint32_t group) { next_group_ = group; }
   void remove(std::size_t index, std::size_t last);
   void clear();
 

@@ -120,6 +120,12 @@ class PairContactCache {
   // commit's swap, and the index), so such a tick allocates nothing.
   void reserve(std::size_t entries, std::size_t points);
   std::size_t size() const { return entries_.size(); }
+  // What the next tick finds, for a saved world (CarriedState): the entries
+  // (each's points [first, first + count) of points()), and the same put back
+  // (keys as the loaded world's ids give them; checked by the caller).
+  const std::vector<Entry>& entries() const { return entries_; }
+  const std::vector<Point>& points() const { return points_; }
+  void restore(const std::vector<Entry>& entries, const std::vector<Point>& points);
 
  private:
   std::vector<Entry> entries_, next_entries_;

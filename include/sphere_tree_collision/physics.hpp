@@ -112,6 +112,14 @@ class Physics {
   // safe from many threads at once.
   std::uint32_t reusableEntry(const StepContext& step, std::uint32_t ia, std::uint32_t ib) const;
   const PairContactCache& pairCache() const { return pair_cache_; }
+  // A saved world's (CarriedState): the carried contacts put back (keys as
+  // the World's ids give them), and the solver, whose warm start it keeps.
+  void restoreCarried(const std::vector<PairContactCache::Entry>& entries,
+                      const std::vector<PairContactCache::Point>& points) {
+    pair_cache_.restore(entries, points);
+  }
+  const ContactSolver& solver() const { return solver_; }
+  ContactSolver& solver() { return solver_; }
   // Drops the carried contacts: the next tick builds every pair's (a static
   // body came or went, so covered faces may have changed; or the options did).
   void forgetReuse() {

@@ -39,6 +39,13 @@ class RestTest {
   // each still fits in `max_radius`; false when one grew past it (the test
   // restarts at `pose`). Windows last `window` seconds.
   bool update(std::size_t body, const Pose& pose, double dt, double window, double max_radius);
+  // A body's balls and the age of its window (a saved world's: CarriedState).
+  const std::array<Sphere, 3>& balls(std::size_t body) const { return balls_[body]; }
+  double age(std::size_t body) const { return age_[body]; }
+  void restore(std::size_t body, const std::array<Sphere, 3>& balls, double age) {
+    balls_[body] = balls;
+    age_[body] = age;
+  }
 
  private:
   std::array<Vec3, 3> pointsOf(std::size_t body, const Pose& pose) const;

@@ -7,6 +7,8 @@
 
 #include "sphere_tree_collision/types.hpp"
 
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -48,6 +50,28 @@ class SweepAndPrune {
   // its per-slot arrays and lists keep the size of its peak otherwise. The
   // pairs stay the same set, perhaps in another order.
   void releaseMemory();
+  // The bands as last chosen: per axis's lists the map of a coordinate on
+  // the band axis to a band (origin, scale, top: band = min(max((v - origin)
+  // * scale, 0), top)), and the boxes they were chosen for (chosen again
+  // when the count doubles or halves). Which band a box is in decides the
+  // order new pairs are found in.
+  struct Banding {
+    std::array<double, 3> origin{}, scale{}, top{};
+    std::uint64_t chosen_for = 0;
+    // Per list, each band's endpoints in their order (id << 1 | is_max):
+    // endpoints of equal value stay in the order they came in (a static
+    // floor's pieces share edges), which decides the order of their pairs.
+    std::array<std::vector<std::vector<std::uint64_t>>, 3> endpoints;
+  };
+  Banding banding() const;
+  // A saved world's broad phase (CarriedState): rebuilt for the boxes it
+  // holds now with these bands, its pairs then in `order`, as the saved one
+  // had them after its last update (the next updates then find and drop
+  // pairs in the same order). Throws InputError("banding") for bands that
+  // are not a map to at most 256 bands or endpoints that are not each band's
+  // in order, InputError("pairs") when `order` is not the pairs of the
+  // boxes; then nothing changes.
+  void restore(const Banding& banding, const std::vector<BroadPair>& order);
   // Endpoint swaps done by the last update(): the measure of coherence.
   std::size_t lastSwapCount() const { return last_swaps_; }
 

@@ -7,6 +7,7 @@
 
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
+#include "sphere_tree_collision/carried_state.hpp"
 #include "sphere_tree_collision/contact.hpp"
 #include "sphere_tree_collision/entity_table.hpp"
 #include "sphere_tree_collision/fracture.hpp"
@@ -195,6 +196,18 @@ class World : private ShapeLibrary, private EntityTable {
   // (island_levels.hpp): Full, Held (still, waiting for its turn), Asleep or
   // Static. Full for an unknown id.
   ResponseLevel responseLevel(EntityId id) const;
+
+  // What the next tick carries over from the last besides the bodies' rows
+  // (carried_state.hpp), by dense index: a saved world's contact_state.
+  CarriedState carriedState() const;
+  // The same put back into a World that holds the saved world's entities in
+  // the same dense order, before its first step: its next ticks at an
+  // unlimited budget are then the saved world's, bit for bit, while the ids
+  // are in the same order as the saved world's (docs/ros_interface.md, Saved
+  // worlds). Throws InputError naming the part and the field ("rest[2].body",
+  // "boxes", "banding", "broad_pairs", "carried[0].points", "warm[3].b", ...)
+  // and then changes nothing.
+  void restoreCarried(const CarriedState& state);
 
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.

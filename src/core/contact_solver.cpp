@@ -32,7 +32,7 @@ constexpr std::size_t kManifoldsPerTask = 128;  // manifolds' rolling resistance
 // manifold a solver stage needs (a bounce step is about a row's work).
 constexpr std::size_t kWaveRowsPerManifold = 4;
 // A pair's points kept for the warm start: one bit each in warmStart's `used`.
-constexpr std::uint32_t kCachedPointsPerPair = 32;
+constexpr std::uint32_t kCachedPointsPerPair = ContactSolver::kMaxCachedPoints;
 
 // Appends to `out`, ascending, the indices whose flag is set; eight flags
 // at a time, as a wave's rows are few among many.
@@ -854,6 +854,16 @@ void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
   }
   cache_.swap(next_cache_);
   cache_manifolds_.swap(next_manifolds_);
+}
+
+void ContactSolver::restore(std::vector<CachedManifold> solved, std::vector<CachedPoint> solved_points,
+                            std::vector<CachedManifold> held, std::vector<CachedPoint> held_points) {
+  std::sort(solved.begin(), solved.end(), byPair);
+  std::sort(held.begin(), held.end(), byPair);
+  cache_manifolds_ = std::move(solved);
+  cache_ = std::move(solved_points);
+  held_manifolds_ = std::move(held);
+  held_points_ = std::move(held_points);
 }
 
 SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,

@@ -160,6 +160,13 @@ void PairContactCache::reserve(std::size_t entries, std::size_t points) {
   next_index_->reserve(entries);
 }
 
+void PairContactCache::restore(const std::vector<Entry>& entries, const std::vector<Point>& points) {
+  entries_ = entries;
+  points_ = points;
+  index_->clear();
+  for (std::uint32_t i = 0; i < entries_.size(); ++i) index_->set(entries_[i].key, i);
+}
+
 void PairContactCache::clear() {
   entries_.clear();
   points_.clear();

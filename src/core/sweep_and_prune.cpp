@@ -393,8 +393,7 @@ struct SweepAndPrune::Impl {
         extent_sum += span.max - span.min;
         ++in_use;
       }
-      Quantiser& q = lists[a].band_of;
-      q = Quantiser{};
+      Quantiser q;
       const double extent = hi - lo;
       if (in_use > 0 && extent > 0.0 && std::isfinite(extent)) {
         const double mean = extent_sum / static_cast<double>(in_use);
@@ -403,20 +402,95 @@ struct SweepAndPrune::Impl {
         q.scale = 1.0 / width;
         q.top = std::floor(extent / width);  // boxes beyond the ends go to the end bands
       }
-      lists[a].bands.resize(static_cast<std::size_t>(q.top) + 1);
-      lists[a].band_lost.assign(lists[a].bands.size(), 0);
-      lists[a].band_dirty.assign(lists[a].bands.size(), 0);
-      // Room in each band for twice its even share of the endpoints (two a
-      // box, a box in at most two bands): grown only as a band first passed
-      // its high, a steady scene whose boxes drift between bands allocated in
-      // a tick long after its start (the swept allocation test, once its
-      // trajectory changed).
-      const std::size_t share = 2 * 2 * in_use / lists[a].bands.size() + 16;
-      for (std::vector<Endpoint>& band : lists[a].bands) {
-        band.clear();
-        band.reserve(2 * share);
+      setBands(a, q, in_use);
+    }
+    putBackAll(pairs);
+    live_at_banding = in_use;
+  }
+
+  // List a's bands: `q` maps a coordinate to one, for `in_use` boxes.
+  void setBands(int a, const Quantiser& q, std::size_t in_use) {
+    lists[a].band_of = q;
+    lists[a].bands.resize(static_cast<std::size_t>(q.top) + 1);
+    lists[a].band_lost.assign(lists[a].bands.size(), 0);
+    lists[a].band_dirty.assign(lists[a].bands.size(), 0);
+    // Room in each band for twice its even share of the endpoints (two a
+    // box, a box in at most two bands): grown only as a band first passed
+    // its high, a steady scene whose boxes drift between bands allocated in
+    // a tick long after its start (the swept allocation test, once its
+    // trajectory changed).
+    const std::size_t share = 2 * 2 * in_use / lists[a].bands.size() + 16;
+    for (std::vector<Endpoint>& band : lists[a].bands) {
+      band.clear();
+      band.reserve(2 * share);
+    }
+  }
+
+  // Each band's endpoints (the same ones, id << 1 | is_max) put in `order`,
+  // which must keep them sorted: only endpoints of equal value move.
+  bool reorderBands(const std::array<std::vector<std::vector<std::uint64_t>>, 3>& order) {
+    std::vector<std::uint64_t> have, want;
+    for (int a = 0; a < 3; ++a) {
+      std::vector<std::vector<Endpoint>>& bands = lists[a].bands;
+      if (order[a].size() != bands.size()) return false;
+      for (std::size_t b = 0; b < bands.size(); ++b) {
+        std::vector<Endpoint>& band = bands[b];
+        const std::vector<std::uint64_t>& tags = order[a][b];
+        if (tags.size() != band.size()) return false;
+        have.clear();
+        want.clear();
+        for (const Endpoint& e : band) have.push_back(e.tag);
+        for (const std::uint64_t tag : tags) {
+          const std::uint32_t slot = slot_of_id.find(static_cast<EntityId>(tag >> 1));
+          if (tag >> 33 != 0 || slot == FlatHashMap::kMissing) return false;
+          want.push_back(std::uint64_t{slot} << 1 | (tag & 1u));
+        }
+        std::vector<std::uint64_t> wanted = want;
+        std::sort(have.begin(), have.end());
+        std::sort(wanted.begin(), wanted.end());
+        if (have != wanted) return false;
+        const Span* span = spans[a].data();
+        for (std::size_t k = 0; k < band.size(); ++k) {
+          const std::uint32_t tag = static_cast<std::uint32_t>(want[k]);
+          const Span& sp = span[tag >> 1];
+          band[k] = Endpoint{(tag & 1u) != 0 ? sp.max : sp.min, tag, sp.others};
+          if (k > 0 && before(band[k], band[k - 1])) return false;
+        }
       }
     }
+    return true;
+  }
+
+  // The pairs (the same set) put in `order`, their keys, links and index with them.
+  bool reorderPairs(const std::vector<BroadPair>& order, std::vector<BroadPair>& pairs) {
+    if (order.size() != pairs.size()) return false;
+    std::vector<std::uint64_t> keys;
+    keys.reserve(order.size());
+    for (const BroadPair& pair : order) {
+      const std::uint32_t a = slot_of_id.find(pair.first), b = slot_of_id.find(pair.second);
+      if (a == FlatHashMap::kMissing || b == FlatHashMap::kMissing || a == b) return false;
+      const std::uint32_t at = pair_index.find(pairKey(a, b));
+      if (at == FlatHashMap::kMissing || !(pairs[at] == pair)) return false;
+      keys.push_back(pairKey(a, b));
+    }
+    std::vector<std::uint64_t> sorted = keys;
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return false;  // a pair twice
+    pairs = order;
+    pair_keys = std::move(keys);
+    pair_links.assign(pairs.size(), PairLinks{});
+    std::fill(first_pair.begin(), first_pair.end(), kNoPair);
+    pair_index = FlatHashMap();
+    for (std::uint32_t i = 0; i < pairs.size(); ++i) {
+      pair_index.set(pair_keys[i], i);
+      link(i);
+    }
+    return true;
+  }
+
+  // Every box put back as if just added (its pairs found again by the local
+  // sweeps at the next update), no pair left.
+  void putBackAll(std::vector<BroadPair>& pairs) {
     pairs.clear();
     pair_keys.clear();
     pair_links.clear();
@@ -428,7 +502,6 @@ struct SweepAndPrune::Impl {
       state[s] = SlotState::kAdded;
       added.push_back(static_cast<std::uint32_t>(s));
     }
-    live_at_banding = in_use;
   }
 
   bool bandsStale() const {
@@ -719,6 +792,56 @@ void SweepAndPrune::releaseMemory() {
     }
   }
   fitted.update();
+  fitted.last_swaps_ = last_swaps_;
+  *this = std::move(fitted);
+}
+
+SweepAndPrune::Banding SweepAndPrune::banding() const {
+  const Impl& m = *impl_;
+  Banding out;
+  for (int a = 0; a < 3; ++a) {
+    out.origin[a] = m.lists[a].band_of.origin;
+    out.scale[a] = m.lists[a].band_of.scale;
+    out.top[a] = m.lists[a].band_of.top;
+  }
+  out.chosen_for = m.live_at_banding;
+  for (int a = 0; a < 3; ++a) {
+    for (const std::vector<Endpoint>& band : m.lists[a].bands) {
+      std::vector<std::uint64_t>& order = out.endpoints[a].emplace_back();
+      order.reserve(band.size());
+      for (const Endpoint& e : band) order.push_back(std::uint64_t{m.ids[slotOf(e)]} << 1 | isMax(e));
+    }
+  }
+  return out;
+}
+
+void SweepAndPrune::restore(const Banding& banding, const std::vector<BroadPair>& order) {
+  for (int a = 0; a < 3; ++a) {
+    const double top = banding.top[a];
+    if (!(std::isfinite(banding.origin[a]) && std::isfinite(banding.scale[a]) && banding.scale[a] >= 0.0 &&
+          top >= 0.0 && top < kMaxBands && top == std::floor(top))) {
+      throw InputError("banding", "origin and scale finite (scale >= 0), top a whole number of bands below " +
+                                      std::to_string(kMaxBands));
+    }
+  }
+  const Impl& m = *impl_;
+  SweepAndPrune fitted;  // as releaseMemory: the boxes in slot order
+  for (std::uint32_t slot = 0; slot < m.state.size(); ++slot) {
+    if (m.inUse(slot)) fitted.add(m.ids[slot], box(m.ids[slot]));
+  }
+  Impl& f = *fitted.impl_;
+  std::size_t in_use = f.state.size();
+  if (banding.chosen_for == 0 ? in_use > 0 : (in_use > 2 * banding.chosen_for || 2 * in_use < banding.chosen_for)) {
+    throw InputError("banding", "chosen for " + std::to_string(banding.chosen_for) + " boxes, not near " +
+                                    std::to_string(in_use));
+  }
+  for (int a = 0; a < 3; ++a) f.setBands(a, Quantiser{banding.origin[a], banding.scale[a], banding.top[a]}, in_use);
+  f.live_at_banding = banding.chosen_for;
+  fitted.update();
+  if (!f.reorderBands(banding.endpoints)) {
+    throw InputError("banding", "endpoints: not each band's endpoints of the boxes, in order");
+  }
+  if (!f.reorderPairs(order, fitted.pairs_)) throw InputError("pairs", "not the pairs of the boxes, each once");
   fitted.last_swaps_ = last_swaps_;
   *this = std::move(fitted);
 }

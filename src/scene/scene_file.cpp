@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
+#include <tuple>
 #include <map>
 #include <set>
 #include <sstream>
@@ -280,6 +282,176 @@ std::string sceneKeyOf(const std::string& field) {
   return it == kKeys.end() ? field : it->second;
 }
 
+// contact_state's rows: a list of lists of `width` numbers each, flat.
+std::vector<double> readRows(const YAML::Node& node, const std::string& field, std::size_t width) {
+  if (!node.IsSequence()) throw InputError(field, "expected a list of rows of " + std::to_string(width) + " numbers");
+  std::vector<double> out;
+  out.reserve(node.size() * width);
+  for (std::size_t k = 0; k < node.size(); ++k) {
+    const std::vector<double> row = readNumbers(node[k], field + "[" + std::to_string(k) + "]", width);
+    out.insert(out.end(), row.begin(), row.end());
+  }
+  return out;
+}
+
+// A whole number in [0, hi] (read as a double: 17 digits hold it exactly).
+std::uint32_t wholeAt(double v, const std::string& field, double hi) {
+  if (!(v >= 0.0 && v <= hi && v == std::floor(v))) {
+    throw InputError(field, "expected a whole number in [0, " + std::to_string(static_cast<std::int64_t>(hi)) + "]");
+  }
+  return static_cast<std::uint32_t>(v);
+}
+
+std::int32_t nodeAt(double v, const std::string& field) {
+  if (!(v >= -2147483648.0 && v <= 2147483647.0 && v == std::floor(v))) {
+    throw InputError(field, "expected a 32-bit integer");
+  }
+  return static_cast<std::int32_t>(v);
+}
+
+bool flagAt(double v, const std::string& field) {
+  if (v != 0.0 && v != 1.0) throw InputError(field, "expected 0 or 1");
+  return v == 1.0;
+}
+
+Vec3 vec3At(const double* v) { return {v[0], v[1], v[2]}; }
+
+// Each entry's points follow the last's: `first` set in turn, the counts
+// must add up to the points given.
+template <typename Entry, typename FirstCount>
+void countPoints(std::vector<Entry>& entries, std::size_t points, const std::string& field, FirstCount fc) {
+  std::uint64_t next = 0;
+  for (Entry& e : entries) {
+    auto [first, count] = fc(e);
+    first = static_cast<std::uint32_t>(std::min<std::uint64_t>(next, 0xffffffffu));
+    next += count;
+  }
+  if (next != points) {
+    throw InputError(field, "its points add up to " + std::to_string(next) + ", not the " + std::to_string(points) +
+                                " given");
+  }
+}
+
+// Each row of the list `key` of `node` when it is there (rows of `width`
+// numbers): row(its numbers, its field "<p><key>[k]").
+template <typename Row>
+void readEachRow(const YAML::Node& node, const std::string& p, const char* key, std::size_t width, Row row) {
+  if (!node[key]) return;
+  const std::vector<double> v = readRows(node[key], p + key, width);
+  for (std::size_t k = 0; k * width < v.size(); ++k) row(v.data() + k * width, p + key + "[" + std::to_string(k) + "]");
+}
+
+// contact_state (World::carriedState), `bodies` the scene's entities; the
+// World checks what it alone knows (which bodies are awake and movable, the
+// pairs of the boxes, the bands' endpoints) when it is put back.
+CarriedState readCarried(const YAML::Node& node, std::size_t bodies) {
+  const std::string p = "contact_state.";
+  if (!node.IsMap()) throw InputError("contact_state", "expected a map");
+  checkKeys(node, p, {"next_group", "rest", "banding", "band_order", "boxes", "broad_pairs", "carried",
+                      "carried_points", "warm", "warm_points"});
+  for (const char* key : {"next_group", "banding", "band_order", "boxes"}) {
+    if (!node[key]) throw InputError(p + key, "missing");
+  }
+  const auto body = [&](double v, const std::string& field) {
+    if (bodies == 0) throw InputError(field, "no entity to name");
+    return wholeAt(v, field, static_cast<double>(bodies - 1));
+  };
+  CarriedState c;
+  c.next_group = static_cast<std::uint32_t>(readInt(node["next_group"], p + "next_group", 1, 0xffffffffll));
+  readEachRow(node, p, "rest", 16, [&](const double* r, const std::string& field) {
+    CarriedState::Rest rest;
+    rest.body = body(r[0], field + ".body");
+    rest.state.moving = flagAt(r[1], field + ".moving");
+    rest.state.rest_time = r[2];
+    rest.state.age = r[3];
+    for (int b = 0; b < 3; ++b) rest.state.balls[b] = Sphere{vec3At(r + 4 + 4 * b), r[7 + 4 * b]};
+    c.rest.push_back(rest);
+  });
+  const std::vector<double> banding = readNumbers(node["banding"], p + "banding", 10);
+  for (int a = 0; a < 3; ++a) {
+    c.banding.origin[a] = banding[a];
+    c.banding.scale[a] = banding[3 + a];
+    c.banding.top[a] = banding[6 + a];
+  }
+  c.banding.chosen_for = wholeAt(banding[9], p + "banding", 4294967295.0);
+  const YAML::Node lists = node["band_order"];
+  if (!lists.IsSequence() || lists.size() != 3) throw InputError(p + "band_order", "expected three lists of bands");
+  for (std::size_t a = 0; a < 3; ++a) {
+    const std::string field = p + "band_order[" + std::to_string(a) + "]";
+    if (!lists[a].IsSequence()) throw InputError(field, "expected a list of bands");
+    for (std::size_t b = 0; b < lists[a].size(); ++b) {
+      const YAML::Node band = lists[a][b];
+      if (!band.IsSequence()) throw InputError(field, "expected each band as a list of endpoints");
+      std::vector<std::uint64_t>& order = c.banding.endpoints[a].emplace_back();
+      for (std::size_t k = 0; k < band.size(); ++k) {
+        order.push_back(static_cast<std::uint64_t>(readInt(band[k], field, 0, 2 * static_cast<std::int64_t>(bodies) - 1)));
+      }
+    }
+  }
+  readEachRow(node, p, "boxes", 6, [&](const double* r, const std::string&) {
+    c.boxes.push_back({vec3At(r), vec3At(r + 3)});
+  });
+  if (c.boxes.size() != bodies) throw InputError(p + "boxes", "one a body: " + std::to_string(bodies));
+  if (node["broad_pairs"]) {
+    const YAML::Node pairs = node["broad_pairs"];
+    if (!pairs.IsSequence() || pairs.size() % 2 != 0) throw InputError(p + "broad_pairs", "expected [a, b, a, b, ...]");
+    const std::vector<double> v = readNumbers(pairs, p + "broad_pairs", pairs.size());
+    for (std::size_t k = 0; k < v.size(); k += 2) {
+      c.broad_pairs.push_back({body(v[k], p + "broad_pairs"), body(v[k + 1], p + "broad_pairs")});
+    }
+  }
+  readEachRow(node, p, "carried", 14, [&](const double* r, const std::string& field) {
+    CarriedState::CarriedEntry e;
+    e.a = body(r[0], field + ".a");
+    e.b = body(r[1], field + ".b");
+    e.entry.b_in_a = vec3At(r + 2);
+    e.entry.a_to_b = Quat(r[8], r[5], r[6], r[7]);
+    e.entry.tolerance = r[9];
+    e.entry.leaf = SpherePair{nodeAt(r[10], field + ".leaf"), nodeAt(r[11], field + ".leaf")};
+    e.entry.level = nodeAt(r[12], field + ".level");
+    e.entry.count = wholeAt(r[13], field + ".points", 4294967295.0);
+    c.carried.push_back(e);
+  });
+  readEachRow(node, p, "carried_points", 17, [&](const double* r, const std::string& field) {
+    PairContactCache::Point pt;
+    pt.on_a = vec3At(r);
+    pt.on_b = vec3At(r + 3);
+    pt.normal = vec3At(r + 6);
+    pt.depth = r[9];
+    pt.separation = r[10];
+    pt.sphere_bound = r[11];
+    pt.node_a = nodeAt(r[12], field + ".node_a");
+    pt.node_b = nodeAt(r[13], field + ".node_b");
+    pt.level = nodeAt(r[14], field + ".level");
+    pt.normal_of_b = flagAt(r[15], field + ".normal_of_b");
+    pt.resolved = flagAt(r[16], field + ".resolved");
+    c.carried_points.push_back(pt);
+  });
+  countPoints(c.carried, c.carried_points.size(), p + "carried",
+              [](CarriedState::CarriedEntry& e) { return std::tie(e.entry.first, e.entry.count); });
+  readEachRow(node, p, "warm", 7, [&](const double* r, const std::string& field) {
+    CarriedState::Warm w;
+    w.a = body(r[0], field + ".a");
+    w.b = body(r[1], field + ".b");
+    w.held = flagAt(r[2], field + ".held");
+    w.manifold.rolling = vec3At(r + 3);
+    w.manifold.count = wholeAt(r[6], field + ".points", ContactSolver::kMaxCachedPoints);
+    c.warm.push_back(w);
+  });
+  readEachRow(node, p, "warm_points", 9, [&](const double* r, const std::string& field) {
+    ContactSolver::CachedPoint pt;
+    pt.node_a = nodeAt(r[0], field + ".node_a");
+    pt.node_b = nodeAt(r[1], field + ".node_b");
+    pt.local_a = vec3At(r + 2);
+    pt.normal = r[5];
+    pt.friction = vec3At(r + 6);
+    c.warm_points.push_back(pt);
+  });
+  countPoints(c.warm, c.warm_points.size(), p + "warm",
+              [](CarriedState::Warm& w) { return std::tie(w.manifold.first, w.manifold.count); });
+  return c;
+}
+
 }  // namespace
 
 namespace {
@@ -292,7 +464,7 @@ Scene parseSceneTree(const std::string& yaml_text) {
     throw InputError("scene", std::string("not valid YAML: ") + e.what());
   }
   if (!root.IsMap()) throw InputError("scene", "expected a map with keys gravity and entities");
-  checkKeys(root, "", {"gravity", "entities"});
+  checkKeys(root, "", {"gravity", "entities", "contact_state"});
   Scene scene;
   if (root["gravity"]) scene.gravity = readVec3(root["gravity"], "gravity");
   if (!scene.gravity.allFinite()) throw InputError("gravity", "not finite");
@@ -303,6 +475,7 @@ Scene parseSceneTree(const std::string& yaml_text) {
       parseEntity(list[i], "entities[" + std::to_string(i) + "]", scene);
     }
   }
+  if (root["contact_state"]) scene.carried = readCarried(root["contact_state"], scene.entities.size());
   return scene;
 }
 
@@ -327,6 +500,9 @@ Scene loadSceneYaml(const std::string& path) {
 
 std::vector<EntityId> addScene(World& world, const Scene& scene, const RequestDefaults& defaults,
                                MeshResolver resolve_mesh) {
+  if (scene.carried && world.entityCount() != 0) {
+    throw InputError("contact_state", "a saved world's: loaded into a world that holds no entity");
+  }
   std::vector<EntityId> ids;
   ids.reserve(scene.entities.size());
   for (const SceneEntry& entry : scene.entities) {
@@ -334,6 +510,14 @@ std::vector<EntityId> addScene(World& world, const Scene& scene, const RequestDe
       ids.push_back(addRequest(world, entry.request, defaults, resolve_mesh));
     } catch (const InputError& e) {
       throw InputError(entry.path + "." + sceneKeyOf(e.field()), e.reason());
+    }
+  }
+  if (scene.carried) {
+    try {
+      world.restoreCarried(*scene.carried);
+    } catch (const InputError& e) {
+      for (const EntityId id : ids) world.removeEntity(id);
+      throw InputError("contact_state." + e.field(), e.reason());
     }
   }
   return ids;
@@ -445,6 +629,78 @@ void putShape(std::string& out, const ShapeInfo& info) {
   out += (first ? "" : ", ") + std::to_string(run) + "]}";
 }
 
+// One row of contact_state: `values` as a flow list, on a line of its own.
+void putRow(std::string& out, std::initializer_list<double> values) {
+  out += "    - ";
+  putNumbers(out, values.begin(), values.size());
+  out += '\n';
+}
+
+// A list of rows under `key`, or [] when there is none.
+template <typename T, typename Row>
+void putRows(std::string& out, const char* key, const std::vector<T>& items, Row row) {
+  out += "  ";
+  out += key;
+  out += items.empty() ? ": []\n" : ":\n";
+  for (const T& item : items) row(item);
+}
+
+double flag(bool b) { return b ? 1.0 : 0.0; }
+
+// What the next tick carries over (World::carriedState), in the order the
+// schema gives (scene_file.hpp).
+void putCarried(std::string& out, const CarriedState& c) {
+  out += "contact_state:\n  next_group: " + std::to_string(c.next_group) + '\n';
+  putRows(out, "rest", c.rest, [&](const CarriedState::Rest& r) {
+    const auto& b = r.state.balls;
+    putRow(out, {double(r.body), flag(r.state.moving), r.state.rest_time, r.state.age, b[0].centre.x(),
+                 b[0].centre.y(), b[0].centre.z(), b[0].radius, b[1].centre.x(), b[1].centre.y(), b[1].centre.z(),
+                 b[1].radius, b[2].centre.x(), b[2].centre.y(), b[2].centre.z(), b[2].radius});
+  });
+  const SweepAndPrune::Banding& bands = c.banding;
+  out += "  banding: ";
+  putNumbers(out, std::initializer_list<double>{bands.origin[0], bands.origin[1], bands.origin[2], bands.scale[0],
+                                                bands.scale[1], bands.scale[2], bands.top[0], bands.top[1],
+                                                bands.top[2], double(bands.chosen_for)}.begin(), 10);
+  out += "\n  band_order:\n";
+  for (const auto& list : bands.endpoints) {
+    out += "    - [";
+    for (std::size_t b = 0; b < list.size(); ++b) {
+      out += b > 0 ? ", [" : "[";
+      for (std::size_t k = 0; k < list[b].size(); ++k) out += (k > 0 ? ", " : "") + std::to_string(list[b][k]);
+      out += ']';
+    }
+    out += "]\n";
+  }
+  putRows(out, "boxes", c.boxes, [&](const Aabb& box) {
+    putRow(out, {box.min.x(), box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z()});
+  });
+  out += "  broad_pairs: [";
+  for (std::size_t k = 0; k < c.broad_pairs.size(); ++k) {
+    out += (k > 0 ? ", " : "") + std::to_string(c.broad_pairs[k][0]) + ", " + std::to_string(c.broad_pairs[k][1]);
+  }
+  out += "]\n";
+  putRows(out, "carried", c.carried, [&](const CarriedState::CarriedEntry& e) {
+    const PairContactCache::Entry& x = e.entry;
+    putRow(out, {double(e.a), double(e.b), x.b_in_a.x(), x.b_in_a.y(), x.b_in_a.z(), x.a_to_b.x(), x.a_to_b.y(),
+                 x.a_to_b.z(), x.a_to_b.w(), x.tolerance, double(x.leaf.a), double(x.leaf.b), double(x.level),
+                 double(x.count)});
+  });
+  putRows(out, "carried_points", c.carried_points, [&](const PairContactCache::Point& p) {
+    putRow(out, {p.on_a.x(), p.on_a.y(), p.on_a.z(), p.on_b.x(), p.on_b.y(), p.on_b.z(), p.normal.x(), p.normal.y(),
+                 p.normal.z(), p.depth, p.separation, p.sphere_bound, double(p.node_a), double(p.node_b),
+                 double(p.level), flag(p.normal_of_b), flag(p.resolved)});
+  });
+  putRows(out, "warm", c.warm, [&](const CarriedState::Warm& w) {
+    const Vec3& r = w.manifold.rolling;
+    putRow(out, {double(w.a), double(w.b), flag(w.held), r.x(), r.y(), r.z(), double(w.manifold.count)});
+  });
+  putRows(out, "warm_points", c.warm_points, [&](const ContactSolver::CachedPoint& p) {
+    putRow(out, {double(p.node_a), double(p.node_b), p.local_a.x(), p.local_a.y(), p.local_a.z(), p.normal,
+                 p.friction.x(), p.friction.y(), p.friction.z()});
+  });
+}
+
 }  // namespace
 
 std::string writeSceneYaml(const World& world, const ColorOf& color_of) {
@@ -490,6 +746,7 @@ std::string writeSceneYaml(const World& world, const ColorOf& color_of) {
     }
     out += "}\n";
   }
+  putCarried(out, world.carriedState());
   return out;
 }
 

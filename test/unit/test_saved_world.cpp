@@ -4,6 +4,8 @@
 #include "sphere_tree_collision/scene/scene_file.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 
+#include "../support/same_state.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -294,6 +296,115 @@ TEST(SavedWorld, OnlyARestoredMovableBodyAtRestSleeps) {
   EXPECT_EQ(refused("sleep: 1, repeat: {count: [2, 1, 1], spacing: [1, 0, 0]}"), "entities[0].sleep");
   EXPECT_EQ(refused("sleep: 2"), "accepted");
   EXPECT_EQ(refused("sleep: 0, velocity: [0, 0, 1]"), "accepted");
+}
+
+
+// Awake bodies in contact (a rockfall of 300 rocks after 120 ticks): the
+// contacts carried between ticks, the warm start, the rest timers and the
+// broad phase's pairs are in the file (contact_state), so the next 300 ticks
+// are the saved world's, bit for bit, contacts included, at 1 and 2 threads.
+TEST(SavedWorld, ATouchingWorldGoesOnTheSame) {
+  for (int threads : {1, 2}) {
+    SceneParams params;
+    params.entities = 300;
+    WorldConfig config;
+    config.threads = threads;
+    SceneWorld made = makeSceneWorld(SceneKind::Rockfall, params, config);
+    for (int t = 0; t < 120; ++t) made.world.step(made.spec.dt, Budget::unlimited());
+    ASSERT_GT(made.world.contacts().size(), 100u);
+    WorldConfig loaded_config = made.world.config();
+    World loaded = loadSaved(writeSceneYaml(made.world), loaded_config);
+    int first_different = -1;
+    for (int t = 0; t < 300 && first_different < 0; ++t) {
+      made.world.step(made.spec.dt, Budget::unlimited());
+      loaded.step(made.spec.dt, Budget::unlimited());
+      if (!sameState(made.world, loaded)) first_different = t;
+    }
+    for (int t = first_different < 0 ? 300 : first_different; t < 300; ++t) {
+      made.world.step(made.spec.dt, Budget::unlimited());
+      loaded.step(made.spec.dt, Budget::unlimited());
+    }
+    EXPECT_EQ(first_different, -1) << threads << " threads: " << sameState(made.world, loaded).message()
+                                   << "; 300 ticks later up to " << maxPositionGap(made.world, loaded) << " m apart";
+    // What both carry on to the next tick is the same too.
+    EXPECT_TRUE(writeSceneYaml(made.world) == writeSceneYaml(loaded)) << threads << " threads";
+  }
+}
+
+// `yaml` with the block of contact_state's `key` (its line and the rows
+// under it) replaced by `block` (lines, each ending in a newline; "" drops it).
+std::string withCarried(const std::string& yaml, const std::string& key, const std::string& block) {
+  const std::size_t at = yaml.find("\n  " + key + ":", yaml.find("contact_state:"));
+  EXPECT_NE(at, std::string::npos) << key;
+  std::size_t end = yaml.find('\n', at + 1);
+  while (end != std::string::npos && yaml.compare(end + 1, 4, "    ") == 0) end = yaml.find('\n', end + 1);
+  return yaml.substr(0, at + 1) + block + (end == std::string::npos ? "" : yaml.substr(end + 1));
+}
+
+// The field a saved world is refused by, parsed and added to a new World
+// (which then holds nothing), or "accepted".
+std::string refusedWorldField(const std::string& yaml) {
+  World world(meshConfig(1));
+  try {
+    addScene(world, parseSceneYaml(yaml));
+  } catch (const InputError& e) {
+    EXPECT_EQ(world.entityCount(), 0u) << e.what();
+    return e.field();
+  }
+  return "accepted";
+}
+
+// A malformed contact_state is refused by the field, and the entities its
+// file added are removed again.
+TEST(SavedWorld, ABadContactStateIsRefusedByField) {
+  World world = mixedWorld(meshConfig(1));
+  for (int t = 0; t < 20; ++t) world.step(1.0 / 60.0, Budget::unlimited());
+  ASSERT_FALSE(world.contacts().empty());
+  const std::string yaml = writeSceneYaml(world);
+  ASSERT_NE(yaml.find("\n  warm:\n"), std::string::npos);
+  EXPECT_EQ(refusedWorldField(yaml), "accepted");
+  const std::string row16 = "[9, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]";
+  const std::string floor_row = "[0" + row16.substr(2);
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "next_group", "  next_group: 0\n")), "contact_state.next_group");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "rest", "  rest:\n    - [1, 0, 0]\n")), "contact_state.rest[0]");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "rest", "  rest:\n    - " + row16 + "\n")),
+            "contact_state.rest[0].body");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "rest", "  rest:\n    - " + floor_row + "\n")),
+            "contact_state.rest[0].body");  // the floor: static
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "banding", "  banding: [0, 0, 0, 1, 1, 1, 0.5, 0, 0, 7]\n")),
+            "contact_state.banding");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "band_order", "  band_order: [[[]], [[]], [[]]]\n")),
+            "contact_state.banding");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "band_order", "  band_order: [[], []]\n")),
+            "contact_state.band_order");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "boxes", "  boxes: []\n")), "contact_state.boxes");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "broad_pairs", "  broad_pairs: [0]\n")), "contact_state.broad_pairs");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "broad_pairs", "  broad_pairs: []\n")), "contact_state.broad_pairs");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "carried_points", "  carried_points: []\n")),
+            yaml.find("\n  carried: []") == std::string::npos ? "contact_state.carried" : "accepted");
+  // A carried entry's leaf pair names nodes of the two bodies' trees.
+  EXPECT_EQ(refusedWorldField(withCarried(withCarried(yaml, "carried_points", "  carried_points: []\n"), "carried",
+                                          "  carried:\n    - [0, 1, 0, 0, 0, 0, 0, 0, 1, 0, 100000, 0, 0, 0]\n")),
+            "contact_state.carried[0].leaf");
+  EXPECT_EQ(refusedWorldField(withCarried(withCarried(yaml, "carried_points", "  carried_points: []\n"), "carried",
+                                          "  carried:\n    - [0, 1, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0]\n")),
+            "accepted");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "warm_points", "  warm_points: []\n")), "contact_state.warm");
+  EXPECT_EQ(refusedWorldField(withCarried(withCarried(yaml, "warm_points", "  warm_points: []\n"), "warm",
+                                          "  warm:\n    - [1, 1, 0, 0, 0, 0, 0]\n")),
+            "contact_state.warm[0]");  // a body with itself
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "warm", "  warm:\n    - [0, 1, 0, 0, 0, 0, 33]\n")),
+            "contact_state.warm[0].points");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "next_group", "  next_group: 1\n  extra: 1\n")),
+            "contact_state.extra");
+  // A saved world's state goes into a world that holds nothing yet.
+  World busy = mixedWorld(meshConfig(1));
+  try {
+    addScene(busy, parseSceneYaml(yaml));
+    ADD_FAILURE() << "loaded into a world with entities";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "contact_state");
+  }
 }
 
 }  // namespace

@@ -26,6 +26,18 @@
 //       resolution: 32           # voxels along the mesh's longest side, unless voxel_size is given
 //     - grid: {size: [2, 1, 1], voxel_size: 0.05, runs: [0, 2]}   # instead of preset: voxels, x fastest,
 //                                # as run lengths alternating empty and solid, empty first
+//   contact_state:               # a saved world's (World::carriedState), bodies by place in entities:
+//     next_group: 4              # the group the next island to fall asleep takes
+//     rest: [[body, moving, rest_time, age, 3 x (ball centre x, y, z, radius)], ...]   # awake bodies
+//     banding: [origin x, y, z, scale x, y, z, top x, y, z, boxes]   # the broad phase's bands
+//     band_order: [[[2 body + is_max, ...], ...], [...], [...]]   # per list, each band's endpoints in order
+//     boxes: [[min x, y, z, max x, y, z], ...]   # one a body: its broad-phase box
+//     broad_pairs: [a, b, a, b, ...]             # the broad phase's pairs, in order
+//     carried: [[a, b, B in A x, y, z, A to B quat x, y, z, w, tolerance, leaf a, leaf b, level, points], ...]
+//     carried_points: [[on a x, y, z, on b x, y, z, normal x, y, z, depth, separation, sphere bound,
+//                       node a, node b, level, normal of b, resolved], ...]   # the entries' points in turn
+//     warm: [[a, b, held, rolling x, y, z, points], ...]   # the solver's warm start
+//     warm_points: [[node a, node b, local a x, y, z, normal, friction x, y, z], ...]
 #pragma once
 
 #include "sphere_tree_collision/scene/entity_request.hpp"
@@ -45,6 +57,9 @@ struct SceneEntry {
 struct Scene {
   Vec3 gravity = Vec3::Zero();
   std::vector<SceneEntry> entities;  // repeats already expanded
+  // A saved world's contact_state: what its next tick carries over (bodies by
+  // place in `entities`); none: it starts afresh.
+  std::optional<CarriedState> carried;
 };
 
 // Throws InputError naming the field, e.g. "entities[2].position".
@@ -60,10 +75,11 @@ using ColorOf = std::function<std::optional<Rgba>(EntityId)>;
 // else its voxels as a grid), pose (orientation as unit_quat: kept bit for
 // bit), velocities, density, material, colour (by `color_of`), static flag,
 // box mode (as resolved), closed faces and sleep group. Numbers are written
-// to 17 significant digits: they read back as the same bits. The new World's
-// ids are 0, 1, ... in that order; the contacts carried between ticks, the
-// warm start and awake bodies' rest timers start afresh
-// (docs/ros_interface.md, "Saved worlds").
+// to 17 significant digits: they read back as the same bits. Then what the
+// next tick carries over (World::carriedState) as contact_state: the
+// contacts carried between ticks, the warm start, awake bodies' rest timers
+// and the broad phase's boxes, bands and pair order. The new World's ids are
+// 0, 1, ... in that order (docs/ros_interface.md, "Saved worlds").
 std::string writeSceneYaml(const World& world, const ColorOf& color_of = nullptr);
 
 // `text` into `path` atomically: a temporary file beside it, flushed, then
@@ -76,7 +92,9 @@ const std::string& defaultSceneYaml();
 
 // Adds every entity (addRequest, with `defaults` for the fields left out or
 // at 0), returns their ids in scene order. Throws
-// InputError("entities[i].<field>") on the first bad one.
+// InputError("entities[i].<field>") on the first bad one. A contact_state
+// is then put back (World::restoreCarried; into a World that held no entity);
+// refused, InputError("contact_state.<field>"), the entities are removed again.
 std::vector<EntityId> addScene(World& world, const Scene& scene, const RequestDefaults& defaults = {},
                                MeshResolver resolve_mesh = meshPathWithinRoots);
 

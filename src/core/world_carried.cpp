@@ -1,0 +1,191 @@
+// World: what a tick carries over to the next (carried_state.hpp), out for
+// a saved world and back into the loaded one.
+#include "sphere_tree_collision/world.hpp"
+
+#include "flat_hash_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace stc {
+namespace {
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+
+void require(bool ok, const std::string& field, const char* reason) {
+  if (!ok) throw InputError(field, reason);
+}
+
+std::string at(const char* part, std::size_t k) { return std::string(part) + "[" + std::to_string(k) + "]"; }
+
+// Points [first, first + count) of `points` of size `size`, at most `most`.
+void requireRange(std::uint32_t first, std::uint32_t count, std::size_t size, std::uint32_t most,
+                  const std::string& field) {
+  require(count <= most && std::uint64_t{first} + count <= size, field,
+          "its points run past the points given (or more than a pair keeps)");
+}
+
+}  // namespace
+
+CarriedState World::carriedState() const {
+  CarriedState out;
+  const std::size_t n = ids_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!bodies_[i].is_static && !islands_.isSleeping(i)) {
+      out.rest.push_back({static_cast<std::uint32_t>(i), islands_.rest(i)});
+    }
+  }
+  out.next_group = islands_.nextGroup();
+  out.boxes.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) out.boxes.push_back(broad_phase_.box(ids_[i]));
+  out.banding = broad_phase_.banding();
+  for (auto& list : out.banding.endpoints) {  // ids to dense indices
+    for (std::vector<std::uint64_t>& band : list) {
+      for (std::uint64_t& e : band) e = std::uint64_t{index_of_->find(static_cast<EntityId>(e >> 1))} << 1 | (e & 1u);
+    }
+  }
+  // A body removed at the tick's end (quarantine) still has its pairs until
+  // the next update: they are left out.
+  const auto indexOfId = [&](EntityId id) { return index_of_->find(id); };
+  constexpr std::uint32_t kMissing = detail::FlatHashMap::kMissing;
+  for (const BroadPair& pair : broad_phase_.pairs()) {
+    const std::uint32_t a = indexOfId(pair.first), b = indexOfId(pair.second);
+    if (a != kMissing && b != kMissing) out.broad_pairs.push_back({a, b});
+  }
+  const PairContactCache& cache = physics_.pairCache();
+  for (const PairContactCache::Entry& e : cache.entries()) {
+    const std::uint32_t a = indexOfId(static_cast<EntityId>(e.key >> 32));
+    const std::uint32_t b = indexOfId(static_cast<EntityId>(e.key & 0xffffffffu));
+    if (a == kMissing || b == kMissing) continue;
+    CarriedState::CarriedEntry entry{a, b, e};
+    entry.entry.first = static_cast<std::uint32_t>(out.carried_points.size());
+    out.carried_points.insert(out.carried_points.end(), cache.points().begin() + e.first,
+                              cache.points().begin() + e.first + e.count);
+    out.carried.push_back(entry);
+  }
+  const ContactSolver& solver = physics_.solver();
+  for (const ContactSolver::WarmStart& store : {solver.solved(), solver.held()}) {
+    const bool held = store.manifolds == solver.held().manifolds;
+    for (const ContactSolver::CachedManifold& m : *store.manifolds) {
+      const std::uint32_t a = indexOfId(static_cast<EntityId>(m.pair >> 32));
+      const std::uint32_t b = indexOfId(static_cast<EntityId>(m.pair & 0xffffffffu));
+      if (a == kMissing || b == kMissing) continue;
+      CarriedState::Warm warm{a, b, held, m};
+      warm.manifold.first = static_cast<std::uint32_t>(out.warm_points.size());
+      out.warm_points.insert(out.warm_points.end(), store.points->begin() + m.first,
+                             store.points->begin() + m.first + m.count);
+      out.warm.push_back(warm);
+    }
+  }
+  return out;
+}
+
+void World::restoreCarried(const CarriedState& state) {
+  const std::size_t n = ids_.size();
+  // Everything checked before anything changes.
+  for (std::size_t k = 0; k < state.rest.size(); ++k) {
+    const CarriedState::Rest& r = state.rest[k];
+    require(r.body < n && !bodies_[r.body].is_static && !islands_.isSleeping(r.body), at("rest", k) + ".body",
+            "not an awake movable body");
+    bool ok = std::isfinite(r.state.rest_time) && r.state.rest_time >= 0.0 && std::isfinite(r.state.age) &&
+              r.state.age >= 0.0;
+    for (const Sphere& ball : r.state.balls) ok = ok && finite(ball.centre) && std::isfinite(ball.radius);
+    require(ok, at("rest", k), "times finite and >= 0, balls finite");
+  }
+  require(state.next_group > 0, "next_group", "must be > 0");
+  require(state.boxes.size() == n, "boxes", "one a body");
+  for (std::size_t i = 0; i < n; ++i) {
+    const Aabb& box = state.boxes[i];
+    require(finite(box.min) && finite(box.max) && (box.min.array() <= box.max.array()).all(), at("boxes", i),
+            "corners finite, min <= max");
+  }
+  std::vector<BroadPair> pairs;
+  pairs.reserve(state.broad_pairs.size());
+  for (std::size_t k = 0; k < state.broad_pairs.size(); ++k) {
+    const auto& p = state.broad_pairs[k];
+    require(p[0] < n && p[1] < n && p[0] != p[1], at("broad_pairs", k), "two bodies of the world");
+    pairs.push_back({std::min(ids_[p[0]], ids_[p[1]]), std::max(ids_[p[0]], ids_[p[1]])});
+  }
+  SweepAndPrune::Banding banding = state.banding;
+  for (auto& list : banding.endpoints) {  // dense indices to ids
+    for (std::vector<std::uint64_t>& band : list) {
+      for (std::uint64_t& e : band) {
+        require(e >> 1 < n, "banding.endpoints", "a body of the world");
+        e = std::uint64_t{ids_[e >> 1]} << 1 | (e & 1u);
+      }
+    }
+  }
+  std::vector<PairContactCache::Entry> entries;
+  entries.reserve(state.carried.size());
+  for (std::size_t k = 0; k < state.carried.size(); ++k) {
+    const CarriedState::CarriedEntry& c = state.carried[k];
+    const PairContactCache::Entry& e = c.entry;
+    require(c.a < n && c.b < n && c.a != c.b, at("carried", k), "two bodies of the world");
+    require(finite(e.b_in_a) && e.a_to_b.coeffs().allFinite() && std::isfinite(e.tolerance), at("carried", k),
+            "not finite");
+    requireRange(e.first, e.count, state.carried_points.size(), 0xffffffffu, at("carried", k) + ".points");
+    // The leaf pair a resumed test starts from: nodes of the two trees.
+    const SphereTree& tree_a = shapes_[body_shapes_[c.a]].tree;
+    const SphereTree& tree_b = shapes_[body_shapes_[c.b]].tree;
+    require(e.leaf.a >= 0 && static_cast<std::size_t>(e.leaf.a) < tree_a.nodes().size() && e.leaf.b >= 0 &&
+                static_cast<std::size_t>(e.leaf.b) < tree_b.nodes().size(),
+            at("carried", k) + ".leaf", "not a node of each body's tree");
+    require(e.level >= 0 && e.level < std::max(tree_a.levelCount(), tree_b.levelCount()), at("carried", k) + ".level",
+            "not a level of the trees");
+    entries.push_back(e);
+    entries.back().key = entityPairKey(ids_[c.a], ids_[c.b]);
+  }
+  for (std::size_t k = 0; k < state.carried_points.size(); ++k) {
+    const PairContactCache::Point& p = state.carried_points[k];
+    require(finite(p.on_a) && finite(p.on_b) && finite(p.normal) && std::isfinite(p.depth) &&
+                std::isfinite(p.separation) && std::isfinite(p.sphere_bound),
+            at("carried_points", k), "not finite");
+  }
+  std::vector<ContactSolver::CachedManifold> solved, held;
+  std::vector<ContactSolver::CachedPoint> solved_points, held_points;
+  for (std::size_t k = 0; k < state.warm.size(); ++k) {
+    const CarriedState::Warm& w = state.warm[k];
+    require(w.a < n && w.b < n && w.a != w.b, at("warm", k), "two bodies of the world");
+    require(finite(w.manifold.rolling), at("warm", k), "not finite");
+    requireRange(w.manifold.first, w.manifold.count, state.warm_points.size(), ContactSolver::kMaxCachedPoints,
+                 at("warm", k) + ".points");
+    std::vector<ContactSolver::CachedPoint>& points = w.held ? held_points : solved_points;
+    ContactSolver::CachedManifold m = w.manifold;
+    m.pair = entityPairKey(ids_[w.a], ids_[w.b]);
+    m.index_a = w.a;
+    m.index_b = w.b;
+    m.first = static_cast<std::uint32_t>(points.size());
+    points.insert(points.end(), state.warm_points.begin() + w.manifold.first,
+                  state.warm_points.begin() + w.manifold.first + w.manifold.count);
+    (w.held ? held : solved).push_back(m);
+  }
+  for (std::size_t k = 0; k < state.warm_points.size(); ++k) {
+    const ContactSolver::CachedPoint& p = state.warm_points[k];
+    require(finite(p.local_a) && std::isfinite(p.normal) && finite(p.friction), at("warm_points", k), "not finite");
+  }
+
+  // The broad phase last: its pairs must be those of the boxes (else it
+  // throws, and the boxes it had are put back).
+  std::vector<Aabb> had;
+  had.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) had.push_back(broad_phase_.box(ids_[i]));
+  try {
+    for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(ids_[i], state.boxes[i]);
+    broad_phase_.restore(banding, pairs);
+  } catch (const InputError& e) {
+    for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(ids_[i], had[i]);
+    throw InputError(e.field() == "pairs" ? "broad_pairs" : e.field(), e.reason());
+  }
+  pairs_seen_.clear();
+  for (const CarriedState::Rest& r : state.rest) islands_.restoreRest(r.body, r.state);
+  islands_.setNextGroup(state.next_group);
+  // The static bodies' covered faces measured now, as the saved world had
+  // them: measured at the first tick, they would drop the carried contacts.
+  static_cover_.update(bodies_, body_shapes_, cover_shapes_);
+  physics_.restoreCarried(entries, state.carried_points);
+  physics_.solver().restore(std::move(solved), std::move(solved_points), std::move(held), std::move(held_points));
+  invalidateLastTick();
+}
+
+}  // namespace stc
