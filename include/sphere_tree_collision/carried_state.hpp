@@ -28,7 +28,9 @@ struct CarriedState {
   std::uint32_t next_group = 1;  // the next island to fall asleep takes this group
 
   // Per body, the box the broad phase holds; its bands (SweepAndPrune::Banding);
-  // its pairs in their order, as dense indices.
+  // its pairs in their order, as dense indices. No boxes: the broad phase
+  // starts afresh (saved before its first update, or with entities added or
+  // removed since its last: SweepAndPrune::settled).
   std::vector<Aabb> boxes;
   SweepAndPrune::Banding banding;
   std::vector<std::array<std::uint32_t, 2>> broad_pairs;

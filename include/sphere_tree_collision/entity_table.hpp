@@ -57,9 +57,11 @@ class EntityTable {
   bool idsLeft() const { return next_id_ != kInvalidEntity; }
 
  protected:
-  // A row at the end (dense index entityCount() - 1) with the next id, which
-  // is returned. The name is empty or unused (checked by the caller).
-  EntityId addRow(const BodyState& body, ShapeId shape, BoxMode box_mode, double density, std::string name);
+  // A row at the end (dense index entityCount() - 1) with the next id, or
+  // `id` (unused; later ids count on from it), which is returned. The name
+  // is empty or unused (checked by the caller).
+  EntityId addRow(const BodyState& body, ShapeId shape, BoxMode box_mode, double density, std::string name,
+                  EntityId id = kInvalidEntity);
   // Row `index` removed: the last row takes its place.
   void removeRow(std::size_t index);
   // Every row removed; ids go on counting.

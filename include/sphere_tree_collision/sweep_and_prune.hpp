@@ -64,6 +64,9 @@ class SweepAndPrune {
     std::array<std::vector<std::vector<std::uint64_t>>, 3> endpoints;
   };
   Banding banding() const;
+  // Updated at least once, and nothing added or removed since: its pairs
+  // are those of its boxes (what restore() needs).
+  bool settled() const;
   // A saved world's broad phase (CarriedState): rebuilt for the boxes it
   // holds now with these bands, its pairs then in `order`, as the saved one
   // had them after its last update (the next updates then find and drop

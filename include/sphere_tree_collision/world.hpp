@@ -95,6 +95,10 @@ struct EntitySpec {
   // with sleeping or the response off. Throws InputError("sleep").
   bool restored = false;
   std::uint32_t sleep_group = 0;
+  // The id it had in a saved world: kept, so that its pairs' bodies come in
+  // the same order (the lower id first) and its frame keeps its name.
+  // kInvalidEntity: the next id. One in use: InputError("id").
+  EntityId id = kInvalidEntity;
 };
 
 // One entity removed at the end of a tick, and why.

@@ -26,9 +26,14 @@ std::optional<EntityId> EntityTable::findByName(const std::string& name) const {
   return it->second;
 }
 
-EntityId EntityTable::addRow(const BodyState& body, ShapeId shape, BoxMode box_mode, double density, std::string name) {
-  assert(idsLeft() && (name.empty() || id_by_name_.count(name) == 0));
-  const EntityId id = next_id_++;
+EntityId EntityTable::addRow(const BodyState& body, ShapeId shape, BoxMode box_mode, double density, std::string name,
+                             EntityId id) {
+  assert((id != kInvalidEntity ? !indexOf(id) : idsLeft()) && (name.empty() || id_by_name_.count(name) == 0));
+  if (id == kInvalidEntity) {
+    id = next_id_++;
+  } else if (id >= next_id_ && next_id_ != kInvalidEntity) {
+    next_id_ = id + 1;  // kInvalidEntity after the last id: none left
+  }
   const std::size_t index = ids_.size();
   ids_.push_back(id);
   bodies_.push_back(body);

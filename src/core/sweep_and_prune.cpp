@@ -159,6 +159,7 @@ struct SweepAndPrune::Impl {
   // the updates since it (the first update is a full one).
   Quantiser filter_q[3];
   int updates_since_full = kFullEvery;
+  bool updated = false;  // update() ran at least once
 
   // Pair set: pairs (owned by SweepAndPrune) and pair_keys are parallel dense
   // arrays; pair_index maps a key to its index there.
@@ -796,6 +797,11 @@ void SweepAndPrune::releaseMemory() {
   *this = std::move(fitted);
 }
 
+bool SweepAndPrune::settled() const {
+  const Impl& m = *impl_;
+  return m.updated && m.added.empty() && m.removed.empty();
+}
+
 SweepAndPrune::Banding SweepAndPrune::banding() const {
   const Impl& m = *impl_;
   Banding out;
@@ -905,6 +911,7 @@ void SweepAndPrune::setBox(EntityId id, const Aabb& box) {
 
 void SweepAndPrune::update() {
   Impl& m = *impl_;
+  m.updated = true;
   if (!m.removed.empty()) m.dropRemoved(pairs_);
   const bool rebanded = m.bandsStale();
   if (rebanded) m.chooseBands(pairs_);

@@ -81,7 +81,10 @@ void World::validateEntity(const EntitySpec& spec) const {
     throw InputError("closed_faces", "static bodies only, a mask of faceBit values (at most " +
                                          std::to_string(kAllFaces) + ")");
   }
-  if (ids_.size() >= config_.max_entities || !idsLeft()) {
+  if (spec.id != kInvalidEntity && indexOf(spec.id)) {
+    throw InputError("id", std::to_string(spec.id) + " is already used");
+  }
+  if (ids_.size() >= config_.max_entities || (spec.id == kInvalidEntity && !idsLeft())) {
     throw InputError("max_entities", "the world holds " + std::to_string(config_.max_entities) +
                                          " entities at most");
   }
@@ -109,7 +112,7 @@ EntityId World::addEntity(const EntitySpec& spec) {
   if (mode == BoxMode::Auto) mode = info.elongated ? BoxMode::Dynamic : BoxMode::FixedCube;
 
   // The row, then what follows it.
-  const EntityId id = addRow(body, spec.shape, mode, spec.density, spec.name);
+  const EntityId id = addRow(body, spec.shape, mode, spec.density, spec.name, spec.id);
   const std::size_t index = ids_.size() - 1;
   static_cover_.add(body, spec.closed_faces);
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once

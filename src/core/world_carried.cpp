@@ -37,21 +37,18 @@ CarriedState World::carriedState() const {
     }
   }
   out.next_group = islands_.nextGroup();
-  out.boxes.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) out.boxes.push_back(broad_phase_.box(ids_[i]));
-  out.banding = broad_phase_.banding();
-  for (auto& list : out.banding.endpoints) {  // ids to dense indices
-    for (std::vector<std::uint64_t>& band : list) {
-      for (std::uint64_t& e : band) e = std::uint64_t{index_of_->find(static_cast<EntityId>(e >> 1))} << 1 | (e & 1u);
-    }
-  }
-  // A body removed at the tick's end (quarantine) still has its pairs until
-  // the next update: they are left out.
   const auto indexOfId = [&](EntityId id) { return index_of_->find(id); };
   constexpr std::uint32_t kMissing = detail::FlatHashMap::kMissing;
-  for (const BroadPair& pair : broad_phase_.pairs()) {
-    const std::uint32_t a = indexOfId(pair.first), b = indexOfId(pair.second);
-    if (a != kMissing && b != kMissing) out.broad_pairs.push_back({a, b});
+  if (broad_phase_.settled()) {
+    out.boxes.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) out.boxes.push_back(broad_phase_.box(ids_[i]));
+    out.banding = broad_phase_.banding();
+    for (auto& list : out.banding.endpoints) {  // ids to dense indices
+      for (std::vector<std::uint64_t>& band : list) {
+        for (std::uint64_t& e : band) e = std::uint64_t{indexOfId(static_cast<EntityId>(e >> 1))} << 1 | (e & 1u);
+      }
+    }
+    for (const BroadPair& pair : broad_phase_.pairs()) out.broad_pairs.push_back({indexOfId(pair.first), indexOfId(pair.second)});
   }
   const PairContactCache& cache = physics_.pairCache();
   for (const PairContactCache::Entry& e : cache.entries()) {
@@ -94,8 +91,10 @@ void World::restoreCarried(const CarriedState& state) {
     require(ok, at("rest", k), "times finite and >= 0, balls finite");
   }
   require(state.next_group > 0, "next_group", "must be > 0");
-  require(state.boxes.size() == n, "boxes", "one a body");
-  for (std::size_t i = 0; i < n; ++i) {
+  const bool broad = !state.boxes.empty();  // else the broad phase starts afresh
+  require(!broad || state.boxes.size() == n, "boxes", "one a body");
+  require(broad || state.broad_pairs.empty(), "broad_pairs", "not without boxes");
+  for (std::size_t i = 0; i < state.boxes.size(); ++i) {
     const Aabb& box = state.boxes[i];
     require(finite(box.min) && finite(box.max) && (box.min.array() <= box.max.array()).all(), at("boxes", i),
             "corners finite, min <= max");
@@ -167,15 +166,17 @@ void World::restoreCarried(const CarriedState& state) {
 
   // The broad phase last: its pairs must be those of the boxes (else it
   // throws, and the boxes it had are put back).
-  std::vector<Aabb> had;
-  had.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) had.push_back(broad_phase_.box(ids_[i]));
-  try {
-    for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(ids_[i], state.boxes[i]);
-    broad_phase_.restore(banding, pairs);
-  } catch (const InputError& e) {
-    for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(ids_[i], had[i]);
-    throw InputError(e.field() == "pairs" ? "broad_pairs" : e.field(), e.reason());
+  if (broad) {
+    std::vector<Aabb> had;
+    had.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) had.push_back(broad_phase_.box(ids_[i]));
+    try {
+      for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(ids_[i], state.boxes[i]);
+      broad_phase_.restore(banding, pairs);
+    } catch (const InputError& e) {
+      for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(ids_[i], had[i]);
+      throw InputError(e.field() == "pairs" ? "broad_pairs" : e.field(), e.reason());
+    }
   }
   pairs_seen_.clear();
   for (const CarriedState::Rest& r : state.rest) islands_.restoreRest(r.body, r.state);

@@ -168,7 +168,7 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
             {"name", "preset", "resolution", "voxel_size", "seed", "position", "orientation", "velocity",
              "angular_velocity", "density", "restitution", "friction", "color", "static", "box_mode",
              "repeat", "mesh_resource", "scale", "strength", "rolling_resistance", "up_axis", "closed_faces",
-             "grid", "sleep"});
+             "grid", "sleep", "id"});
   // Which shape source, and what belongs to it, is validateRequest's to judge
   // when the scene is added: a file, a topic and a service refuse alike.
   EntityRequest r;
@@ -198,6 +198,10 @@ void parseEntity(const YAML::Node& node, const std::string& path, Scene& scene) 
     if (node["repeat"]) throw InputError(p + "sleep", "not with repeat");
     r.spec.restored = true;
     r.spec.sleep_group = static_cast<std::uint32_t>(readInt(node["sleep"], p + "sleep", 0, 0xffffffffll));
+  }
+  if (node["id"]) {  // a saved world's entity keeps its id
+    if (node["repeat"]) throw InputError(p + "id", "not with repeat");
+    r.spec.id = static_cast<EntityId>(readInt(node["id"], p + "id", 0, kInvalidEntity - 1));
   }
   if (node["grid"]) {
     for (const char* key : {"resolution", "voxel_size", "seed"}) {
@@ -302,6 +306,12 @@ std::uint32_t wholeAt(double v, const std::string& field, double hi) {
   return static_cast<std::uint32_t>(v);
 }
 
+// The place of one of the scene's `bodies` entities.
+std::uint32_t bodyAt(double v, const std::string& field, std::size_t bodies) {
+  if (bodies == 0) throw InputError(field, "no entity to name");
+  return wholeAt(v, field, static_cast<double>(bodies - 1));
+}
+
 std::int32_t nodeAt(double v, const std::string& field) {
   if (!(v >= -2147483648.0 && v <= 2147483647.0 && v == std::floor(v))) {
     throw InputError(field, "expected a 32-bit integer");
@@ -341,32 +351,11 @@ void readEachRow(const YAML::Node& node, const std::string& p, const char* key, 
   for (std::size_t k = 0; k * width < v.size(); ++k) row(v.data() + k * width, p + key + "[" + std::to_string(k) + "]");
 }
 
-// contact_state (World::carriedState), `bodies` the scene's entities; the
-// World checks what it alone knows (which bodies are awake and movable, the
-// pairs of the boxes, the bands' endpoints) when it is put back.
-CarriedState readCarried(const YAML::Node& node, std::size_t bodies) {
+// contact_state's broad phase: its bands, each band's endpoints, the boxes
+// (one a body) and the pairs in order.
+void readBroadPhase(const YAML::Node& node, std::size_t bodies, CarriedState& c) {
   const std::string p = "contact_state.";
-  if (!node.IsMap()) throw InputError("contact_state", "expected a map");
-  checkKeys(node, p, {"next_group", "rest", "banding", "band_order", "boxes", "broad_pairs", "carried",
-                      "carried_points", "warm", "warm_points"});
-  for (const char* key : {"next_group", "banding", "band_order", "boxes"}) {
-    if (!node[key]) throw InputError(p + key, "missing");
-  }
-  const auto body = [&](double v, const std::string& field) {
-    if (bodies == 0) throw InputError(field, "no entity to name");
-    return wholeAt(v, field, static_cast<double>(bodies - 1));
-  };
-  CarriedState c;
-  c.next_group = static_cast<std::uint32_t>(readInt(node["next_group"], p + "next_group", 1, 0xffffffffll));
-  readEachRow(node, p, "rest", 16, [&](const double* r, const std::string& field) {
-    CarriedState::Rest rest;
-    rest.body = body(r[0], field + ".body");
-    rest.state.moving = flagAt(r[1], field + ".moving");
-    rest.state.rest_time = r[2];
-    rest.state.age = r[3];
-    for (int b = 0; b < 3; ++b) rest.state.balls[b] = Sphere{vec3At(r + 4 + 4 * b), r[7 + 4 * b]};
-    c.rest.push_back(rest);
-  });
+  const auto body = [&](double v, const std::string& field) { return bodyAt(v, field, bodies); };
   const std::vector<double> banding = readNumbers(node["banding"], p + "banding", 10);
   for (int a = 0; a < 3; ++a) {
     c.banding.origin[a] = banding[a];
@@ -400,6 +389,34 @@ CarriedState readCarried(const YAML::Node& node, std::size_t bodies) {
       c.broad_pairs.push_back({body(v[k], p + "broad_pairs"), body(v[k + 1], p + "broad_pairs")});
     }
   }
+}
+
+// contact_state (World::carriedState), `bodies` the scene's entities; the
+// World checks what it alone knows (which bodies are awake and movable, the
+// pairs of the boxes, the bands' endpoints) when it is put back.
+CarriedState readCarried(const YAML::Node& node, std::size_t bodies) {
+  const std::string p = "contact_state.";
+  if (!node.IsMap()) throw InputError("contact_state", "expected a map");
+  checkKeys(node, p, {"next_group", "rest", "banding", "band_order", "boxes", "broad_pairs", "carried",
+                      "carried_points", "warm", "warm_points"});
+  if (!node["next_group"]) throw InputError(p + "next_group", "missing");
+  // The broad phase's parts come together, or none (it starts afresh).
+  for (const char* key : {"banding", "band_order", "broad_pairs"}) {
+    if (!node[key] != !node["boxes"]) throw InputError(p + key, node["boxes"] ? "missing" : "not without boxes");
+  }
+  const auto body = [&](double v, const std::string& field) { return bodyAt(v, field, bodies); };
+  CarriedState c;
+  c.next_group = static_cast<std::uint32_t>(readInt(node["next_group"], p + "next_group", 1, 0xffffffffll));
+  readEachRow(node, p, "rest", 16, [&](const double* r, const std::string& field) {
+    CarriedState::Rest rest;
+    rest.body = body(r[0], field + ".body");
+    rest.state.moving = flagAt(r[1], field + ".moving");
+    rest.state.rest_time = r[2];
+    rest.state.age = r[3];
+    for (int b = 0; b < 3; ++b) rest.state.balls[b] = Sphere{vec3At(r + 4 + 4 * b), r[7 + 4 * b]};
+    c.rest.push_back(rest);
+  });
+  if (node["boxes"]) readBroadPhase(node, bodies, c);
   readEachRow(node, p, "carried", 14, [&](const double* r, const std::string& field) {
     CarriedState::CarriedEntry e;
     e.a = body(r[0], field + ".a");
@@ -647,16 +664,8 @@ void putRows(std::string& out, const char* key, const std::vector<T>& items, Row
 
 double flag(bool b) { return b ? 1.0 : 0.0; }
 
-// What the next tick carries over (World::carriedState), in the order the
-// schema gives (scene_file.hpp).
-void putCarried(std::string& out, const CarriedState& c) {
-  out += "contact_state:\n  next_group: " + std::to_string(c.next_group) + '\n';
-  putRows(out, "rest", c.rest, [&](const CarriedState::Rest& r) {
-    const auto& b = r.state.balls;
-    putRow(out, {double(r.body), flag(r.state.moving), r.state.rest_time, r.state.age, b[0].centre.x(),
-                 b[0].centre.y(), b[0].centre.z(), b[0].radius, b[1].centre.x(), b[1].centre.y(), b[1].centre.z(),
-                 b[1].radius, b[2].centre.x(), b[2].centre.y(), b[2].centre.z(), b[2].radius});
-  });
+// contact_state's broad phase: bands, each band's endpoints, boxes, pairs.
+void putBroadPhase(std::string& out, const CarriedState& c) {
   const SweepAndPrune::Banding& bands = c.banding;
   out += "  banding: ";
   putNumbers(out, std::initializer_list<double>{bands.origin[0], bands.origin[1], bands.origin[2], bands.scale[0],
@@ -680,6 +689,19 @@ void putCarried(std::string& out, const CarriedState& c) {
     out += (k > 0 ? ", " : "") + std::to_string(c.broad_pairs[k][0]) + ", " + std::to_string(c.broad_pairs[k][1]);
   }
   out += "]\n";
+}
+
+// What the next tick carries over (World::carriedState), in the order the
+// schema gives (scene_file.hpp).
+void putCarried(std::string& out, const CarriedState& c) {
+  out += "contact_state:\n  next_group: " + std::to_string(c.next_group) + '\n';
+  putRows(out, "rest", c.rest, [&](const CarriedState::Rest& r) {
+    const auto& b = r.state.balls;
+    putRow(out, {double(r.body), flag(r.state.moving), r.state.rest_time, r.state.age, b[0].centre.x(),
+                 b[0].centre.y(), b[0].centre.z(), b[0].radius, b[1].centre.x(), b[1].centre.y(), b[1].centre.z(),
+                 b[1].radius, b[2].centre.x(), b[2].centre.y(), b[2].centre.z(), b[2].radius});
+  });
+  if (!c.boxes.empty()) putBroadPhase(out, c);
   putRows(out, "carried", c.carried, [&](const CarriedState::CarriedEntry& e) {
     const PairContactCache::Entry& x = e.entry;
     putRow(out, {double(e.a), double(e.b), x.b_in_a.x(), x.b_in_a.y(), x.b_in_a.z(), x.a_to_b.x(), x.a_to_b.y(),
@@ -713,6 +735,7 @@ std::string writeSceneYaml(const World& world, const ColorOf& color_of) {
   for (std::size_t i = 0; i < world.entityCount(); ++i) {
     const BodyState& body = world.bodies()[i];
     out += "  - {";
+    out += "id: " + std::to_string(world.entityIds()[i]) + ", ";
     if (!world.bodyNames()[i].empty()) out += "name: " + world.bodyNames()[i] + ", ";
     putShape(out, world.shape(world.bodyShapes()[i]));
     putVec3(out, "position", body.pose.position);

@@ -295,6 +295,10 @@ TEST(SavedWorld, OnlyARestoredMovableBodyAtRestSleeps) {
   EXPECT_EQ(refused("sleep: x"), "entities[0].sleep");
   EXPECT_EQ(refused("sleep: 1, repeat: {count: [2, 1, 1], spacing: [1, 0, 0]}"), "entities[0].sleep");
   EXPECT_EQ(refused("sleep: 2"), "accepted");
+  EXPECT_EQ(refused("id: 5, repeat: {count: [2, 1, 1], spacing: [1, 0, 0]}"), "entities[0].id");
+  EXPECT_EQ(refused("id: -1"), "entities[0].id");
+  EXPECT_EQ(refused("id: 4294967295"), "entities[0].id");  // kInvalidEntity
+  EXPECT_EQ(refused("id: 4294967294"), "accepted");
   EXPECT_EQ(refused("sleep: 0, velocity: [0, 0, 1]"), "accepted");
 }
 
@@ -303,6 +307,8 @@ TEST(SavedWorld, OnlyARestoredMovableBodyAtRestSleeps) {
 // contacts carried between ticks, the warm start, the rest timers and the
 // broad phase's pairs are in the file (contact_state), so the next 300 ticks
 // are the saved world's, bit for bit, contacts included, at 1 and 2 threads.
+// A rock despawned on the way puts the last entity in its place: the ids
+// are kept (`id`), so each pair's bodies still come in the same order.
 TEST(SavedWorld, ATouchingWorldGoesOnTheSame) {
   for (int threads : {1, 2}) {
     SceneParams params;
@@ -310,8 +316,12 @@ TEST(SavedWorld, ATouchingWorldGoesOnTheSame) {
     WorldConfig config;
     config.threads = threads;
     SceneWorld made = makeSceneWorld(SceneKind::Rockfall, params, config);
-    for (int t = 0; t < 120; ++t) made.world.step(made.spec.dt, Budget::unlimited());
+    for (int t = 0; t < 120; ++t) {
+      if (t == 60) ASSERT_TRUE(made.world.removeEntity(made.world.entityIds()[400]));
+      made.world.step(made.spec.dt, Budget::unlimited());
+    }
     ASSERT_GT(made.world.contacts().size(), 100u);
+    ASSERT_GT(made.world.entityIds()[400], made.world.entityIds().back());  // ids out of dense order
     WorldConfig loaded_config = made.world.config();
     World loaded = loadSaved(writeSceneYaml(made.world), loaded_config);
     int first_different = -1;
@@ -397,6 +407,23 @@ TEST(SavedWorld, ABadContactStateIsRefusedByField) {
             "contact_state.warm[0].points");
   EXPECT_EQ(refusedWorldField(withCarried(yaml, "next_group", "  next_group: 1\n  extra: 1\n")),
             "contact_state.extra");
+  // Saved before the first tick, or between a spawn and the next tick: the
+  // broad phase starts afresh (no boxes written), the rest is carried.
+  World fresh = mixedWorld(meshConfig(1));
+  const std::string unstepped = writeSceneYaml(fresh);
+  EXPECT_EQ(unstepped.find("\n  boxes:"), std::string::npos);
+  EXPECT_EQ(refusedWorldField(unstepped), "accepted");
+  EntitySpec spawn;
+  spawn.shape = world.bodyShapes()[1];
+  spawn.pose.position = Vec3(2.0, 2.0, 1.0);
+  world.addEntity(spawn);
+  const std::string spawned = writeSceneYaml(world);
+  EXPECT_EQ(spawned.find("\n  boxes:"), std::string::npos);
+  EXPECT_NE(spawned.find("\n  warm:\n"), std::string::npos);
+  EXPECT_EQ(refusedWorldField(spawned), "accepted");
+  EXPECT_EQ(refusedWorldField(withCarried(unstepped, "next_group", "  next_group: 1\n  broad_pairs: []\n")),
+            "contact_state.broad_pairs");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "band_order", "")), "contact_state.band_order");
   // A saved world's state goes into a world that holds nothing yet.
   World busy = mixedWorld(meshConfig(1));
   try {

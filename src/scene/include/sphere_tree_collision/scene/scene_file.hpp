@@ -21,6 +21,7 @@
 //       box_mode: auto           # auto | fixed | dynamic
 //       repeat: {count: [3, 1, 1], spacing: [0.5, 0, 0]}   # copies on a grid, names get _i
 //       sleep: 0                 # a saved world's: EntitySpec::restored, sleep_group (not with repeat)
+//       id: 7                    # a saved world's: the id it keeps (EntitySpec::id; not with repeat)
 //     - mesh_resource: package://pkg/meshes/link.stl   # instead of preset: STL, OBJ, DAE
 //       scale: [1, 1, 1]         # mesh only, per axis
 //       resolution: 32           # voxels along the mesh's longest side, unless voxel_size is given
@@ -71,15 +72,15 @@ using ColorOf = std::function<std::optional<Rgba>(EntityId)>;
 
 // The world as a scene file that parseSceneYaml and addScene load back into
 // a new World as it is: gravity, then every entity in dense order, each with
-// its name, shape (its recipe: a preset, a mesh resource as requested, or
+// its id, name, shape (its recipe: a preset, a mesh resource as requested, or
 // else its voxels as a grid), pose (orientation as unit_quat: kept bit for
 // bit), velocities, density, material, colour (by `color_of`), static flag,
 // box mode (as resolved), closed faces and sleep group. Numbers are written
 // to 17 significant digits: they read back as the same bits. Then what the
 // next tick carries over (World::carriedState) as contact_state: the
 // contacts carried between ticks, the warm start, awake bodies' rest timers
-// and the broad phase's boxes, bands and pair order. The new World's ids are
-// 0, 1, ... in that order (docs/ros_interface.md, "Saved worlds").
+// and the broad phase's boxes, bands and pair order. The new World's
+// entities keep their ids (docs/ros_interface.md, "Saved worlds").
 std::string writeSceneYaml(const World& world, const ColorOf& color_of = nullptr);
 
 // `text` into `path` atomically: a temporary file beside it, flushed, then
