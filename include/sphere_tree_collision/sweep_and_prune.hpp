@@ -62,6 +62,9 @@ class SweepAndPrune {
     // endpoints of equal value stay in the order they came in (a static
     // floor's pieces share edges), which decides the order of their pairs.
     std::array<std::vector<std::vector<std::uint64_t>>, 3> endpoints;
+    // The boxes' ids in the order of their slots: boxes entering bands in
+    // one update are swept in it (a despawn frees a slot a spawn takes).
+    std::vector<EntityId> slots;
   };
   Banding banding() const;
   // Updated at least once, and nothing added or removed since: its pairs
@@ -72,8 +75,8 @@ class SweepAndPrune {
   // had them after its last update (the next updates then find and drop
   // pairs in the same order). Throws InputError("banding") for bands that
   // are not a map to at most 256 bands or endpoints that are not each band's
-  // in order, InputError("pairs") when `order` is not the pairs of the
-  // boxes; then nothing changes.
+  // in order or slots that are not its boxes' ids, InputError("pairs") when
+  // `order` is not the pairs of the boxes; then nothing changes.
   void restore(const Banding& banding, const std::vector<BroadPair>& order);
   // Endpoint swaps done by the last update(): the measure of coherence.
   std::size_t lastSwapCount() const { return last_swaps_; }

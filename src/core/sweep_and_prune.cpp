@@ -811,6 +811,9 @@ SweepAndPrune::Banding SweepAndPrune::banding() const {
     out.top[a] = m.lists[a].band_of.top;
   }
   out.chosen_for = m.live_at_banding;
+  for (std::uint32_t slot = 0; slot < m.state.size(); ++slot) {
+    if (m.inUse(slot)) out.slots.push_back(m.ids[slot]);
+  }
   for (int a = 0; a < 3; ++a) {
     for (const std::vector<Endpoint>& band : m.lists[a].bands) {
       std::vector<std::uint64_t>& order = out.endpoints[a].emplace_back();
@@ -831,11 +834,13 @@ void SweepAndPrune::restore(const Banding& banding, const std::vector<BroadPair>
     }
   }
   const Impl& m = *impl_;
-  SweepAndPrune fitted;  // as releaseMemory: the boxes in slot order
-  for (std::uint32_t slot = 0; slot < m.state.size(); ++slot) {
-    if (m.inUse(slot)) fitted.add(m.ids[slot], box(m.ids[slot]));
+  SweepAndPrune fitted;  // as releaseMemory, the boxes in the slot order given
+  for (const EntityId id : banding.slots) {
+    if (!contains(id) || fitted.contains(id)) throw InputError("banding", "slots: not each box's id once");
+    fitted.add(id, box(id));
   }
   Impl& f = *fitted.impl_;
+  if (f.state.size() != m.slot_of_id.size()) throw InputError("banding", "slots: not each box's id once");
   std::size_t in_use = f.state.size();
   if (banding.chosen_for == 0 ? in_use > 0 : (in_use > 2 * banding.chosen_for || 2 * in_use < banding.chosen_for)) {
     throw InputError("banding", "chosen for " + std::to_string(banding.chosen_for) + " boxes, not near " +

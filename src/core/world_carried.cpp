@@ -43,7 +43,8 @@ CarriedState World::carriedState() const {
     out.boxes.reserve(n);
     for (std::size_t i = 0; i < n; ++i) out.boxes.push_back(broad_phase_.box(ids_[i]));
     out.banding = broad_phase_.banding();
-    for (auto& list : out.banding.endpoints) {  // ids to dense indices
+    for (EntityId& id : out.banding.slots) id = indexOfId(id);  // ids to dense indices
+    for (auto& list : out.banding.endpoints) {
       for (std::vector<std::uint64_t>& band : list) {
         for (std::uint64_t& e : band) e = std::uint64_t{indexOfId(static_cast<EntityId>(e >> 1))} << 1 | (e & 1u);
       }
@@ -107,6 +108,10 @@ void World::restoreCarried(const CarriedState& state) {
     pairs.push_back({std::min(ids_[p[0]], ids_[p[1]]), std::max(ids_[p[0]], ids_[p[1]])});
   }
   SweepAndPrune::Banding banding = state.banding;
+  for (EntityId& body : banding.slots) {  // dense indices to ids
+    require(body < n, "banding.slots", "a body of the world");
+    body = ids_[body];
+  }
   for (auto& list : banding.endpoints) {  // dense indices to ids
     for (std::vector<std::uint64_t>& band : list) {
       for (std::uint64_t& e : band) {

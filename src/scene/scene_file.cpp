@@ -363,6 +363,11 @@ void readBroadPhase(const YAML::Node& node, std::size_t bodies, CarriedState& c)
     c.banding.top[a] = banding[6 + a];
   }
   c.banding.chosen_for = wholeAt(banding[9], p + "banding", 4294967295.0);
+  const YAML::Node slots = node["slot_order"];
+  if (!slots.IsSequence()) throw InputError(p + "slot_order", "expected a list of the entities' places");
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    c.banding.slots.push_back(static_cast<EntityId>(readInt(slots[k], p + "slot_order", 0, static_cast<std::int64_t>(bodies) - 1)));
+  }
   const YAML::Node lists = node["band_order"];
   if (!lists.IsSequence() || lists.size() != 3) throw InputError(p + "band_order", "expected three lists of bands");
   for (std::size_t a = 0; a < 3; ++a) {
@@ -397,11 +402,11 @@ void readBroadPhase(const YAML::Node& node, std::size_t bodies, CarriedState& c)
 CarriedState readCarried(const YAML::Node& node, std::size_t bodies) {
   const std::string p = "contact_state.";
   if (!node.IsMap()) throw InputError("contact_state", "expected a map");
-  checkKeys(node, p, {"next_group", "rest", "banding", "band_order", "boxes", "broad_pairs", "carried",
+  checkKeys(node, p, {"next_group", "rest", "banding", "slot_order", "band_order", "boxes", "broad_pairs", "carried",
                       "carried_points", "warm", "warm_points"});
   if (!node["next_group"]) throw InputError(p + "next_group", "missing");
   // The broad phase's parts come together, or none (it starts afresh).
-  for (const char* key : {"banding", "band_order", "broad_pairs"}) {
+  for (const char* key : {"banding", "slot_order", "band_order", "broad_pairs"}) {
     if (!node[key] != !node["boxes"]) throw InputError(p + key, node["boxes"] ? "missing" : "not without boxes");
   }
   const auto body = [&](double v, const std::string& field) { return bodyAt(v, field, bodies); };
@@ -671,7 +676,9 @@ void putBroadPhase(std::string& out, const CarriedState& c) {
   putNumbers(out, std::initializer_list<double>{bands.origin[0], bands.origin[1], bands.origin[2], bands.scale[0],
                                                 bands.scale[1], bands.scale[2], bands.top[0], bands.top[1],
                                                 bands.top[2], double(bands.chosen_for)}.begin(), 10);
-  out += "\n  band_order:\n";
+  out += "\n  slot_order: [";
+  for (std::size_t k = 0; k < bands.slots.size(); ++k) out += (k > 0 ? ", " : "") + std::to_string(bands.slots[k]);
+  out += "]\n  band_order:\n";
   for (const auto& list : bands.endpoints) {
     out += "    - [";
     for (std::size_t b = 0; b < list.size(); ++b) {

@@ -307,8 +307,10 @@ TEST(SavedWorld, OnlyARestoredMovableBodyAtRestSleeps) {
 // contacts carried between ticks, the warm start, the rest timers and the
 // broad phase's pairs are in the file (contact_state), so the next 300 ticks
 // are the saved world's, bit for bit, contacts included, at 1 and 2 threads.
-// A rock despawned on the way puts the last entity in its place: the ids
-// are kept (`id`), so each pair's bodies still come in the same order.
+// A rock despawned on the way puts the last entity in its place, and one
+// spawned then takes its broad-phase slot: the ids are kept (`id`), so each
+// pair's bodies still come in the same order, and the boxes go back in the
+// order of their slots (slot_order), in which boxes entering a band are swept.
 TEST(SavedWorld, ATouchingWorldGoesOnTheSame) {
   for (int threads : {1, 2}) {
     SceneParams params;
@@ -317,11 +319,17 @@ TEST(SavedWorld, ATouchingWorldGoesOnTheSame) {
     config.threads = threads;
     SceneWorld made = makeSceneWorld(SceneKind::Rockfall, params, config);
     for (int t = 0; t < 120; ++t) {
-      if (t == 60) ASSERT_TRUE(made.world.removeEntity(made.world.entityIds()[400]));
+      if (t == 60) {
+        ASSERT_TRUE(made.world.removeEntity(made.world.entityIds()[400]));
+        EntitySpec rock;
+        rock.shape = made.world.bodyShapes()[500];
+        rock.pose.position = made.world.bodies()[500].pose.position + Vec3(0.0, 0.0, 3.0);
+        made.world.addEntity(rock);
+      }
       made.world.step(made.spec.dt, Budget::unlimited());
     }
     ASSERT_GT(made.world.contacts().size(), 100u);
-    ASSERT_GT(made.world.entityIds()[400], made.world.entityIds().back());  // ids out of dense order
+    ASSERT_GT(made.world.entityIds()[400], made.world.entityIds()[401]);  // ids out of dense order
     WorldConfig loaded_config = made.world.config();
     World loaded = loadSaved(writeSceneYaml(made.world), loaded_config);
     int first_different = -1;
@@ -424,6 +432,10 @@ TEST(SavedWorld, ABadContactStateIsRefusedByField) {
   EXPECT_EQ(refusedWorldField(withCarried(unstepped, "next_group", "  next_group: 1\n  broad_pairs: []\n")),
             "contact_state.broad_pairs");
   EXPECT_EQ(refusedWorldField(withCarried(yaml, "band_order", "")), "contact_state.band_order");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "slot_order", "  slot_order: [0, 0, 1, 2, 3, 4, 5]\n")),
+            "contact_state.banding");
+  EXPECT_EQ(refusedWorldField(withCarried(yaml, "slot_order", "  slot_order: [6, 5, 4, 3, 2, 1, 0]\n")),
+            "accepted");  // any order of the boxes
   // A saved world's state goes into a world that holds nothing yet.
   World busy = mixedWorld(meshConfig(1));
   try {

@@ -31,6 +31,7 @@
 //     next_group: 4              # the group the next island to fall asleep takes
 //     rest: [[body, moving, rest_time, age, 3 x (ball centre x, y, z, radius)], ...]   # awake bodies
 //     banding: [origin x, y, z, scale x, y, z, top x, y, z, boxes]   # the broad phase's bands
+//     slot_order: [body, ...]    # the broad phase's boxes in the order of their slots
 //     band_order: [[[2 body + is_max, ...], ...], [...], [...]]   # per list, each band's endpoints in order
 //     boxes: [[min x, y, z, max x, y, z], ...]   # one a body: its broad-phase box
 //     broad_pairs: [a, b, a, b, ...]             # the broad phase's pairs, in order
