@@ -205,12 +205,12 @@ class World : private ShapeLibrary, private EntityTable {
   // (carried_state.hpp), by dense index: a saved world's contact_state.
   CarriedState carriedState() const;
   // The same put back into a World that holds the saved world's entities in
-  // the same dense order, before its first step: its next ticks at an
-  // unlimited budget are then the saved world's, bit for bit, while the ids
-  // are in the same order as the saved world's (docs/ros_interface.md, Saved
-  // worlds). Throws InputError naming the part and the field ("rest[2].body",
-  // "boxes", "banding", "broad_pairs", "carried[0].points", "warm[3].b", ...)
-  // and then changes nothing.
+  // the same dense order with the same ids (EntitySpec::id), before its
+  // first step: its next ticks at an unlimited budget are then the saved
+  // world's, bit for bit (docs/ros_interface.md, Saved worlds). Throws
+  // InputError naming the part and the field ("rest[2].body", "boxes",
+  // "banding", "broad_pairs", "carried[0].leaf", "warm[3]", ...) and then
+  // changes nothing.
   void restoreCarried(const CarriedState& state);
 
   // Dense views, valid until the next add/remove/step. Adding or removing an
