@@ -18,7 +18,6 @@
 #include <array>
 #include <cstdint>
 #include <limits>
-#include <memory>
 #include <vector>
 
 namespace stc {
@@ -76,10 +75,6 @@ struct SolveBudget {
 // budget, the state is as consistent as after a full solve: normal impulses
 // >= 0, friction clamped to the cone as each pass goes, and velocities what
 // the impulses sum to (shock propagation aside: it holds supports still).
-namespace detail {
-class FlatHashMap;  // src/core/flat_hash_map.hpp
-}
-
 class ContactSolver {
  public:
   SolveStats solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
@@ -269,8 +264,7 @@ class ContactSolver {
   // last solve's.
   void keepHeldManifolds(const std::vector<BodyState>& bodies);
   // A pair's manifold for the warm start: of last solve, else of the held
-  // store (the two never hold one pair); nullptr when neither has it. Only
-  // after warmStart has indexed the cache (cache_index_).
+  // store (the two never hold one pair); nullptr when neither has it.
   const CachedManifold* findCached(std::uint64_t pair, const CachedPoint*& points) const;
   void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
                const ResponseOptions& options, double dt, SolveStats& stats);
@@ -447,24 +441,6 @@ class ContactSolver {
   std::vector<std::uint32_t> adjacency_, queue_;  // adjacency_: the other body of each contact at a body
   std::vector<CachedPoint> cache_, next_cache_;
   std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // last solve's and this one's, sorted by pair
-  // Pair -> index into cache_manifolds_, made anew by each warm start: one
-  // probe a manifold where a binary search over ten thousand missed the
-  // cache a dozen times (it was a sixth of the response on rockfall 5,000).
-  // A copy starts empty (it is made anew before it is read).
-  class CacheIndex {
-   public:
-    CacheIndex();
-    ~CacheIndex();
-    CacheIndex(const CacheIndex&);
-    CacheIndex(CacheIndex&&) noexcept;
-    CacheIndex& operator=(const CacheIndex&);
-    CacheIndex& operator=(CacheIndex&&) noexcept;
-    detail::FlatHashMap& map() const { return *map_; }
-
-   private:
-    std::unique_ptr<detail::FlatHashMap> map_;
-  };
-  CacheIndex cache_index_;
   // Manifolds of sleeping pairs, sorted by pair, their points in held_points_.
   // Kept apart from the solved ones, so a tick of a mostly sleeping pile
   // copies none of them: only a wake or a despawn (an entry that no longer

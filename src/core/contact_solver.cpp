@@ -4,7 +4,6 @@
 
 #include "sphere_tree_collision/dynamics.hpp"
 #include "contact_rows.hpp"
-#include "flat_hash_map.hpp"
 #include "grow_capacity.hpp"
 
 #include <algorithm>
@@ -360,27 +359,9 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
 // Each manifold looks up last tick's manifold of its entity pair once; each
 // point takes the impulse of the old point with its feature id, else of the
 // nearest unused old point within half the gap bound (in A's frame).
-ContactSolver::CacheIndex::CacheIndex() : map_(std::make_unique<detail::FlatHashMap>()) {}
-ContactSolver::CacheIndex::~CacheIndex() = default;
-ContactSolver::CacheIndex::CacheIndex(const CacheIndex&) : CacheIndex() {}
-ContactSolver::CacheIndex::CacheIndex(CacheIndex&&) noexcept = default;
-ContactSolver::CacheIndex& ContactSolver::CacheIndex::operator=(const CacheIndex&) {
-  map_ = std::make_unique<detail::FlatHashMap>();
-  return *this;
-}
-ContactSolver::CacheIndex& ContactSolver::CacheIndex::operator=(CacheIndex&&) noexcept = default;
-
 void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
                               SolveStats& stats) {
   if (cache_manifolds_.empty() && held_manifolds_.empty()) return;
-  // Whatever changed the cache since (a solve's store, forget, a restore),
-  // the index is made from it here, once a tick.
-  detail::FlatHashMap& index = cache_index_.map();
-  index.clear();
-  index.reserve(cache_manifolds_.size());
-  for (std::size_t m = 0; m < cache_manifolds_.size(); ++m) {
-    index.set(cache_manifolds_[m].pair, static_cast<std::uint32_t>(m));
-  }
   std::atomic<std::size_t> by_feature{0}, started{0};
   // Stage by stage, as a pass: each body meets its manifolds in the same
   // order whatever the thread count, and a block's bodies stay on its thread.
@@ -801,14 +782,12 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
 
 const ContactSolver::CachedManifold* ContactSolver::findCached(std::uint64_t pair,
                                                               const CachedPoint*& points) const {
-  const std::uint32_t m = cache_index_.map().find(pair);
-  if (m != detail::FlatHashMap::kMissing) {
-    const CachedManifold& solved = cache_manifolds_[m];
-    assert(solved.pair == pair);
-    points = cache_.data() + solved.first;
-    return &solved;
-  }
   const auto byKey = [](const CachedManifold& x, std::uint64_t k) { return x.pair < k; };
+  const auto solved = std::lower_bound(cache_manifolds_.begin(), cache_manifolds_.end(), pair, byKey);
+  if (solved != cache_manifolds_.end() && solved->pair == pair) {
+    points = cache_.data() + solved->first;
+    return &*solved;
+  }
   const auto held = std::lower_bound(held_manifolds_.begin(), held_manifolds_.end(), pair, byKey);
   if (held != held_manifolds_.end() && held->pair == pair) {
     points = held_points_.data() + held->first;
