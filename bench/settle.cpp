@@ -32,6 +32,7 @@
 //   --sleep-off  WorldConfig::sleeping.enabled = false (what the pile costs awake)
 //   --rolling C  every body's Material::rolling_resistance set to C after the
 //              scene is built (default: the scene's own)
+//   --solver NAME  ResponseOptions::solver: sequential (default), jacobi or soft
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
@@ -55,6 +56,7 @@ struct Options {
   double every = 5.0;
   bool sleep_off = false;
   double rolling = -1.0;  // < 0: the scene's
+  SolverKind solver = ResponseOptions{}.solver;
 };
 
 Options parse(int argc, char** argv) {
@@ -72,6 +74,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--every") o.every = std::stod(next());
     else if (a == "--sleep-off") o.sleep_off = true;
     else if (a == "--rolling") o.rolling = std::stod(next());
+    else if (a == "--solver") o.solver = parseSolverKind(next());
     else if (a == "--smoke") o.bodies = 200, o.settle = 0.1, o.seconds = 0.05, o.every = 0.05;
     else throw InputError(a, "unknown option");
   }
@@ -244,6 +247,7 @@ int main(int argc, char** argv) {
     const Options opt = parse(argc, argv);
     WorldConfig config;
     config.sleeping.enabled = !opt.sleep_off;
+    config.response.solver = opt.solver;
     SceneParams params;
     params.entities = opt.bodies;
     SceneWorld scene = makeSceneWorld(opt.scene, params, config);
@@ -255,9 +259,10 @@ int main(int argc, char** argv) {
     const double dt = spec.dt;
     double rolling = 0.0;
     for (const BodyState& b : world.bodies()) rolling = std::max(rolling, b.material.rolling_resistance);
-    std::printf("scene=%s bodies=%d dt=%.5f sleeping=%s (linear_speed %.3g m/s for %.3g s) rolling_resistance=%.3g\n",
-                toString(opt.scene), opt.bodies, dt, opt.sleep_off ? "off" : "on", config.sleeping.linear_speed,
-                config.sleeping.time_to_sleep, rolling);
+    std::printf("scene=%s bodies=%d dt=%.5f solver=%s sleeping=%s (linear_speed %.3g m/s for %.3g s) "
+                "rolling_resistance=%.3g\n",
+                toString(opt.scene), opt.bodies, dt, toString(opt.solver), opt.sleep_off ? "off" : "on",
+                config.sleeping.linear_speed, config.sleeping.time_to_sleep, rolling);
     Diagnosis diagnosis(world, spec);
     const int every = std::max(1, static_cast<int>(std::lround(opt.every / dt)));
     const int settle = static_cast<int>(std::lround(opt.settle / dt));

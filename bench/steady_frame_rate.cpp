@@ -28,7 +28,7 @@
 //
 // Usage: bench_steady_frame_rate [--scene all|NAME[:N][,NAME[:N]...]] [--entities N]
 //          [--tick-budget-ms 16.7] [--seconds 60] [--budget-off] [--no-reference] [--wall-clock]
-//          [--trace-escape] [--sphere-tests N] [--solver-iterations N]
+//          [--trace-escape] [--trace-ticks FILE] [--sphere-tests N] [--solver-iterations N]
 //          [--position-correction F] [--reuse-tolerance T] [--solver sequential|jacobi|soft]
 //          [--markdown FILE] [--smoke]
 //   --scene: a bare NAME picks that scene's default cases (rockfall: 1,000 and 5,000)
@@ -36,6 +36,7 @@
 //   --budget-off: the unbudgeted run alone; --no-reference: the budgeted run alone
 //   --reuse-tolerance T: ResponseOptions::reuse_tolerance in [0, 1] (0: every pair built
 //     every tick; default: the World's), to measure contact recycling off and on
+//   --trace-ticks FILE: a CSV line a tick of every run (its cost, contacts, the island levels)
 //   --smoke: every scene at 100 entities for 0.05 s: that the bench runs, scripts/bench_smoke.sh
 #include "bench_args.hpp"
 #include "plausibility.hpp"
@@ -114,7 +115,14 @@ struct RunSettings {
   SolverKind solver = ResponseOptions{}.solver;
   bool wall_clock = false;
   bool trace_escape = false;
+  std::FILE* trace_ticks = nullptr;  // --trace-ticks: a CSV line a tick, or none
 };
+
+// --trace-ticks: what each tick cost and what the island levels did, to see
+// which ticks make p99 and why.
+constexpr const char* kTraceHeader =
+    "scene,bodies,run,tick,cpu_ms,response_ms,contacts_ms,narrow_ms,contacts,islands_full,bodies_full,"
+    "islands_held,bodies_held,islands_joined,largest_island,most_ticks_held,full_cost,allowance,velocity_passes\n";
 
 Run simulate(const Case& c, const RunSettings& settings, const Budget& budget, bool budgeted) {
   const double seconds = settings.seconds;
@@ -182,6 +190,14 @@ Run simulate(const Case& c, const RunSettings& settings, const Budget& budget, b
       run.root_contacts += contact.level == 0 ? 1.0 : 0.0;
     }
     if (i % 600 == 599) std::fprintf(stderr, "  %s: %d / %d ticks\n", run.scene.c_str(), i + 1, ticks);
+    if (settings.trace_ticks != nullptr) {
+      const IslandLevelReport& l = r.response.levels;
+      std::fprintf(settings.trace_ticks, "%s,%d,%s,%d,%.3f,%.3f,%.3f,%.3f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%d,%.0f,%.0f,%d\n",
+                   run.scene.c_str(), run.bodies, budgeted ? "budgeted" : "unbudgeted", i, run.cpu.back() * 1e3,
+                   r.phases.response_s * 1e3, r.phases.contacts_s * 1e3, r.phases.narrow_s * 1e3, r.response.contacts,
+                   l.islands_full, l.bodies_full, l.islands_held, l.bodies_held, l.islands_joined, l.largest_island,
+                   l.most_ticks_held, l.full_cost, l.allowance, r.response.velocity_passes);
+    }
     if (settings.trace_escape) {  // every tick a mover is outside: where, how fast, what the tick did
       for (EntityId id : spec.movers) {
         const BodyState& b = world.bodies()[*world.indexOf(id)];
@@ -270,7 +286,7 @@ int main(int argc, char** argv) {
   std::int64_t sphere_tests = std::numeric_limits<std::int64_t>::max();
   int solver_iterations = std::numeric_limits<int>::max();
   bool reuse_set = false;
-  std::string markdown;
+  std::string markdown, trace_ticks;
   std::vector<Case> cases;
   try {
     for (stc_bench::Args args(argc, argv); args.more();) {
@@ -291,6 +307,7 @@ int main(int argc, char** argv) {
       else if (a == "--solver") settings.solver = parseSolverKind(args.required());
       else if (a == "--wall-clock") settings.wall_clock = true;
       else if (a == "--trace-escape") settings.trace_escape = true;
+      else if (a == "--trace-ticks") trace_ticks = args.required();
       else if (a == "--markdown") markdown = args.required();
       else if (a == "--smoke") smoke = true;
       else return args.unknown();
@@ -302,6 +319,11 @@ int main(int argc, char** argv) {
     if (budget_off && !reference) throw InputError("--no-reference", "with --budget-off nothing would run");
     cases = scene == "all" ? kDefaultCases : stc_bench::parseSceneCases(scene, kDefaultCases);
     if (cases.empty()) throw InputError("--scene", "names no scene");
+    if (!trace_ticks.empty()) {
+      settings.trace_ticks = std::fopen(trace_ticks.c_str(), "w");
+      if (settings.trace_ticks == nullptr) throw InputError("--trace-ticks", "cannot write '" + trace_ticks + "'");
+      std::fputs(kTraceHeader, settings.trace_ticks);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_steady_frame_rate: %s\n", e.what());
     return 2;
@@ -333,6 +355,7 @@ int main(int argc, char** argv) {
     }
   }
 
+  if (settings.trace_ticks != nullptr) std::fclose(settings.trace_ticks);
   std::string md;
   char buf[1024];
   std::snprintf(buf, sizeof buf,

@@ -358,8 +358,10 @@ class ContactSolver {
     Vec3 p = Vec3::Zero();
     Quat q = Quat::Identity();
   };
-  // A row's separation at the poses now (soft_move_).
-  double separationNow(const Row& row) const;
+  // A row's separation at the poses now (soft_move_): its separation where
+  // found plus closedSince, the bodies' moves since along its normal.
+  double closedSince(const Row& row) const;
+  double separationNow(const Row& row) const { return row.separation + closedSince(row); }
   // Rows' separations at the tick's start, the restitution's wave 0 from them.
   void prepareSoft(const std::vector<Contact>& contacts, const ResponseOptions& options, double dt);
   // A substep's shock sweep (contact_solver_soft.cpp), substep length h.

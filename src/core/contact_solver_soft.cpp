@@ -86,11 +86,11 @@ STC_HOT_INLINE void softRow(ContactSolver::Row& row, double s, const SoftPass& p
 
 }  // namespace
 
-double ContactSolver::separationNow(const Row& row) const {
+double ContactSolver::closedSince(const Row& row) const {
   const SoftMove& ma = soft_move_[row.a];
   const SoftMove& mb = soft_move_[row.b];
   const Vec3 d = (mb.p - ma.p) + (mb.q * row.rb - row.rb) - (ma.q * row.ra - row.ra);
-  return row.separation + row.n.dot(d);
+  return row.n.dot(d);
 }
 
 void ContactSolver::prepareSoft(const std::vector<Contact>& contacts, const ResponseOptions& options, double dt) {
@@ -109,11 +109,12 @@ void ContactSolver::prepareSoft(const std::vector<Contact>& contacts, const Resp
       // predicted poses instead, a rock sliding down a plate under a starved
       // budget was let close a "gap" of its own predicted move each tick and
       // sank 1.6 voxels into the plate.
-      if (!c.resolved) row.separation -= separationNow(row) - row.separation;
+      const double moved = closedSince(row);  // the bodies' moves since, along n (one measure for both uses)
+      if (!c.resolved) row.separation -= (row.separation + moved) - row.separation;
       // Wave 0 of the restitution as prepare() classifies it, but from the
       // gap at the tick's start: a contact bounces when it closes that gap
       // this tick faster than the threshold.
-      const double s = separationNow(row);
+      const double s = row.separation + moved;
       row.speculative = s > 0.0 ? s / dt : 0.0;
       info.bounced = info.restitution > 0.0 && info.approach < -std::max(options.restitution_threshold, row.speculative);
       info.wave = info.bounced ? 0 : -1;

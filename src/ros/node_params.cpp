@@ -27,7 +27,7 @@ const std::set<std::string>& knownParams() {
       "camera_position", "camera_look_at", "camera_width", "camera_height", "camera_fov_y",
       "max_speed", "max_spin", "world_extent", "min_density", "max_density", "max_friction", "max_gravity",
       "min_voxel_size", "max_voxel_size", "entity_states_rate", "entities_rate", "publish_clock", "error_report",
-      "min_piece_voxels", "small_pieces", "strength_exponent", "threads", "reuse_tolerance",
+      "min_piece_voxels", "small_pieces", "strength_exponent", "threads", "reuse_tolerance", "solver",
       "diagnostic_period", "camera_info_topic", "mesh_roots", "max_mesh_bytes", "max_mesh_vertices",
       "max_mesh_triangles", "save_dir", "autosave_period"};  // diagnostic_period: read by diagnostic_updater
   return kNames;
@@ -208,6 +208,9 @@ NodeParams readNodeParams(const ros::NodeHandle& nh) {
   readParam(nh, "reuse_tolerance", reuse);
   if (!(reuse >= 0.0 && reuse <= 1.0)) throw InputError("reuse_tolerance", "must be in [0, 1]");
   p.world.response.reuse_tolerance = reuse;
+  std::string solver = stc::toString(p.world.response.solver);
+  readParam(nh, "solver", solver);
+  p.world.response.solver = parsed("solver", [&] { return stc::parseSolverKind(solver); });
   p.world.max_entities = static_cast<std::size_t>(
       intParamIn(nh, "max_entities", static_cast<int>(p.world.max_entities), 1, 10000000));
   // Folders file:// and path meshes may be read from (none: package:// only).

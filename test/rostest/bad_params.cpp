@@ -82,6 +82,7 @@ TEST(BadParams, EachBadParameterIsNamedAndTheNodeExits) {
       {world, {{"rate", -1.0}}, "rate"},
       {world, {{"rate", "fast"}}, "rate"},
       {world, {{"scheduler", "fifo"}}, "scheduler"},
+      {world, {{"solver", "gauss"}}, "solver"},
       {world, {{"unresolved_policy", "maybe"}}, "unresolved_policy"},
       {world, {{"sphere_test_budget", -5}}, "sphere_test_budget"},
       {world, {{"tick_budget", -16.7}}, "tick_budget"},
@@ -144,7 +145,7 @@ TEST(BadParams, AGoodSetKeepsRunning) {
                   {{"rate", 30}, {"scheduler", "round_robin"}, {"marker_levels", list({0, 3})}, {"tick_budget", 16.7},
                    {"camera_position", list({0, -3, 1})}, {"camera_look_at", list({0, 0, 0.5})},
                    {"reuse_tolerance", 0.05}, {"default_density", 2500.0}, {"default_voxel_size", 0.1},
-                   {"mesh_roots", strings({"/tmp"})}, {"max_mesh_triangles", 500000}},
+                   {"mesh_roots", strings({"/tmp"})}, {"max_mesh_triangles", 500000}, {"solver", "soft"}},
                   ""};
   const auto [status, output] = run(good, 1000, 3.0);
   EXPECT_FALSE(status.has_value()) << "exited with " << status.value_or(-1) << ":\n" << output;
