@@ -28,7 +28,8 @@
 // by it, and the speed-up given for each class.
 //
 // Usage: bench_parallel_speedup [--scenes corner_drift:500,rockfall:1000,packed_box:500,cube_box:10000]
-//          [--threads 2] [--seconds 6] [--cube-seconds 1.5] [--settle 1] [--smoke]
+//          [--threads 2] [--seconds 6] [--cube-seconds 1.5] [--settle 1] [--solver NAME] [--smoke]
+//   --solver: ResponseOptions::solver of every world, sequential (default), jacobi or soft;
 //   --seconds: simulated time timed per scene (cube_box: --cube-seconds);
 //   --settle: simulated time run first, untimed, at one thread (so the
 //   scene is moving and colliding when timing starts).
@@ -70,6 +71,7 @@ using stc_bench::caseName;
 struct Options : stc_bench::SceneTiming {
   Options() { seconds = 6.0; }
   int threads = 2;
+  SolverKind solver = ResponseOptions{}.solver;
 };
 
 // Per-tick samples of one run, seconds.
@@ -80,9 +82,10 @@ struct Run {
   double contacts = 0.0, manifolds = 0.0, crossing = 0.0, slabs = 0.0;  // sums over the ticks
 };
 
-SceneWorld makeWorld(const Case& c, int threads) {
+SceneWorld makeWorld(const Case& c, int threads, SolverKind solver) {
   WorldConfig config;
   config.threads = threads;
+  config.response.solver = solver;
   SceneParams params;
   params.entities = c.bodies;
   return makeSceneWorld(c.kind, params, config);
@@ -176,8 +179,8 @@ struct SceneWorlds {
 };
 
 SceneWorlds makeWorlds(const Case& c, const Options& opt) {
-  SceneWorlds w{makeWorld(c, 1), makeWorld(c, opt.threads), {}};
-  for (int k = 0; k < opt.threads; ++k) w.side_by_side.push_back(makeWorld(c, 1));
+  SceneWorlds w{makeWorld(c, 1, opt.solver), makeWorld(c, opt.threads, opt.solver), {}};
+  for (int k = 0; k < opt.threads; ++k) w.side_by_side.push_back(makeWorld(c, 1, opt.solver));
   return w;
 }
 
@@ -280,6 +283,8 @@ Options parseOptions(int argc, char** argv) {
       o.threads = std::stoi(args.required());
       validateThreads(o.threads);
       if (o.threads < 2) throw InputError("--threads", "compare with at least 2");
+    } else if (a == "--solver") {
+      o.solver = parseSolverKind(args.required());
     } else {
       throw InputError(a, "unknown option (see the comment at the top of bench/parallel_speedup.cpp)");
     }
@@ -292,7 +297,8 @@ Options parseOptions(int argc, char** argv) {
 int main(int argc, char** argv) {
   Options opt;
   if (!stc_bench::parseFlags("bench_parallel_speedup", parseOptions, argc, argv, opt)) return 2;
-  std::printf("# Parallel tick: 1 vs %d threads, unlimited budget (load average %.2f)\n", opt.threads, loadAverage());
+  std::printf("# Parallel tick: 1 vs %d threads, unlimited budget, %s solver (load average %.2f)\n", opt.threads,
+              toString(opt.solver), loadAverage());
   std::vector<std::string> lines, ceilings;
   for (const Case& c : opt.cases) {
     double ceiling = NAN;
