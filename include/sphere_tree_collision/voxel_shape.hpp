@@ -23,6 +23,11 @@ struct VoxelLimits {
 void validateVoxelSize(double voxel_size, const VoxelLimits& limits, const std::string& source = "",
                        const std::string& note = "");
 
+// Throws InputError("max_voxels") when an nx x ny x nz grid has more cells
+// than limits.max_voxels: the one check of a grid's size, made before a grid
+// is built (presets) as well as when a shape is made of it.
+void validateGridCells(int nx, int ny, int nz, const VoxelLimits& limits);
+
 // Grid frame: voxel (i,j,k) occupies [i,i+1]x[j,j+1]x[k,k+1] * voxel_size,
 // so the grid's min corner is the origin.
 class VoxelShape {

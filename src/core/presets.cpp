@@ -22,6 +22,10 @@ struct Grid {
   int nx, ny, nz;
   std::vector<std::uint8_t> occ;
   Grid(int x, int y, int z) : nx(x), ny(y), nz(z), occ(static_cast<std::size_t>(x) * y * z, 0) {}
+  // A preset's working grid, refused before it is filled when it is larger
+  // than the limit: filling a rock of resolution 256 (8 million cells, a few
+  // fills as it grows) took seconds before VoxelShape::create refused it.
+  Grid(int x, int y, int z, const VoxelLimits& limits) : Grid((validateGridCells(x, y, z, limits), x), y, z) {}
   std::size_t at(int i, int j, int k) const {
     return static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * (j + static_cast<std::size_t>(ny) * k);
   }
@@ -81,7 +85,7 @@ Grid cropped(const Grid& g) {
 
 // A lumpy ellipsoid: a star-shaped radius function of random bumps, scaled up
 // until its 6-connected core spans the full resolution along x.
-Grid makeRock(int res, std::uint32_t seed) {
+Grid makeRock(int res, std::uint32_t seed, const VoxelLimits& limits) {
   std::mt19937 rng(seed);
   struct Bump { Vec3 dir; double amplitude; };
   std::array<Bump, 7> bumps;
@@ -103,7 +107,7 @@ Grid makeRock(int res, std::uint32_t seed) {
   };
 
   Grid grid(res, std::max(1, static_cast<int>(std::lround(res * aspect_y))),
-            std::max(1, static_cast<int>(std::lround(res * aspect_z))));
+            std::max(1, static_cast<int>(std::lround(res * aspect_z))), limits);
   const Vec3 half = Vec3(grid.nx, grid.ny, grid.nz) * 0.5;
   for (double scale = 0.8;; scale *= 1.05) {
     grid.fill([&](const Vec3& p) {
@@ -124,35 +128,35 @@ Grid makeRock(int res, std::uint32_t seed) {
   return cropped(grid);
 }
 
-Grid makeNamed(const std::string& name, const PresetParams& p) {
+Grid makeNamed(const std::string& name, const PresetParams& p, const VoxelLimits& limits) {
   const int r = p.resolution;
   const int quarter = std::max(1, (r + 2) / 4);
   if (name == "cube") {
-    Grid g(r, r, r);
+    Grid g(r, r, r, limits);
     g.fill([](const Vec3&) { return true; });
     return g;
   }
   if (name == "sphere") {
-    Grid g(r, r, r);
+    Grid g(r, r, r, limits);
     const double radius = 0.5 * r;
     g.fill([&](const Vec3& q) { return q.norm() <= radius; });
     return g;
   }
-  if (name == "rock") return makeRock(r, p.seed);
+  if (name == "rock") return makeRock(r, p.seed, limits);
   if (name == "rod") {
-    Grid g(r, quarter, quarter);
+    Grid g(r, quarter, quarter, limits);
     g.fill([](const Vec3&) { return true; });
     return g;
   }
   if (name == "plate") {
-    Grid g(r, r, std::max(1, (r + 4) / 8));
+    Grid g(r, r, std::max(1, (r + 4) / 8), limits);
     g.fill([](const Vec3&) { return true; });
     return g;
   }
   if (name == "L") {
     // Two arms of width w in the xy plane, joined at the origin corner.
     const int w = std::max(1, (r + 1) / 3);
-    Grid g(r, r, w);
+    Grid g(r, r, w, limits);
     for (int k = 0; k < g.nz; ++k)
       for (int j = 0; j < g.ny; ++j)
         for (int i = 0; i < g.nx; ++i) g.occ[g.at(i, j, k)] = (i < w || j < w) ? 1 : 0;
@@ -161,7 +165,7 @@ Grid makeNamed(const std::string& name, const PresetParams& p) {
   if (name == "ring") {
     // A washer: annulus between r/4 and r/2 about the z axis, with a through hole.
     if (r < 3) throw InputError("resolution", "the ring needs resolution >= 3 to have a hole");
-    Grid g(r, r, quarter);
+    Grid g(r, r, quarter, limits);
     const double inner = 0.25 * r, outer = 0.5 * r;
     g.fill([&](const Vec3& q) {
       const double rho = std::hypot(q.x(), q.y());
@@ -186,7 +190,7 @@ VoxelShape makePreset(const std::string& name, const PresetParams& params, const
     throw InputError("resolution", "must be in [1, " + std::to_string(kMaxResolution) + "], got " +
                                        std::to_string(params.resolution));
   }
-  Grid g = makeNamed(name, params);
+  Grid g = makeNamed(name, params, limits);
   VoxelShape shape = VoxelShape::create(g.nx, g.ny, g.nz, params.voxel_size, std::move(g.occ), limits);
   if (name == "sphere") shape.markSphere();
   return shape;

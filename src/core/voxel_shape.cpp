@@ -18,6 +18,15 @@ void validateVoxelSize(double voxel_size, const VoxelLimits& limits, const std::
   throw InputError("voxel_size", out.str());
 }
 
+void validateGridCells(int nx, int ny, int nz, const VoxelLimits& limits) {
+  // In double: the int64 product of three ints can overflow, the double one cannot.
+  const double cells = static_cast<double>(nx) * ny * nz;
+  if (cells > static_cast<double>(limits.max_voxels)) {
+    throw InputError("max_voxels", "grid has " + std::to_string(cells) + " voxels, limit is " +
+                                       std::to_string(limits.max_voxels));
+  }
+}
+
 VoxelShape VoxelShape::create(int nx, int ny, int nz, double voxel_size,
                               std::vector<std::uint8_t> occupancy, const VoxelLimits& limits) {
   if (nx <= 0 || ny <= 0 || nz <= 0) {
@@ -25,12 +34,7 @@ VoxelShape VoxelShape::create(int nx, int ny, int nz, double voxel_size,
                                  " x " + std::to_string(ny) + " x " + std::to_string(nz));
   }
   validateVoxelSize(voxel_size, limits);
-  // In double: the int64 product of three ints can overflow, the double one cannot.
-  const double cells = static_cast<double>(nx) * ny * nz;
-  if (cells > static_cast<double>(limits.max_voxels)) {
-    throw InputError("max_voxels", "grid has " + std::to_string(cells) + " voxels, limit is " +
-                                       std::to_string(limits.max_voxels));
-  }
+  validateGridCells(nx, ny, nz, limits);
   const std::size_t count = static_cast<std::size_t>(nx) * ny * nz;
   if (occupancy.size() != count) {
     throw InputError("occupancy", "size " + std::to_string(occupancy.size()) +

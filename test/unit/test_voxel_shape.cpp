@@ -131,6 +131,26 @@ TEST(Presets, SpanTheResolutionAndHaveTheirFeatures) {
   }
 }
 
+// A preset is refused by its working grid before that grid is filled: a
+// rock of resolution 256 under a limit of 32^3 cells (a fuzzer's spawn: it
+// took 44 s under the sanitizers to build a grid of 8 million cells that
+// VoxelShape::create then refused). A preset whose grid is exactly the limit
+// is made; one cell less refuses it.
+TEST(Presets, APresetBeyondTheVoxelLimitIsRefusedBeforeItsGridIsBuilt) {
+  VoxelLimits small;
+  small.max_voxels = 32 * 32 * 32;
+  EXPECT_EQ(thrownField([&] { makePreset("rock", PresetParams{256, 0.05, 7}, small); }), "max_voxels");
+  for (const char* name : {"cube", "sphere", "rod", "plate", "L", "ring"}) {
+    SCOPED_TRACE(name);
+    const VoxelShape made = makePreset(name, PresetParams{12, 0.05, 1});
+    VoxelLimits exact;
+    exact.max_voxels = static_cast<std::int64_t>(made.nx()) * made.ny() * made.nz();
+    EXPECT_NO_THROW(makePreset(name, PresetParams{12, 0.05, 1}, exact));
+    exact.max_voxels -= 1;
+    EXPECT_EQ(thrownField([&] { makePreset(name, PresetParams{12, 0.05, 1}, exact); }), "max_voxels");
+  }
+}
+
 TEST(Presets, RingHasAThroughHoleAndSphereIsRound) {
   PresetParams p;
   p.resolution = 16;
