@@ -11,8 +11,6 @@
 namespace stc {
 namespace {
 
-bool finite(const Vec3& v) { return v.allFinite(); }
-
 void require(bool ok, const std::string& field, const char* reason) {
   if (!ok) throw InputError(field, reason);
 }
@@ -88,7 +86,7 @@ void World::restoreCarried(const CarriedState& state) {
             "not an awake movable body");
     bool ok = std::isfinite(r.state.rest_time) && r.state.rest_time >= 0.0 && std::isfinite(r.state.age) &&
               r.state.age >= 0.0;
-    for (const Sphere& ball : r.state.balls) ok = ok && finite(ball.centre) && std::isfinite(ball.radius);
+    for (const Sphere& ball : r.state.balls) ok = ok && allFinite(ball.centre) && std::isfinite(ball.radius);
     require(ok, at("rest", k), "times finite and >= 0, balls finite");
   }
   require(state.next_group > 0, "next_group", "must be > 0");
@@ -97,7 +95,7 @@ void World::restoreCarried(const CarriedState& state) {
   require(broad || state.broad_pairs.empty(), "broad_pairs", "not without boxes");
   for (std::size_t i = 0; i < state.boxes.size(); ++i) {
     const Aabb& box = state.boxes[i];
-    require(finite(box.min) && finite(box.max) && (box.min.array() <= box.max.array()).all(), at("boxes", i),
+    require(allFinite(box.min) && allFinite(box.max) && (box.min.array() <= box.max.array()).all(), at("boxes", i),
             "corners finite, min <= max");
   }
   std::vector<BroadPair> pairs;
@@ -126,7 +124,7 @@ void World::restoreCarried(const CarriedState& state) {
     const CarriedState::CarriedEntry& c = state.carried[k];
     const PairContactCache::Entry& e = c.entry;
     require(c.a < n && c.b < n && c.a != c.b, at("carried", k), "two bodies of the world");
-    require(finite(e.b_in_a) && e.a_to_b.coeffs().allFinite() && std::isfinite(e.tolerance), at("carried", k),
+    require(allFinite(e.b_in_a) && e.a_to_b.coeffs().allFinite() && std::isfinite(e.tolerance), at("carried", k),
             "not finite");
     requireRange(e.first, e.count, state.carried_points.size(), 0xffffffffu, at("carried", k) + ".points");
     // The leaf pair a resumed test starts from: nodes of the two trees.
@@ -142,7 +140,7 @@ void World::restoreCarried(const CarriedState& state) {
   }
   for (std::size_t k = 0; k < state.carried_points.size(); ++k) {
     const PairContactCache::Point& p = state.carried_points[k];
-    require(finite(p.on_a) && finite(p.on_b) && finite(p.normal) && std::isfinite(p.depth) &&
+    require(allFinite(p.on_a) && allFinite(p.on_b) && allFinite(p.normal) && std::isfinite(p.depth) &&
                 std::isfinite(p.separation) && std::isfinite(p.sphere_bound),
             at("carried_points", k), "not finite");
   }
@@ -151,7 +149,7 @@ void World::restoreCarried(const CarriedState& state) {
   for (std::size_t k = 0; k < state.warm.size(); ++k) {
     const CarriedState::Warm& w = state.warm[k];
     require(w.a < n && w.b < n && w.a != w.b, at("warm", k), "two bodies of the world");
-    require(finite(w.manifold.rolling), at("warm", k), "not finite");
+    require(allFinite(w.manifold.rolling), at("warm", k), "not finite");
     requireRange(w.manifold.first, w.manifold.count, state.warm_points.size(), ContactSolver::kMaxCachedPoints,
                  at("warm", k) + ".points");
     std::vector<ContactSolver::CachedPoint>& points = w.held ? held_points : solved_points;
@@ -166,7 +164,7 @@ void World::restoreCarried(const CarriedState& state) {
   }
   for (std::size_t k = 0; k < state.warm_points.size(); ++k) {
     const ContactSolver::CachedPoint& p = state.warm_points[k];
-    require(finite(p.local_a) && std::isfinite(p.normal) && finite(p.friction), at("warm_points", k), "not finite");
+    require(allFinite(p.local_a) && std::isfinite(p.normal) && allFinite(p.friction), at("warm_points", k), "not finite");
   }
 
   // The broad phase last: its pairs must be those of the boxes (else it
