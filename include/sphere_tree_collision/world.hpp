@@ -117,13 +117,20 @@ struct BrokenEntity {
   std::vector<EntityId> pieces;
 };
 
-class WorldFracture;  // src/core/world_fracture.hpp
-struct TickContext;   // src/core/tick_context.hpp
+// The internal types a few of World's accessors return: declared here, defined
+// in headers that stay in src/core (tests and benches see them; a user of the
+// installed headers does not need them).
+class PairTest;        // src/core/pair_test.hpp
+class SweepAndPrune;   // src/core/sweep_and_prune.hpp
+struct PhysicsReport;  // src/core/physics.hpp
+struct CarriedState;   // src/core/carried_state.hpp
 
-// The shapes are a ShapeLibrary (shape_library.hpp) and the entities' rows
-// an EntityTable (entity_table.hpp), private bases: what World adds to them
-// is the validation, and the parts that follow each add and remove.
-class World : private ShapeLibrary, private EntityTable {
+// The shapes (a ShapeLibrary), the entities' rows (an EntityTable), what
+// follows each add and remove, fracture and the phases are World::Parts
+// (src/core/world_parts.hpp), held by pointer: this header names none of
+// them, and a World moves by moving the pointer. What World adds to them is
+// the validation, and the parts that follow each add and remove.
+class World {
  public:
   explicit World(const WorldConfig& config = WorldConfig{});
   ~World();
@@ -133,10 +140,12 @@ class World : private ShapeLibrary, private EntityTable {
   // Shapes are shared: the same key returns the same id (the tree is built
   // once, under config().voxel_limits and config().tree; ShapeLibrary).
   ShapeId addShape(const std::string& key, VoxelShape shape);
-  using ShapeLibrary::findShape;
-  using ShapeLibrary::shape;
-  using ShapeLibrary::shapeCount;
-  using ShapeLibrary::setShapeRecipe;
+  std::optional<ShapeId> findShape(const std::string& key) const;
+  const ShapeInfo& shape(ShapeId id) const;  // throws InputError("shape") for an unknown id
+  std::size_t shapeCount() const;
+  // Records how shape `id` was made (ShapeInfo::recipe); the first recipe
+  // of a shape stays (a shape found again by its key was made by it).
+  void setShapeRecipe(ShapeId id, const ShapeRecipe& recipe);
 
   // Throws InputError naming the field ("shape", "pose.position",
   // "pose.orientation", "linear_velocity", "angular_velocity", "density",
@@ -147,7 +156,7 @@ class World : private ShapeLibrary, private EntityTable {
   // built yet: the same errors, in the same order.
   void validateEntity(const EntitySpec& spec) const;
   bool removeEntity(EntityId id);
-  using EntityTable::findByName;
+  std::optional<EntityId> findByName(const std::string& name) const;
   void clear();  // removes every entity, keeps shapes
   // Hands back what the pooled arrays keep beyond today's entities and pairs
   // (after a large removal: a flood of 10,000 spawns and despawns left 13 MB
@@ -174,15 +183,15 @@ class World : private ShapeLibrary, private EntityTable {
   // (checkEveryFor, budget.hpp).
   void setClock(SecondsClock clock);
   // The entities the last step removed, with the reason.
-  const std::vector<QuarantinedEntity>& quarantined() const { return quarantined_; }
+  const std::vector<QuarantinedEntity>& quarantined() const;
   // The bodies the last step (and breakEntity since) broke, with their pieces.
   const std::vector<BrokenEntity>& broken() const;
 
-  Perception& perception() { return perception_; }
-  const Perception& perception() const { return perception_; }
-  const WorldConfig& config() const { return config_; }
+  Perception& perception();
+  const Perception& perception() const;
+  const WorldConfig& config() const;
   void setScheduler(const SchedulerOptions& options);
-  void setUnresolvedPolicy(UnresolvedPolicy policy) { config_.unresolved_policy = policy; }
+  void setUnresolvedPolicy(UnresolvedPolicy policy);
   // From the next step on; throws InputError (validateResponseOptions) and changes nothing.
   void setResponse(const ResponseOptions& options);
   // Throws InputError("gravity") as the constructor does; wakes every island.
@@ -192,7 +201,7 @@ class World : private ShapeLibrary, private EntityTable {
   bool isSleeping(EntityId id) const;
   // The group the body at dense index `index` sleeps with (0: awake): what a
   // saved world writes (EntitySpec::sleep_group).
-  std::uint32_t sleepGroup(std::size_t index) const { return islands_.group(index); }
+  std::uint32_t sleepGroup(std::size_t index) const;
   // Awake and failing the rest test at the last step (it moved out of its
   // rest balls, rest_test.hpp): what keeps its island awake. False when asleep.
   bool isRestless(EntityId id) const;
@@ -202,7 +211,8 @@ class World : private ShapeLibrary, private EntityTable {
   ResponseLevel responseLevel(EntityId id) const;
 
   // What the next tick carries over from the last besides the bodies' rows
-  // (carried_state.hpp), by dense index: a saved world's contact_state.
+  // (carried_state.hpp, internal: the saved world's scene file reads it), by
+  // dense index: a saved world's contact_state.
   CarriedState carriedState() const;
   // The same put back into a World that holds the saved world's entities in
   // the same dense order with the same ids (EntitySpec::id), before its
@@ -216,114 +226,45 @@ class World : private ShapeLibrary, private EntityTable {
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.
   // A sleeping body's pose or velocity edited here wakes its island at the next step.
-  using EntityTable::entityCount;
-  using EntityTable::entityIds;
-  using EntityTable::bodies;
-  using EntityTable::bodyShapes;
-  using EntityTable::bodyNames;
-  using EntityTable::bodyDensities;
-  using EntityTable::bodyBoxModes;
+  std::size_t entityCount() const;
+  const std::vector<EntityId>& entityIds() const;
+  const std::vector<BodyState>& bodies() const;
+  std::vector<BodyState>& bodies();
+  const std::vector<ShapeId>& bodyShapes() const;
+  const std::vector<std::string>& bodyNames() const;
+  // The density each entity was added with (kg/m^3; a static body's too),
+  // and its box mode as resolved (never Auto): what a saved world needs
+  // that BodyState does not keep.
+  const std::vector<double>& bodyDensities() const;
+  const std::vector<BoxMode>& bodyBoxModes() const;
   // EntitySpec::closed_faces of the entity at dense index `index`.
-  std::uint8_t closedFaces(std::size_t index) const { return static_cover_.closedFaces(index); }
-  using EntityTable::indexOf;
+  std::uint8_t closedFaces(std::size_t index) const;
+  std::optional<std::size_t> indexOf(EntityId id) const;
 
   // Narrow-phase results of the last step: pairTests()[0..pairCount()).
-  const std::vector<PairTest>& pairTests() const { return pair_tests_; }
-  std::size_t pairCount() const { return pair_count_; }
+  // PairTest is internal (pair_test.hpp): for tests and benches.
+  const std::vector<PairTest>& pairTests() const;
+  std::size_t pairCount() const;
   // The last narrow phase's chunks (narrow_chunks.hpp; threads() before the
   // first): pairs chunkRange(pairCount(), k, narrowChunks()) were stepped by
   // chunk k's scheduler under chunkShare(budget, k, ...).
-  std::size_t narrowChunks() const { return narrow_chunks_used_; }
+  std::size_t narrowChunks() const;
   // Threads the tick runs on (WorldConfig::threads resolved: 0 -> the cores).
-  int threads() const { return workers_.threads(); }
+  int threads() const;
   // Times the team's loops into TickReport::phases.team_* (Workers::timeLoops: three
   // clock reads a loop, about 200 loops a tick of 500 bodies); off by default.
-  void timeTeamLoops(bool on) { workers_.timeLoops(on); }
-  const std::vector<Contact>& contacts() const { return contacts_; }
-  // The broad phase: its pairs and boxes as of the last step (checks and tests).
-  const SweepAndPrune& broadPhase() const { return broad_phase_; }
-  // What the physics did in the last step: fast bodies swept back, solver stats.
-  const PhysicsReport& physicsReport() const { return physics_.lastReport(); }
+  void timeTeamLoops(bool on);
+  const std::vector<Contact>& contacts() const;
+  // The broad phase: its pairs and boxes as of the last step (checks and
+  // tests; SweepAndPrune is internal).
+  const SweepAndPrune& broadPhase() const;
+  // What the physics did in the last step: fast bodies swept back, solver
+  // stats (PhysicsReport is internal: physics.hpp).
+  const PhysicsReport& physicsReport() const;
 
  private:
-  // The tick's context, made once at its start (tick_context.hpp), then the
-  // phases in tick order; each times itself into the report (PhaseTimer).
-  TickContext beginTick(double dt, const Budget& budget, TickReport& report);
-  void integrate(TickContext& tick);
-  void broadPhase(TickContext& tick);  // also sets up the pair tests of its pairs
-  void continuousCollision(TickContext& tick);
-  void narrowPhase(TickContext& tick);  // notes when the scheduler stopped (what follows is not interruptible)
-  void response(TickContext& tick);
-  // First and last: removes bodies beyond the limits; bodies flagged in
-  // `unchanged` (held through the tick) are not looked at again.
-  void quarantine(TickReport& report, const std::vector<std::uint8_t>* unchanged = nullptr);
-  // Fracture after the response, and the breaks that waited, at the tick's
-  // start (WorldFracture::fracture / breakPending, world_fracture.cpp); their
-  // time counts in TickFracture::fracture_s.
-  void fracture(TickContext& tick);
-  void breakPending(TickContext& tick);
-  Aabb boxOf(std::size_t index) const;
-  Aabb sweptBoxOf(std::size_t index) const;
-  void invalidateLastTick();
-  // Island levels (world_levels.cpp). Whether the response is limited this
-  // tick; the islands ranked and the ones beyond the allowance held
-  // (before integrate); held islands a moving body reaches joined to the tick
-  // and integrated (after the broad phase's pairs); after the tick, what a
-  // unit of cost took and what the phases that must run took, for the next.
-  static bool responseLimited(const Budget& budget);
-  void chooseLevels(const Budget& budget, TickReport& report);
-  void joinHeldIslands(TickContext& tick);
-  void learnLevelCosts(double must_run_s, double response_mandatory_s, const TickReport& report);
-  // The solver's "held" bodies: asleep or held by their level (for its warm-start store).
-  const std::vector<std::uint8_t>& outOfStep();
-  bool setUpPairTests();  // bodies of the broad phase's pairs; true when a sleeping island woke
-
-  WorldConfig config_;
-  Workers workers_;  // before the phases that use it
-  // The shapes: the ShapeLibrary base (shapes_, shape_bounds_, cover_shapes_).
-  // The entities' rows: the EntityTable base (ids_, bodies_, body_shapes_,
-  // box_modes_, densities_, names_, index_of_).
-  StaticCover static_cover_;  // static bodies' faces other static bodies cover, by dense index
-
-  SweepAndPrune broad_phase_;
-  std::vector<Aabb> boxes_;  // this tick's box of each body, by dense index (pooled)
-  std::vector<EntityId> partners_;  // removeEntity: the broad-phase partners of the removed body (pooled)
-  // The narrow phase's chunks, as many as it ever cuts (narrow_chunks.hpp): a
-  // scheduler each and the arena of its pair tests' hits; in a vector made
-  // once, so the arenas keep their address when the World is moved (the pair
-  // tests point at them).
-  std::vector<NarrowChunk> narrow_chunks_;
-  std::size_t narrow_chunks_used_ = 1;  // by the last narrow phase
-  Perception perception_;
-  std::vector<PairTest> pair_tests_;  // pooled: capacity kept between ticks
-  std::size_t pair_count_ = 0;
-  std::vector<std::array<std::uint32_t, 2>> pair_bodies_;  // dense indices of each pair test's bodies
-  std::vector<std::uint8_t> pair_tested_;  // setUpPairTests: per broad-phase pair, not static-static
-  // setUpPairTests: each broad-phase pair's ids and dense indices as last
-  // looked up, by its place in the pair list (a pair mostly keeps its place
-  // from tick to tick); emptied when a removal moves dense indices.
-  struct SeenPair {
-    BroadPair ids{0, 0};  // {0, 0} is no pair: a miss
-    std::array<std::uint32_t, 2> indices{};
-  };
-  std::vector<SeenPair> pairs_seen_;
-  std::vector<double> pair_priority_;  // perceptual priority of each pair test (0 without gaze)
-  std::vector<std::uint32_t> pair_reused_;  // each pair's carried-over contacts (PairContactCache), or kNone
-  std::vector<Contact> contacts_;
-  Physics physics_;  // integration and response (response.hpp), warm-start state
-  Islands islands_;  // which bodies sleep, indexed like bodies_
-  IslandLevels levels_;  // which awake islands are held this tick, indexed like bodies_
-  // Learnt from timed ticks (world_levels.cpp): seconds of the response's
-  // mandatory part per unit of island cost, and of the phases that must run.
-  double cost_unit_s_ = 0.0;
-  double must_run_s_ = 0.0;
-  std::vector<std::uint8_t> out_of_step_;  // outOfStep (pooled)
-  SecondsClock clock_ = steadySeconds;
-  std::int64_t clock_check_every_ = BudgetTracker::kDefaultCheckEvery;  // of clock_ (setClock)
-  double reserve_s_ = 0.0;  // TickReport::budget.reserve_s of the next tick
-  std::vector<QuarantinedEntity> quarantined_;  // by the last step
-  std::vector<std::uint8_t> held_through_tick_;  // step: Islands::held() before endTick (pooled)
-  std::unique_ptr<WorldFracture> fracture_;  // its queue, tree costs and what broke
+  struct Parts;  // src/core/world_parts.hpp
+  std::unique_ptr<Parts> parts_;
 };
 
 }  // namespace stc

@@ -1,6 +1,6 @@
 // World: composes shapes, entities, what follows them and fracture, and runs
 // the phases of one tick.
-#include "sphere_tree_collision/world.hpp"
+#include "world_parts.hpp"
 
 #include "flat_hash_map.hpp"
 #include "grow_capacity.hpp"
@@ -37,8 +37,9 @@ bool narrowPhaseLimited(const Budget& budget, const Deadline& tick_end) {
 
 }  // namespace
 
-World::World(const WorldConfig& config)
-    : config_(config),
+World::Parts::Parts(World& owner, const WorldConfig& config)
+    : world(&owner),
+      config_(config),
       workers_(config.threads),
       narrow_chunks_(makeNarrowChunks(narrowChunkCount(static_cast<std::size_t>(workers_.threads()), false),
                                       config.scheduler)),
@@ -50,21 +51,89 @@ World::World(const WorldConfig& config)
   validateFractureOptions(config_.fracture);
   validateSleepOptions(config_.sleeping);
 }
+World::Parts::~Parts() = default;
+
+// ---------------------------------------------------------------------------------
+// World: its calls, each into its parts
+
+World::World(const WorldConfig& config) : parts_(std::make_unique<Parts>(*this, config)) {}
 World::~World() = default;
-World::World(World&&) noexcept = default;
-World& World::operator=(World&&) noexcept = default;
+World::World(World&& other) noexcept : parts_(std::move(other.parts_)) {
+  if (parts_) parts_->world = this;
+}
+World& World::operator=(World&& other) noexcept {
+  parts_ = std::move(other.parts_);
+  if (parts_) parts_->world = this;
+  return *this;
+}
+
+ShapeId World::addShape(const std::string& key, VoxelShape shape) { return parts_->addShape(key, std::move(shape)); }
+std::optional<ShapeId> World::findShape(const std::string& key) const { return parts_->findShape(key); }
+const ShapeInfo& World::shape(ShapeId id) const { return parts_->shape(id); }
+std::size_t World::shapeCount() const { return parts_->shapeCount(); }
+void World::setShapeRecipe(ShapeId id, const ShapeRecipe& recipe) { parts_->setShapeRecipe(id, recipe); }
+
+EntityId World::addEntity(const EntitySpec& spec) { return parts_->addEntity(spec); }
+void World::validateEntity(const EntitySpec& spec) const { parts_->validateEntity(spec); }
+bool World::removeEntity(EntityId id) { return parts_->removeEntity(id); }
+std::optional<EntityId> World::findByName(const std::string& name) const { return parts_->findByName(name); }
+void World::clear() { parts_->clear(); }
+void World::releaseMemory() { parts_->releaseMemory(); }
+std::vector<EntityId> World::breakEntity(EntityId id, const Vec3& point, const Vec3& normal) {
+  return parts_->breakEntity(id, point, normal);
+}
+
+TickReport World::step(double dt, const Budget& budget) { return parts_->step(dt, budget); }
+void World::setClock(SecondsClock clock) { parts_->setClock(std::move(clock)); }
+const std::vector<QuarantinedEntity>& World::quarantined() const { return parts_->quarantined_; }
+
+Perception& World::perception() { return parts_->perception_; }
+const Perception& World::perception() const { return parts_->perception_; }
+const WorldConfig& World::config() const { return parts_->config_; }
+void World::setScheduler(const SchedulerOptions& options) { parts_->setScheduler(options); }
+void World::setUnresolvedPolicy(UnresolvedPolicy policy) { parts_->config_.unresolved_policy = policy; }
+void World::setResponse(const ResponseOptions& options) { parts_->setResponse(options); }
+void World::setGravity(const Vec3& gravity) { parts_->setGravity(gravity); }
+bool World::wake(EntityId id) { return parts_->wake(id); }
+bool World::isSleeping(EntityId id) const { return parts_->isSleeping(id); }
+std::uint32_t World::sleepGroup(std::size_t index) const { return parts_->islands_.group(index); }
+bool World::isRestless(EntityId id) const { return parts_->isRestless(id); }
+ResponseLevel World::responseLevel(EntityId id) const { return parts_->responseLevel(id); }
+
+CarriedState World::carriedState() const { return parts_->carriedState(); }
+void World::restoreCarried(const CarriedState& state) { parts_->restoreCarried(state); }
+
+std::size_t World::entityCount() const { return parts_->entityCount(); }
+const std::vector<EntityId>& World::entityIds() const { return parts_->entityIds(); }
+const std::vector<BodyState>& World::bodies() const { return parts_->EntityTable::bodies(); }
+std::vector<BodyState>& World::bodies() { return parts_->EntityTable::bodies(); }
+const std::vector<ShapeId>& World::bodyShapes() const { return parts_->bodyShapes(); }
+const std::vector<std::string>& World::bodyNames() const { return parts_->bodyNames(); }
+const std::vector<double>& World::bodyDensities() const { return parts_->bodyDensities(); }
+const std::vector<BoxMode>& World::bodyBoxModes() const { return parts_->bodyBoxModes(); }
+std::uint8_t World::closedFaces(std::size_t index) const { return parts_->static_cover_.closedFaces(index); }
+std::optional<std::size_t> World::indexOf(EntityId id) const { return parts_->indexOf(id); }
+
+const std::vector<PairTest>& World::pairTests() const { return parts_->pair_tests_; }
+std::size_t World::pairCount() const { return parts_->pair_count_; }
+std::size_t World::narrowChunks() const { return parts_->narrow_chunks_used_; }
+int World::threads() const { return parts_->workers_.threads(); }
+void World::timeTeamLoops(bool on) { parts_->workers_.timeLoops(on); }
+const std::vector<Contact>& World::contacts() const { return parts_->contacts_; }
+const SweepAndPrune& World::broadPhase() const { return parts_->broad_phase_; }
+const PhysicsReport& World::physicsReport() const { return parts_->physics_.lastReport(); }
 
 // ---------------------------------------------------------------------------------
 // Shapes
 
-ShapeId World::addShape(const std::string& key, VoxelShape voxels) {
+ShapeId World::Parts::addShape(const std::string& key, VoxelShape voxels) {
   return ShapeLibrary::addShape(key, std::move(voxels), config_.voxel_limits, config_.tree);
 }
 
 // ---------------------------------------------------------------------------------
 // Entities
 
-void World::validateEntity(const EntitySpec& spec) const {
+void World::Parts::validateEntity(const EntitySpec& spec) const {
   validateBodyInput(spec.pose, spec.linear_velocity, spec.angular_velocity, spec.density,
                     spec.material, config_.limits);
   if (!spec.name.empty() && findByName(spec.name)) {
@@ -90,7 +159,7 @@ void World::validateEntity(const EntitySpec& spec) const {
   }
 }
 
-EntityId World::addEntity(const EntitySpec& spec) {
+EntityId World::Parts::addEntity(const EntitySpec& spec) {
   // Validate everything first: on throw nothing has changed.
   const ShapeInfo& info = shape(spec.shape);  // throws InputError("shape") for an unknown id
   validateEntity(spec);
@@ -127,7 +196,7 @@ EntityId World::addEntity(const EntitySpec& spec) {
   return id;
 }
 
-bool World::removeEntity(EntityId id) {
+bool World::Parts::removeEntity(EntityId id) {
   const std::uint32_t found = index_of_->find(id);
   if (found == detail::FlatHashMap::kMissing) return false;
   const std::size_t index = found;
@@ -148,7 +217,7 @@ bool World::removeEntity(EntityId id) {
   return true;
 }
 
-void World::clear() {
+void World::Parts::clear() {
   clearRows();
   pairs_seen_.clear();
   broad_phase_ = SweepAndPrune();
@@ -159,7 +228,7 @@ void World::clear() {
   invalidateLastTick();
 }
 
-void World::releaseMemory() {
+void World::Parts::releaseMemory() {
   releaseRowMemory();
   dropSpareCapacity(static_cover_);
   broad_phase_.releaseMemory();
@@ -178,7 +247,7 @@ void World::releaseMemory() {
   fracture_->releaseMemory();
 }
 
-void World::setScheduler(const SchedulerOptions& options) {
+void World::Parts::setScheduler(const SchedulerOptions& options) {
   // All made before any is replaced (makeScheduler may throw: change nothing).
   // The chunks stay: their arenas hold the last tick's pairs.
   std::vector<NarrowChunk> made = makeNarrowChunks(narrow_chunks_.size(), options);
@@ -186,7 +255,7 @@ void World::setScheduler(const SchedulerOptions& options) {
   config_.scheduler = options;
 }
 
-void World::setResponse(const ResponseOptions& options) {
+void World::Parts::setResponse(const ResponseOptions& options) {
   validateResponseOptions(options);
   if (options.solver != config_.response.solver) physics_.forget();  // impulses of another kind of step
   config_.response = options;
@@ -194,31 +263,31 @@ void World::setResponse(const ResponseOptions& options) {
   if (!options.enabled) islands_.wakeAll();  // detection alone: every pair is tested again
 }
 
-void World::setGravity(const Vec3& gravity) {
+void World::Parts::setGravity(const Vec3& gravity) {
   validateGravity(gravity, config_.limits);
   config_.gravity = gravity;
   islands_.wakeAll();
 }
 
-bool World::wake(EntityId id) {
+bool World::Parts::wake(EntityId id) {
   const auto index = indexOf(id);
   if (index) islands_.wake(*index);
   return index.has_value();
 }
 
-bool World::isSleeping(EntityId id) const {
+bool World::Parts::isSleeping(EntityId id) const {
   const auto index = indexOf(id);
   return index && islands_.isSleeping(*index);
 }
 
-bool World::isRestless(EntityId id) const {
+bool World::Parts::isRestless(EntityId id) const {
   const auto index = indexOf(id);
   return index && islands_.isRestless(*index);
 }
 
 // The last tick's pair tests point at bodies and its contacts name dense
 // indices: both go stale when entities are added or removed.
-void World::invalidateLastTick() {
+void World::Parts::invalidateLastTick() {
   pair_count_ = 0;
   contacts_.clear();
 }
@@ -226,12 +295,12 @@ void World::invalidateLastTick() {
 // ---------------------------------------------------------------------------------
 // The tick
 
-void World::setClock(SecondsClock clock) {
+void World::Parts::setClock(SecondsClock clock) {
   clock_check_every_ = checkEveryFor(clock);
   clock_ = std::move(clock);
 }
 
-TickReport World::step(double dt, const Budget& budget) {
+TickReport World::Parts::step(double dt, const Budget& budget) {
   if (!(std::isfinite(dt) && dt >= 0.0)) throw InputError("dt", "must be finite and >= 0");
   TickReport report;
   report.bodies.entities = ids_.size();
@@ -286,7 +355,7 @@ TickReport World::step(double dt, const Budget& budget) {
 // Read once, at the tick's start: the clock, the deadline and the physics
 // phases' view of the World (its pointers hold for the tick; the pair count
 // is read where it stands when each phase runs).
-TickContext World::beginTick(double dt, const Budget& budget, TickReport& report) {
+TickContext World::Parts::beginTick(double dt, const Budget& budget, TickReport& report) {
   const double start = clock_();
   const bool timed = budget.tick_seconds < std::numeric_limits<double>::infinity();  // NaN: none
   const Deadline tick_end = timed ? Deadline(&clock_, start + std::max(budget.tick_seconds, 0.0)) : Deadline();
@@ -324,13 +393,13 @@ TickContext World::beginTick(double dt, const Budget& budget, TickReport& report
 
 // The island levels first (held islands are static until released), then
 // semi-implicit Euler; marks the fast bodies (physics.hpp).
-void World::integrate(TickContext& tick) {
+void World::Parts::integrate(TickContext& tick) {
   PhaseTimer timer(tick.time, tick.report.phases.integrate_s);
   if (tick.levelled) chooseLevels(tick.budget, tick.report);
   physics_.integrate(tick.physics);
 }
 
-Aabb World::boxOf(std::size_t index) const {
+Aabb World::Parts::boxOf(std::size_t index) const {
   const BodyState& body = bodies_[index];
   const ShapeInfo& info = shapes_[body_shapes_[index]];
   Aabb box;
@@ -361,7 +430,7 @@ Aabb World::boxOf(std::size_t index) const {
 // A fast body's box covers its whole path of the tick (the cube that holds it
 // in any orientation, at its start and at its end), so its sweep partners
 // are among its broad-phase pairs.
-Aabb World::sweptBoxOf(std::size_t index) const {
+Aabb World::Parts::sweptBoxOf(std::size_t index) const {
   const double radius = shapes_[body_shapes_[index]].bounding_radius;
   const Vec3 start = physics_.startPose(index).position;
   const Vec3 end = bodies_[index].pose.position;
@@ -371,7 +440,7 @@ Aabb World::sweptBoxOf(std::size_t index) const {
   return box;
 }
 
-void World::broadPhase(TickContext& tick) {
+void World::Parts::broadPhase(TickContext& tick) {
   PhaseTimer timer(tick.time, tick.report.phases.broad_s);
   const double dt = tick.dt;
   // The boxes in parallel (each body alone), then handed over in order. A
@@ -407,7 +476,7 @@ void World::broadPhase(TickContext& tick) {
 
 // The pairs' bodies; the tests themselves are reset by their chunk of the
 // narrow phase, in parallel, each into its chunk's arena.
-bool World::setUpPairTests() {
+bool World::Parts::setUpPairTests() {
   pair_count_ = 0;
   if (islands_.quiet()) return false;  // all asleep: every pair is held-held or held-static
   // Each pair's dense indices and whether it is tested, in pieces on the
@@ -447,12 +516,12 @@ bool World::setUpPairTests() {
 
 // Fast bodies put back at their first contact with a broad-phase partner
 // (continuous.hpp, sweepFastBodies); the pair tests read the poses when they run.
-void World::continuousCollision(TickContext& tick) {
+void World::Parts::continuousCollision(TickContext& tick) {
   PhaseTimer timer(tick.time, tick.report.phases.sweep_s);
   physics_.sweep(tick.physics);
 }
 
-void World::narrowPhase(TickContext& tick) {
+void World::Parts::narrowPhase(TickContext& tick) {
   PhaseTimer timer(tick.time, tick.report.phases.narrow_s);
   tick.narrow_start = timer.start();
   const double start = timer.start();
@@ -542,7 +611,7 @@ void World::narrowPhase(TickContext& tick) {
 // Contacts from the deepest sphere pairs of each colliding or accepted pair,
 // then impulses and position correction (contact_builder.hpp,
 // contact_solver.hpp), refined until the tick's deadline or the iteration budget.
-void World::response(TickContext& tick) {
+void World::Parts::response(TickContext& tick) {
   PhaseTimer timer(tick.time, tick.report.phases.response_s);
   TickReport& report = tick.report;
   if (tick.timed) report.budget.response_budget_s = std::max(tick.tick_end.at() - timer.start(), 0.0);
@@ -563,7 +632,7 @@ void World::response(TickContext& tick) {
 // solver blow-up, a fall forever) is removed here, before anything reads its
 // state, and named in quarantined(). Removing invalidates this tick's
 // contacts (they name dense indices); the rest of the world is untouched.
-void World::quarantine(TickReport& report, const std::vector<std::uint8_t>* unchanged) {
+void World::Parts::quarantine(TickReport& report, const std::vector<std::uint8_t>* unchanged) {
   const std::size_t first = quarantined_.size();
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     if (unchanged != nullptr && (*unchanged)[i] != 0) continue;

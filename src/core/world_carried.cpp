@@ -1,6 +1,6 @@
 // World: what a tick carries over to the next (carried_state.hpp), out for
 // a saved world and back into the loaded one.
-#include "sphere_tree_collision/world.hpp"
+#include "world_parts.hpp"
 
 #include "flat_hash_map.hpp"
 
@@ -26,7 +26,7 @@ void requireRange(std::uint32_t first, std::uint32_t count, std::size_t size, st
 
 }  // namespace
 
-CarriedState World::carriedState() const {
+CarriedState World::Parts::carriedState() const {
   CarriedState out;
   const std::size_t n = ids_.size();
   for (std::size_t i = 0; i < n; ++i) {
@@ -77,7 +77,7 @@ CarriedState World::carriedState() const {
   return out;
 }
 
-void World::restoreCarried(const CarriedState& state) {
+void World::Parts::restoreCarried(const CarriedState& state) {
   const std::size_t n = ids_.size();
   // Everything checked before anything changes.
   for (std::size_t k = 0; k < state.rest.size(); ++k) {

@@ -4,6 +4,7 @@
 #include "world_fracture.hpp"
 
 #include "tick_context.hpp"
+#include "world_parts.hpp"
 
 #include <algorithm>
 #include <string>
@@ -13,18 +14,18 @@ namespace stc {
 // ---------------------------------------------------------------------------------
 // World: its calls into the part
 
-std::vector<EntityId> World::breakEntity(EntityId id, const Vec3& point, const Vec3& normal) {
-  return fracture_->breakEntity(*this, id, point, normal);
+std::vector<EntityId> World::Parts::breakEntity(EntityId id, const Vec3& point, const Vec3& normal) {
+  return fracture_->breakEntity(*world, id, point, normal);
 }
 
-const std::vector<BrokenEntity>& World::broken() const { return fracture_->broken(); }
+const std::vector<BrokenEntity>& World::broken() const { return parts_->fracture_->broken(); }
 
-void World::fracture(TickContext& tick) {
-  tick.time.now = fracture_->fracture(*this, clock_, tick.time.now, tick.tick_end, tick.report);
+void World::Parts::fracture(TickContext& tick) {
+  tick.time.now = fracture_->fracture(*world, clock_, tick.time.now, tick.tick_end, tick.report);
 }
 
-void World::breakPending(TickContext& tick) {
-  tick.time.now = fracture_->breakPending(*this, clock_, tick.time.now, tick.tick_end, tick.report);
+void World::Parts::breakPending(TickContext& tick) {
+  tick.time.now = fracture_->breakPending(*world, clock_, tick.time.now, tick.tick_end, tick.report);
 }
 
 // ---------------------------------------------------------------------------------

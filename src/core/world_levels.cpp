@@ -1,7 +1,7 @@
 // World: the island levels of a limited response (island_levels.hpp) wired
 // into the tick: what the allowance is, the joins after the broad phase, and
 // what a unit of cost took.
-#include "sphere_tree_collision/world.hpp"
+#include "world_parts.hpp"
 
 #include "tick_context.hpp"
 
@@ -38,12 +38,12 @@ double reachOf(const ShapeInfo& shape) {
 
 }  // namespace
 
-bool World::responseLimited(const Budget& budget) {
+bool World::Parts::responseLimited(const Budget& budget) {
   return budget.tick_seconds < std::numeric_limits<double>::infinity() ||
          budget.response_contacts < std::numeric_limits<std::int64_t>::max();
 }
 
-void World::chooseLevels(const Budget& budget, TickReport& report) {
+void World::Parts::chooseLevels(const Budget& budget, TickReport& report) {
   double allowance = std::numeric_limits<double>::infinity();
   if (budget.response_contacts < std::numeric_limits<std::int64_t>::max()) {
     allowance = static_cast<double>(std::max<std::int64_t>(budget.response_contacts, 0));
@@ -66,7 +66,7 @@ void World::chooseLevels(const Budget& budget, TickReport& report) {
 // sleeper, which moves from now on too: until nothing more joins. Then the
 // joined bodies are integrated, from where they were held; their boxes
 // (IslandLevels::heldBox) already cover where that takes them.
-void World::joinHeldIslands(TickContext& tick) {
+void World::Parts::joinHeldIslands(TickContext& tick) {
   const double dt = tick.dt;
   const std::vector<BroadPair>& pairs = broad_phase_.pairs();
   const auto pair_at = [&](std::size_t k) { return pairs_seen_[k].indices; };
@@ -102,7 +102,7 @@ void World::joinHeldIslands(TickContext& tick) {
   physics_.integrate(step);
 }
 
-void World::learnLevelCosts(double must_run_s, double response_mandatory_s, const TickReport& report) {
+void World::Parts::learnLevelCosts(double must_run_s, double response_mandatory_s, const TickReport& report) {
   must_run_s_ = must_run_s_ > 0.0 ? must_run_s_ + kCostUnitWeight * (must_run_s - must_run_s_) : must_run_s;
   const double units = static_cast<double>(contacts_.size() + report.response.levels.bodies_full);
   if (!(units > 0.0)) return;
@@ -110,14 +110,14 @@ void World::learnLevelCosts(double must_run_s, double response_mandatory_s, cons
   cost_unit_s_ = cost_unit_s_ > 0.0 ? cost_unit_s_ + kCostUnitWeight * (measured - cost_unit_s_) : measured;
 }
 
-const std::vector<std::uint8_t>& World::outOfStep() {
+const std::vector<std::uint8_t>& World::Parts::outOfStep() {
   const std::vector<std::uint8_t>& asleep = islands_.held();
   out_of_step_.resize(bodies_.size());
   for (std::size_t i = 0; i < bodies_.size(); ++i) out_of_step_[i] = (asleep[i] != 0 || levels_.isHeld(i)) ? 1 : 0;
   return out_of_step_;
 }
 
-ResponseLevel World::responseLevel(EntityId id) const {
+ResponseLevel World::Parts::responseLevel(EntityId id) const {
   const auto index = indexOf(id);
   if (!index) return ResponseLevel::Full;
   if (bodies_[*index].is_static) return ResponseLevel::Static;
