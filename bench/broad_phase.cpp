@@ -10,9 +10,9 @@
 //
 // Usage: bench_broad_phase [--quick|--smoke]  (--quick: smaller N, 20 ticks; --smoke: one small N, 3 ticks)
 // Prints three markdown tables.
-#include "sphere_tree_collision/sweep_and_prune.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "sweep_and_prune.hpp"
 
 #include <fcl/broadphase/broadphase_SaP.h>
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>

@@ -9,6 +9,7 @@
 //   --smoke: 3 ticks of small scenes, that the bench runs (scripts/bench_smoke.sh)
 //   default: packed_box:500 bouncing_box:100 rockfall:1000 corner_drift:500, 10 s
 //   e.g.     bench_continuous --seconds 2 rockfall:1000
+#include "physics.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 

@@ -12,6 +12,7 @@
 #include "sphere_tree_collision/world.hpp"
 
 #include "bench_args.hpp"
+#include "sweep_and_prune.hpp"
 #include "tick_clock.hpp"
 
 #include <algorithm>

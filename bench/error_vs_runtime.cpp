@@ -36,8 +36,10 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
-#include "fcl_mesh.hpp"
 #include "bench_args.hpp"
+#include "contact_builder.hpp"
+#include "fcl_mesh.hpp"
+#include "pair_test.hpp"
 #include "tick_clock.hpp"
 
 #include <algorithm>

@@ -15,8 +15,9 @@
 // Usage: bench_leaf_boxes [--scene cube_box] [--bodies 10000] [--ticks 150] [--margin 0.1]
 //          [--smoke]  (200 bodies, 3 ticks: that the bench runs, scripts/bench_smoke.sh)
 #include "bench_args.hpp"
+#include "pair_test.hpp"
+#include "shape_bounds.hpp"
 #include "sphere_tree_collision/scenes.hpp"
-#include "sphere_tree_collision/shape_bounds.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <cmath>

@@ -19,6 +19,7 @@
 //
 // Usage: bench_load [--quick|--smoke] [--markdown FILE]   (--smoke: that the bench runs, scripts/bench_smoke.sh)
 #include "fcl_mesh.hpp"
+#include "physics.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
 

@@ -21,7 +21,7 @@
 //   --smoke: 50 poses, 1 pass: that the bench runs (scripts/bench_smoke.sh)
 #include "fcl_mesh.hpp"
 #include "pose_sampling.hpp"
-#include "sphere_tree_collision/pair_test.hpp"
+#include "pair_test.hpp"
 #include "tick_clock.hpp"
 
 #include <fcl/narrowphase/collision.h>

@@ -36,6 +36,7 @@
 // Last lines: SPEEDUP scene=<name> threads=<N> x=<wall ratio>, then
 // CEILING scene=<name> threads=<N> x=<N worlds side by side: throughput over one alone>.
 #include "bench_args.hpp"
+#include "physics.hpp"
 #include "scene_cases.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"

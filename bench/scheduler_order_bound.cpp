@@ -39,9 +39,11 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 
-#include "fcl_mesh.hpp"
 #include "bench_args.hpp"
+#include "fcl_mesh.hpp"
+#include "pair_test.hpp"
 #include "scene_sim.hpp"
+#include "scheduler.hpp"
 
 #include <algorithm>
 #include <array>

@@ -8,7 +8,7 @@
 //   bench_stability --smoke    a few ticks of each: that the bench runs, scripts/bench_smoke.sh
 #include "stability_scenes.hpp"
 
-#include "sphere_tree_collision/dynamics.hpp"
+#include "dynamics.hpp"
 
 #include <cstdio>
 #include <cstring>

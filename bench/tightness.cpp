@@ -17,8 +17,8 @@
 //   --smoke: the first preset only, that the bench runs, scripts/bench_smoke.sh)
 #include "doc_output.hpp"
 #include "fcl_mesh.hpp"
-#include "sphere_union.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
+#include "sphere_union.hpp"
 
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/narrowphase/distance.h>

@@ -8,7 +8,7 @@ add_library(stc_fuzz_ros STATIC
   ${PROJECT_SOURCE_DIR}/src/ros/conversions.cpp
   ${PROJECT_SOURCE_DIR}/src/ros/mesh_resource.cpp)
 target_include_directories(stc_fuzz_ros PUBLIC ${PROJECT_SOURCE_DIR}/include ${PROJECT_SOURCE_DIR}/src/ros/include)
-target_link_libraries(stc_fuzz_ros stc_core stc_scene ${catkin_LIBRARIES})
+target_link_libraries(stc_fuzz_ros stc_core stc_core_internal stc_scene ${catkin_LIBRARIES})
 # Mesh entities: assimp loading and package:// resolution.
 target_link_libraries(stc_fuzz_ros stc_mesh ${roslib_LIBRARIES})
 target_include_directories(stc_fuzz_ros SYSTEM PRIVATE ${roslib_INCLUDE_DIRS})

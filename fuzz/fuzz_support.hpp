@@ -4,6 +4,7 @@
 #pragma once
 
 #include "sphere_tree_collision/world.hpp"
+#include "sweep_and_prune.hpp"
 
 #include <fuzzer/FuzzedDataProvider.h>
 

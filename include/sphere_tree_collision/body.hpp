@@ -1,7 +1,12 @@
-// Rigid-body state of one entity, stored in the World's flat array.
+// What one entity is besides its shape: its rigid-body state (stored in the
+// World's flat array), material, broad-phase box mode and closed faces.
 #pragma once
 
 #include "sphere_tree_collision/types.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
 
 namespace stc {
 
@@ -31,5 +36,25 @@ struct BodyState {
   Material material;
   bool is_static = false;
 };
+
+// How an entity's broad-phase box is made (paper 3.2).
+enum class BoxMode : std::uint8_t {
+  Auto,     // chosen from the shape: Dynamic when elongated, else FixedCube
+  FixedCube,  // cube big enough for any orientation; only moves with the centre
+  Dynamic,    // tight AABB of the rotated root-level spheres, recomputed each tick
+};
+
+// EntitySpec::closed_faces (world.hpp); the static cover (src/core) keeps
+// them. Bit of a node box's face in a per-node mask: body-frame axis 0..2, outward
+// along +axis (positive) or -axis.
+inline std::uint8_t faceBit(int axis, bool positive) {
+  return static_cast<std::uint8_t>(1u << (2 * axis + (positive ? 0 : 1)));
+}
+constexpr std::uint8_t kAllFaces = 63;
+// "+x", "-x", "+y", "-y", "+z", "-z" (body frame) -> their faceBits OR'ed;
+// throws InputError("closed_faces") naming an unknown face.
+std::uint8_t parseFaces(const std::vector<std::string>& names);
+// The names of a mask's faces, in faceBit order (parseFaces' inverse).
+std::vector<std::string> faceNames(std::uint8_t mask);
 
 }  // namespace stc

@@ -3,7 +3,6 @@
 // f(e, g) = g / exp(e / 100) with e and g in pixels.
 #pragma once
 
-#include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/types.hpp"
 
 #include <cmath>
@@ -12,6 +11,8 @@
 namespace stc {
 
 using Vec2 = Eigen::Vector2d;
+
+class PairTest;  // src/core/pair_test.hpp: what measure() and projectedGap() read
 
 // Pinhole camera. The camera frame is the optical frame: x right, y down,
 // z forward (REP 103 "_optical" convention). Pixel (0,0) is the top-left.

@@ -1,43 +1,32 @@
-// World: composes the shapes (ShapeLibrary), the entities' rows
-// (EntityTable), what follows them, fracture (WorldFracture) and the phases;
-// step() runs one tick:
+// World: the shapes, the entities, what follows them, fracture and the
+// phases (World::Parts, internal: src/core/world_parts.hpp); step() runs one
+// tick:
 //   1 integrate  2 broad phase  3 narrow phase + scheduler  4 response
 // and returns a TickReport. Each phase reads what the previous one wrote.
 #pragma once
 
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
-#include "sphere_tree_collision/carried_state.hpp"
 #include "sphere_tree_collision/contact.hpp"
-#include "sphere_tree_collision/entity_table.hpp"
-#include "sphere_tree_collision/fracture.hpp"
-#include "sphere_tree_collision/island_levels.hpp"
-#include "sphere_tree_collision/islands.hpp"
 #include "sphere_tree_collision/limits.hpp"
-#include "sphere_tree_collision/narrow_chunks.hpp"
-#include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
-#include "sphere_tree_collision/response.hpp"
-#include "sphere_tree_collision/scheduler.hpp"
-#include "sphere_tree_collision/shape_library.hpp"
+#include "sphere_tree_collision/phase_options.hpp"
+#include "sphere_tree_collision/response_options.hpp"
+#include "sphere_tree_collision/shape_info.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
-#include "sphere_tree_collision/static_cover.hpp"
-#include "sphere_tree_collision/sweep_and_prune.hpp"
 #include "sphere_tree_collision/tick_report.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
-#include "sphere_tree_collision/workers.hpp"
 
-#include <array>
-#include <limits>
+#include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 namespace stc {
 
-// BoxMode (entity_table.hpp): "auto" | "fixed" | "dynamic"; throws InputError("box_mode").
+// BoxMode (body.hpp): "auto" | "fixed" | "dynamic"; throws InputError("box_mode").
 BoxMode parseBoxMode(const std::string& name);
 const char* toString(BoxMode mode);
 
@@ -55,9 +44,9 @@ struct WorldConfig {
   std::size_t max_entities = 20000;
   ResponseOptions response;
   PhysicalLimits limits;  // inputs beyond them are rejected; bodies beyond them quarantined
-  FractureOptions fracture;  // for bodies with a material strength (fracture.hpp)
-  SleepOptions sleeping;  // islands at rest sleep (islands.hpp); validated as "sleeping.*"
-  // Threads of the tick (workers.hpp): 0 = every core, 1 = the calling thread
+  FractureOptions fracture;  // for bodies with a material strength (phase_options.hpp)
+  SleepOptions sleeping;  // islands at rest sleep (phase_options.hpp); validated as "sleeping.*"
+  // Threads of the tick (docs/parallel.md): 0 = every core, 1 = the calling thread
   // alone (no task library), n = n. Results at an unlimited budget do not
   // depend on it (docs/parallel.md). Throws
   // InputError("threads") outside [0, kMaxThreads].
@@ -83,7 +72,7 @@ struct EntitySpec {
   bool is_static = false;
   BoxMode box_mode = BoxMode::Auto;
   // Static bodies only: faces of the body frame that are not surfaces
-  // (faceBit, static_cover.hpp), so no contact pushes a body out through them.
+  // (faceBit, body.hpp), so no contact pushes a body out through them.
   // The back of a one-sided wall or floor (faceBit(2, false) when its inside
   // faces +z): a body pressed deeper than half the wall's thickness is still
   // pushed back in, not out through the back. 0: every face is a surface.
@@ -128,8 +117,8 @@ struct CarriedState;   // src/core/carried_state.hpp
 // The shapes (a ShapeLibrary), the entities' rows (an EntityTable), what
 // follows each add and remove, fracture and the phases are World::Parts
 // (src/core/world_parts.hpp), held by pointer: this header names none of
-// them, and a World moves by moving the pointer. What World adds to them is
-// the validation, and the parts that follow each add and remove.
+// them, and a World moves by moving the pointer (a moved-from World may only
+// be assigned to or destroyed).
 class World {
  public:
   explicit World(const WorldConfig& config = WorldConfig{});

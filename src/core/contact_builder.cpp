@@ -1,8 +1,8 @@
 // Contacts from the intersecting sphere pairs of a PairTest (paper 3.5, Fig. 4).
-#include "sphere_tree_collision/contact_builder.hpp"
+#include "contact_builder.hpp"
 
-#include "sphere_tree_collision/contact_solver.hpp"  // tangentBasis
-#include "sphere_tree_collision/static_cover.hpp"    // faceBit
+#include "contact_solver.hpp"  // tangentBasis
+#include "static_cover.hpp"    // faceBit
 
 #include <algorithm>
 #include <cmath>

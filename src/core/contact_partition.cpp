@@ -1,5 +1,5 @@
 // Spatial partition of the solver's contact groups (contact_partition.hpp).
-#include "sphere_tree_collision/contact_partition.hpp"
+#include "contact_partition.hpp"
 
 #include "grow_capacity.hpp"
 

@@ -4,7 +4,7 @@
 // normal, rolling resistance. Internal to src/core.
 #pragma once
 
-#include "sphere_tree_collision/contact_solver.hpp"
+#include "contact_solver.hpp"
 
 #include <cmath>
 

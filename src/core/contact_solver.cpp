@@ -1,8 +1,8 @@
 // Impulse solver: non-penetration + Coulomb friction, restitution, split-impulse
 // position correction; sequential (Gauss-Seidel) or simultaneous (Jacobi).
-#include "sphere_tree_collision/contact_solver.hpp"
+#include "contact_solver.hpp"
 
-#include "sphere_tree_collision/dynamics.hpp"
+#include "dynamics.hpp"
 #include "contact_rows.hpp"
 #include "grow_capacity.hpp"
 

@@ -1,6 +1,6 @@
 // The solver's manifolds in block order (contact_partition.hpp) and the loop
 // that runs a pass over them stage by stage, each stage's blocks in parallel.
-#include "sphere_tree_collision/contact_solver.hpp"
+#include "contact_solver.hpp"
 
 #include "grow_capacity.hpp"
 

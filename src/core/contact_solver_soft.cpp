@@ -1,9 +1,9 @@
 // The soft step (SolverKind::Soft), after the idea of Box2D v3's solver:
 // substeps inside the tick, soft contacts, positions moved in the solve.
 // Reuses the default solver's rows, blocks, stages and restitution waves.
-#include "sphere_tree_collision/contact_solver.hpp"
+#include "contact_solver.hpp"
 
-#include "sphere_tree_collision/dynamics.hpp"
+#include "dynamics.hpp"
 #include "contact_rows.hpp"
 
 #include <algorithm>

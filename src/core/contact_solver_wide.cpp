@@ -5,7 +5,7 @@
 // registers. The operations and their order are those of relaxRow and
 // pushStep (contact_solver.cpp), with no fused multiply-add (CMakeLists.txt),
 // so each lane computes the one-at-a-time result bit for bit.
-#include "sphere_tree_collision/contact_solver.hpp"
+#include "contact_solver.hpp"
 
 #include "grow_capacity.hpp"
 

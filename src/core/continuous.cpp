@@ -1,9 +1,9 @@
 // Anti-tunnelling: fast bodies are swept from their start to their end pose
 // and put back at their first contact (paper 3.5: backtracking to the instant
 // of collision).
-#include "sphere_tree_collision/continuous.hpp"
+#include "continuous.hpp"
 
-#include "sphere_tree_collision/dynamics.hpp"
+#include "dynamics.hpp"
 
 #include <algorithm>
 #include <cmath>

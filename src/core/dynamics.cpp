@@ -1,6 +1,6 @@
 // Dynamics: semi-implicit Euler with unit quaternions and an energy-safe
 // gyroscopic term.
-#include "sphere_tree_collision/dynamics.hpp"
+#include "dynamics.hpp"
 
 #include <cmath>
 

@@ -3,7 +3,7 @@
 // or coincident points, common with voxel corners) are handled by solving for
 // the smallest sphere through them in their affine hull with a rank-revealing
 // least-squares solve, and the final radius is recomputed exactly.
-#include "sphere_tree_collision/enclosing_sphere.hpp"
+#include "enclosing_sphere.hpp"
 
 #include <Eigen/Dense>
 

@@ -1,5 +1,5 @@
 // EntityTable: the entities' dense rows and their id and name maps.
-#include "sphere_tree_collision/entity_table.hpp"
+#include "entity_table.hpp"
 
 #include "flat_hash_map.hpp"
 #include "grow_capacity.hpp"

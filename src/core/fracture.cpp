@@ -1,7 +1,7 @@
 // Fracture geometry: split a voxel grid by a plane into connected pieces.
-#include "sphere_tree_collision/fracture.hpp"
+#include "fracture.hpp"
 
-#include "sphere_tree_collision/contact_solver.hpp"  // tangentBasis
+#include "contact_solver.hpp"  // tangentBasis
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // Island levels (island_levels.hpp): awake islands ranked by the viewer's
 // priority and their wait, the ones beyond the allowance held still.
-#include "sphere_tree_collision/island_levels.hpp"
+#include "island_levels.hpp"
 
 #include "union_find.hpp"
 

@@ -1,6 +1,6 @@
 // Islands and sleep (islands.hpp): union-find over the tick's contacts, rest
 // timers per body, whole islands put to sleep and woken.
-#include "sphere_tree_collision/islands.hpp"
+#include "islands.hpp"
 
 #include "union_find.hpp"
 

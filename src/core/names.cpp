@@ -1,7 +1,7 @@
 // Names of the enum options, as parameters and scenes spell them. One table per
 // enum, so parsing and printing cannot drift apart.
-#include "sphere_tree_collision/pair_test.hpp"
-#include "sphere_tree_collision/scheduler.hpp"
+#include "pair_test.hpp"
+#include "scheduler.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/world.hpp"
 

@@ -1,5 +1,5 @@
 // The narrow phase's chunks (narrow_chunks.hpp).
-#include "sphere_tree_collision/narrow_chunks.hpp"
+#include "narrow_chunks.hpp"
 
 namespace stc {
 

@@ -1,5 +1,5 @@
 // PairContactCache: contacts carried over while a pair barely moves (pair_contact_cache.hpp).
-#include "sphere_tree_collision/pair_contact_cache.hpp"
+#include "pair_contact_cache.hpp"
 
 #include "flat_hash_map.hpp"
 #include "grow_capacity.hpp"

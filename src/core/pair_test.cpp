@@ -1,6 +1,6 @@
 // PairTest: the paper's Collision object (3.3.2, 3.4.1). One step() tests
 // every sphere hit's target against its test list and builds the next hits.
-#include "sphere_tree_collision/pair_test.hpp"
+#include "pair_test.hpp"
 
 #include <algorithm>
 #include <cmath>

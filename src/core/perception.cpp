@@ -14,6 +14,8 @@
 // Either way the World still accepts or rejects unresolved pairs per its policy.
 #include "sphere_tree_collision/perception.hpp"
 
+#include "pair_test.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>

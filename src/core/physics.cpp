@@ -1,8 +1,8 @@
 // Physics: the World's integrate, sweep and response phases over its flat
 // arrays, as the step context names them.
-#include "sphere_tree_collision/physics.hpp"
+#include "physics.hpp"
 
-#include "sphere_tree_collision/dynamics.hpp"
+#include "dynamics.hpp"
 
 #include "grow_capacity.hpp"
 

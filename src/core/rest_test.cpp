@@ -1,5 +1,5 @@
 // Rest test by motion (rest_test.hpp): three balls per body, grown point by point.
-#include "sphere_tree_collision/rest_test.hpp"
+#include "rest_test.hpp"
 
 namespace stc {
 namespace {

@@ -2,7 +2,7 @@
 // helper they share (a step that obeys the budget and is timed as work).
 #pragma once
 
-#include "sphere_tree_collision/scheduler.hpp"
+#include "scheduler.hpp"
 
 #include <array>
 #include <chrono>

@@ -1,6 +1,6 @@
 // Per-shape bounds of every sphere-tree node: the voxels' box inside each
 // sphere (contact surfaces) and the leaves' reach below each node (sweeps).
-#include "sphere_tree_collision/shape_bounds.hpp"
+#include "shape_bounds.hpp"
 
 #include <cmath>
 #include <limits>

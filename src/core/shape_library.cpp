@@ -1,5 +1,5 @@
 // ShapeLibrary: each shape built once, by key (shape_library.hpp).
-#include "sphere_tree_collision/shape_library.hpp"
+#include "shape_library.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -10,7 +10,7 @@
 // voxels, and dropping it loses no coverage of the surface.
 #include "sphere_tree_collision/sphere_tree.hpp"
 
-#include "sphere_tree_collision/enclosing_sphere.hpp"
+#include "enclosing_sphere.hpp"
 #include "voxel_pyramid.hpp"
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 // Faces of static bodies' voxel boxes that other static bodies cover (static_cover.hpp).
-#include "sphere_tree_collision/static_cover.hpp"
+#include "static_cover.hpp"
 
 #include <algorithm>
 #include <cassert>

@@ -34,7 +34,7 @@
 // Bloom masks keep their stale bits until the next full update (a stale bit
 // only lets a swap through as a no-op event). The pairs, and their order, are
 // those of a full update.
-#include "sphere_tree_collision/sweep_and_prune.hpp"
+#include "sweep_and_prune.hpp"
 
 #include "flat_hash_map.hpp"
 

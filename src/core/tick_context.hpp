@@ -4,8 +4,8 @@
 // phase into the report.
 #pragma once
 
+#include "physics.hpp"
 #include "sphere_tree_collision/budget.hpp"
-#include "sphere_tree_collision/physics.hpp"
 #include "sphere_tree_collision/tick_report.hpp"
 
 namespace stc {

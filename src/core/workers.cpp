@@ -1,5 +1,5 @@
 // Workers on a oneTBB task arena (workers.hpp).
-#include "sphere_tree_collision/workers.hpp"
+#include "workers.hpp"
 
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/types.hpp"

@@ -2,6 +2,7 @@
 // the phases of one tick.
 #include "world_parts.hpp"
 
+#include "carried_state.hpp"
 #include "flat_hash_map.hpp"
 #include "grow_capacity.hpp"
 #include "tick_context.hpp"

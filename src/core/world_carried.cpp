@@ -2,6 +2,7 @@
 // a saved world and back into the loaded one.
 #include "world_parts.hpp"
 
+#include "carried_state.hpp"
 #include "flat_hash_map.hpp"
 
 #include <algorithm>

@@ -6,9 +6,9 @@
 // one and calls it from step() and breakEntity().
 #pragma once
 
+#include "fracture.hpp"
 #include "grow_capacity.hpp"
 #include "sphere_tree_collision/budget.hpp"
-#include "sphere_tree_collision/fracture.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <cstdint>

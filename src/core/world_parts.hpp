@@ -7,16 +7,16 @@
 
 #include "sphere_tree_collision/world.hpp"
 
-#include "sphere_tree_collision/entity_table.hpp"
-#include "sphere_tree_collision/island_levels.hpp"
-#include "sphere_tree_collision/islands.hpp"
-#include "sphere_tree_collision/narrow_chunks.hpp"
-#include "sphere_tree_collision/pair_test.hpp"
-#include "sphere_tree_collision/physics.hpp"
-#include "sphere_tree_collision/shape_library.hpp"
-#include "sphere_tree_collision/static_cover.hpp"
-#include "sphere_tree_collision/sweep_and_prune.hpp"
-#include "sphere_tree_collision/workers.hpp"
+#include "entity_table.hpp"
+#include "island_levels.hpp"
+#include "islands.hpp"
+#include "narrow_chunks.hpp"
+#include "pair_test.hpp"
+#include "physics.hpp"
+#include "shape_library.hpp"
+#include "static_cover.hpp"
+#include "sweep_and_prune.hpp"
+#include "workers.hpp"
 
 #include <array>
 #include <memory>

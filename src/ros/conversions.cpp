@@ -1,7 +1,5 @@
 #include "sphere_tree_collision/ros/conversions.hpp"
 
-#include "sphere_tree_collision/static_cover.hpp"
-
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <Eigen/LU>

@@ -1,6 +1,6 @@
 #include "sphere_tree_collision/scene/scene_file.hpp"
 
-#include "sphere_tree_collision/static_cover.hpp"
+#include "carried_state.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -497,7 +497,7 @@ Scene parseSceneTree(const std::string& yaml_text) {
       parseEntity(list[i], "entities[" + std::to_string(i) + "]", scene);
     }
   }
-  if (root["contact_state"]) scene.carried = readCarried(root["contact_state"], scene.entities.size());
+  if (root["contact_state"]) scene.carried = std::make_shared<const CarriedState>(readCarried(root["contact_state"], scene.entities.size()));
   return scene;
 }
 

@@ -3,6 +3,7 @@
 // a world of cubes over its ticks.
 #pragma once
 
+#include "physics.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <algorithm>

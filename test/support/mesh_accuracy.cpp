@@ -4,7 +4,7 @@
 #include "pose_sampling.hpp"
 #include "sphere_union.hpp"
 
-#include "sphere_tree_collision/pair_test.hpp"
+#include "pair_test.hpp"
 
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/narrowphase/distance.h>

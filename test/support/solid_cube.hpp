@@ -2,7 +2,7 @@
 // the contact steps: 4 x 4 x 4 voxels of 10 cm, body origin at its centre.
 #pragma once
 
-#include "sphere_tree_collision/shape_bounds.hpp"
+#include "shape_bounds.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
 

@@ -1,7 +1,8 @@
 // Stiff and extreme scenes for the stability test and bench.
 #include "stability_scenes.hpp"
 
-#include "sphere_tree_collision/dynamics.hpp"
+#include "dynamics.hpp"
+#include "physics.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 
 #include <algorithm>

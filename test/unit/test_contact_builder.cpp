@@ -1,7 +1,8 @@
 // The steps of ContactBuilder::append, each on its own: gathering and
 // refining candidates (face normals), picking spread-out representatives,
 // clustering, and a cluster's normal and separation.
-#include "sphere_tree_collision/contact_builder.hpp"
+#include "contact_builder.hpp"
+#include "pair_test.hpp"
 #include "solid_cube.hpp"
 
 #include <gtest/gtest.h>

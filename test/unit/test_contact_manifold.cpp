@@ -4,7 +4,9 @@
 // and enough to hold a box on a plane and a stack at rest.
 #include "stability_scenes.hpp"
 
-#include "sphere_tree_collision/dynamics.hpp"
+#include "contact_solver.hpp"
+#include "dynamics.hpp"
+#include "physics.hpp"
 
 #include <gtest/gtest.h>
 

@@ -5,11 +5,12 @@
 #include "cube_overlap.hpp"
 #include "stability_scenes.hpp"
 
-#include "sphere_tree_collision/continuous.hpp"
-#include "sphere_tree_collision/dynamics.hpp"
-#include "sphere_tree_collision/shape_bounds.hpp"
-#include "sphere_tree_collision/sphere_tree.hpp"
+#include "continuous.hpp"
+#include "dynamics.hpp"
+#include "physics.hpp"
+#include "shape_bounds.hpp"
 #include "sphere_tree_collision/scenes.hpp"
+#include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <gtest/gtest.h>

@@ -2,8 +2,14 @@
 // arrays of BodyState / Contact without a World.
 #include "thrown_field.hpp"
 
-#include "sphere_tree_collision/dynamics.hpp"
-#include "sphere_tree_collision/response.hpp"
+#include "contact_builder.hpp"
+#include "contact_solver.hpp"
+#include "continuous.hpp"
+#include "dynamics.hpp"
+#include "pair_test.hpp"
+#include "response.hpp"
+#include "shape_bounds.hpp"
+#include "workers.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // minimalEnclosingSphere: known answers, degenerate voxel-corner inputs, and
 // optimality against a brute force over all support sets of up to 4 points.
-#include "sphere_tree_collision/enclosing_sphere.hpp"
+#include "enclosing_sphere.hpp"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>

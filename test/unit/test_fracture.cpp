@@ -2,8 +2,9 @@
 // voxels were, momentum and energy through a break, strength 0 never breaks,
 // small pieces attached or dropped, breaks deferred past the deadline, bad
 // input rejected naming the field.
-#include "sphere_tree_collision/dynamics.hpp"
-#include "sphere_tree_collision/fracture.hpp"
+#include "dynamics.hpp"
+#include "fracture.hpp"
+#include "physics.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <gtest/gtest.h>

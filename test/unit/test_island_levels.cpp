@@ -3,8 +3,9 @@
 // nearest the gaze runs first; none waits for ever; a moving body that reaches
 // a held island joins it to the tick; a scene under a budget that cannot fit
 // every island stays plausible. Deterministic: Budget::response_contacts, no clock.
+#include "dynamics.hpp"
+#include "island_levels.hpp"
 #include "plausibility.hpp"
-#include "sphere_tree_collision/dynamics.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 

@@ -11,7 +11,7 @@
 #include "fcl_mesh.hpp"
 #include "pose_sampling.hpp"
 
-#include "sphere_tree_collision/pair_test.hpp"
+#include "pair_test.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
 

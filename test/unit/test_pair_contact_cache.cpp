@@ -1,12 +1,14 @@
 // Contacts carried over between ticks (PairContactCache,
 // ResponseOptions::reuse_tolerance): when an entry is found, where its
 // contacts are placed again, and what a World does with it.
-#include "sphere_tree_collision/contact_builder.hpp"
-#include "sphere_tree_collision/dynamics.hpp"
-#include "sphere_tree_collision/pair_contact_cache.hpp"
+#include "contact_builder.hpp"
+#include "dynamics.hpp"
+#include "pair_contact_cache.hpp"
+#include "pair_test.hpp"
+#include "physics.hpp"
+#include "solid_cube.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
-#include "solid_cube.hpp"
 
 #include <gtest/gtest.h>
 

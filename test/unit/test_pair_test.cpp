@@ -1,6 +1,6 @@
 // PairTest: the paper's Collision object on hand-built shapes whose sphere
 // trees are simple enough to reason about by hand.
-#include "sphere_tree_collision/pair_test.hpp"
+#include "pair_test.hpp"
 
 #include <gtest/gtest.h>
 

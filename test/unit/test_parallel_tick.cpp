@@ -4,11 +4,15 @@
 // phase runs the scheduler over its pairs under its share of the budget; the
 // deadline stops every worker. No timing is asserted: budgets are counts, and
 // the deadline runs on a fake clock.
-#include "sphere_tree_collision/contact_partition.hpp"
-#include "sphere_tree_collision/scenes.hpp"
-#include "sphere_tree_collision/workers.hpp"
-#include "sphere_tree_collision/world.hpp"
+#include "contact_partition.hpp"
+#include "narrow_chunks.hpp"
+#include "pair_test.hpp"
+#include "physics.hpp"
 #include "same_state.hpp"
+#include "scheduler.hpp"
+#include "sphere_tree_collision/scenes.hpp"
+#include "sphere_tree_collision/world.hpp"
+#include "workers.hpp"
 
 #include <gtest/gtest.h>
 

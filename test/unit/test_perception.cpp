@@ -2,6 +2,7 @@
 // pairs behind the camera or off screen.
 #include "thrown_field.hpp"
 
+#include "pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
 #include "sphere_tree_collision/perception_ray.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"

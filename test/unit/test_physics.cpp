@@ -1,7 +1,8 @@
 // Physics correctness through the World (issue 4, item 4): collisions
 // conserve what they must, a dropped ball rebounds to e^2 h and a sliding
 // cube stops after v^2 / (2 mu g).
-#include "sphere_tree_collision/dynamics.hpp"
+#include "dynamics.hpp"
+#include "physics.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // Rest test by motion (rest_test.hpp): a body rests while its centre and
 // surface points stay in small balls, whatever its velocity of the moment.
-#include "sphere_tree_collision/rest_test.hpp"
+#include "rest_test.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,9 @@
 // Schedulers: each one's defining order under a sphere-test budget, identical
 // results with an unlimited budget, zero budget, no perception, no allocation.
 // PairTests are built directly from preset sphere-trees and poses (no World).
+#include "pair_test.hpp"
+#include "scheduler.hpp"
 #include "sphere_tree_collision/scenes.hpp"
-#include "sphere_tree_collision/scheduler.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
 #include "sphere_tree_collision/world.hpp"

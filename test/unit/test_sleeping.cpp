@@ -2,7 +2,9 @@
 // poses exactly and costs no sphere test; a moving body, a spawn, a despawn,
 // a change of gravity, an edit and World::wake wake it; with sleeping off
 // nothing changes; bad thresholds are rejected naming the field.
-#include "sphere_tree_collision/dynamics.hpp"
+#include "contact_solver.hpp"
+#include "dynamics.hpp"
+#include "physics.hpp"
 #include "sphere_tree_collision/gaze_model.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"

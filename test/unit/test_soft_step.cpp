@@ -7,8 +7,8 @@
 #include "stability_scenes.hpp"
 #include "stepping_clock.hpp"
 
-#include "sphere_tree_collision/contact_solver.hpp"
-#include "sphere_tree_collision/dynamics.hpp"
+#include "contact_solver.hpp"
+#include "dynamics.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 
 #include <gtest/gtest.h>

@@ -4,7 +4,7 @@
 // allows, and its own outcome. Scenes: test/support/stability_scenes.hpp.
 #include "stability_scenes.hpp"
 
-#include "sphere_tree_collision/dynamics.hpp"
+#include "dynamics.hpp"
 
 #include <gtest/gtest.h>
 

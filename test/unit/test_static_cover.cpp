@@ -1,8 +1,9 @@
 // Static geometry made of tiles holds a body as one piece would: the faces of
 // static voxel boxes that solid covers (the body's own voxels, a flush
 // neighbour tile, a one-sided wall's back) never give a contact normal.
-#include "sphere_tree_collision/static_cover.hpp"
+#include "shape_bounds.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "static_cover.hpp"
 
 #include <gtest/gtest.h>
 

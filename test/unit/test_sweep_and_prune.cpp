@@ -1,7 +1,7 @@
 // SweepAndPrune: the incremental pair set must equal a brute-force O(n^2)
 // Aabb::overlaps test after every update(), through coherent motion, teleports,
 // adds and removes; bad input is rejected with the field named.
-#include "sphere_tree_collision/sweep_and_prune.hpp"
+#include "sweep_and_prune.hpp"
 
 #include <gtest/gtest.h>
 

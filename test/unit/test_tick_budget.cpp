@@ -5,6 +5,7 @@
 // reached change nothing. Deterministic: iteration counts and a fake clock.
 #include "stepping_clock.hpp"
 
+#include "contact_solver.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 

@@ -3,9 +3,10 @@
 // is shared, so every body meets its contacts in the one-at-a-time order:
 // the worlds must agree bit for bit, tick by tick, on every built-in scene
 // and with the options that change which passes run.
+#include "physics.hpp"
+#include "same_state.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
-#include "same_state.hpp"
 
 #include <gtest/gtest.h>
 

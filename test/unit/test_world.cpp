@@ -1,7 +1,9 @@
 // World: entity validation and bookkeeping, kinematic integration, and the
 // narrow phase under a budget with the accept/reject policy.
+#include "pair_test.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "sweep_and_prune.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,6 +2,7 @@
 // warm. Global operator new is replaced by one that counts while a flag is
 // set; a few hundred moving entities are stepped until every pool has grown
 // to its working size, then N more ticks must allocate exactly nothing.
+#include "physics.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 

@@ -45,6 +45,7 @@
 #include "sphere_tree_collision/scene/entity_request.hpp"
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,8 +61,9 @@ struct Scene {
   Vec3 gravity = Vec3::Zero();
   std::vector<SceneEntry> entities;  // repeats already expanded
   // A saved world's contact_state: what its next tick carries over (bodies by
-  // place in `entities`); none: it starts afresh.
-  std::optional<CarriedState> carried;
+  // place in `entities`); none: it starts afresh. CarriedState is the core's
+  // (internal: src/core/carried_state.hpp), so it is held by pointer here.
+  std::shared_ptr<const CarriedState> carried;
 };
 
 // Throws InputError naming the field, e.g. "entities[2].position".

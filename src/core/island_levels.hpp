@@ -34,37 +34,13 @@
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/contact.hpp"
 #include "sphere_tree_collision/perception.hpp"
+#include "sphere_tree_collision/tick_report.hpp"
 
 #include <algorithm>
 #include <cstdint>
 #include <vector>
 
 namespace stc {
-
-enum class ResponseLevel : std::uint8_t {
-  Full,    // stepped fully (or no level applied: unlimited response)
-  Held,    // held still for the tick, waiting for its turn
-  Asleep,  // its island sleeps (islands.hpp)
-  Static,  // a static body
-};
-const char* responseLevelName(ResponseLevel level);  // "full" | "held" | "asleep" | "static"
-
-// What the island levels did in one tick (TickReport::response.levels).
-struct IslandLevelReport {
-  bool used = false;                // the response was limited: islands were ranked
-  double allowance = 0.0;           // cost the full islands could bring (contacts; inf: any)
-  double full_cost = 0.0;           // estimated cost of the islands stepped fully
-  std::size_t islands_full = 0, bodies_full = 0;  // awake islands stepped fully (joined ones included)
-  std::size_t islands_held = 0, bodies_held = 0;  // held still this tick
-  std::size_t islands_joined = 0;   // chosen held, then stepped: a moving body reached them
-  int most_ticks_held = 0;          // the longest wait of an island held now (ticks, this one included)
-  std::size_t largest_island = 0;   // bodies of the largest awake island (one that always runs when first)
-  double largest_cost = 0.0;        // its cost
-  // Perceived cost of holding: the summed gaze priority (without aging) of
-  // the islands held this tick. Summed over ticks it is the held ticks
-  // weighted by how noticeable each island was.
-  double held_priority = 0.0;
-};
 
 class IslandLevels {
  public:

@@ -8,8 +8,8 @@
 // keeps every normal out of covered faces, so tiles hold a body as one floor.
 #pragma once
 
+#include "shape_bounds.hpp"
 #include "sphere_tree_collision/body.hpp"
-#include "sphere_tree_collision/shape_bounds.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
 
 #include <cstddef>
@@ -18,18 +18,6 @@
 #include <vector>
 
 namespace stc {
-
-// Bit of a node box's face in a per-node mask: body-frame axis 0..2, outward
-// along +axis (positive) or -axis.
-inline std::uint8_t faceBit(int axis, bool positive) {
-  return static_cast<std::uint8_t>(1u << (2 * axis + (positive ? 0 : 1)));
-}
-constexpr std::uint8_t kAllFaces = 63;
-// "+x", "-x", "+y", "-y", "+z", "-z" (body frame) -> their faceBits OR'ed;
-// throws InputError("closed_faces") naming an unknown face.
-std::uint8_t parseFaces(const std::vector<std::string>& names);
-// The names of a mask's faces, in faceBit order (parseFaces' inverse).
-std::vector<std::string> faceNames(std::uint8_t mask);
 
 // What the cover needs of a shape: its grid, the grid point the body frame is
 // centred on (ShapeInfo::body_origin) and its node boxes.

@@ -6,11 +6,11 @@
 // index, so that a World loaded in the same order takes it whatever its ids.
 #pragma once
 
-#include "sphere_tree_collision/contact_solver.hpp"
-#include "sphere_tree_collision/islands.hpp"
-#include "sphere_tree_collision/pair_contact_cache.hpp"
-#include "sphere_tree_collision/sweep_and_prune.hpp"
+#include "contact_solver.hpp"
+#include "islands.hpp"
+#include "pair_contact_cache.hpp"
 #include "sphere_tree_collision/types.hpp"
+#include "sweep_and_prune.hpp"
 
 #include <array>
 #include <cstdint>

@@ -1,9 +1,9 @@
 // Contacts from the intersecting sphere pairs of a PairTest (paper 3.5, Fig. 4).
 #pragma once
 
+#include "pair_test.hpp"
+#include "shape_bounds.hpp"
 #include "sphere_tree_collision/contact.hpp"
-#include "sphere_tree_collision/pair_test.hpp"
-#include "sphere_tree_collision/shape_bounds.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/types.hpp"
 

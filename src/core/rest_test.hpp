@@ -17,7 +17,7 @@
 // threshold, as Box2D v3's |v| + extent * |w|).
 #pragma once
 
-#include "sphere_tree_collision/enclosing_sphere.hpp"
+#include "enclosing_sphere.hpp"
 #include "sphere_tree_collision/types.hpp"
 
 #include <array>

@@ -26,13 +26,6 @@ namespace detail {
 class FlatHashMap;  // src/core/flat_hash_map.hpp
 }  // namespace detail
 
-// How an entity's broad-phase box is made (paper 3.2).
-enum class BoxMode : std::uint8_t {
-  Auto,     // chosen from the shape: Dynamic when elongated, else FixedCube
-  FixedCube,  // cube big enough for any orientation; only moves with the centre
-  Dynamic,    // tight AABB of the rotated root-level spheres, recomputed each tick
-};
-
 class EntityTable {
  public:
   EntityTable();

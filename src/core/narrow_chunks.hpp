@@ -10,9 +10,9 @@
 // and its share: the same thread count gives the same chunks and results.
 #pragma once
 
-#include "sphere_tree_collision/pair_test.hpp"
-#include "sphere_tree_collision/scheduler.hpp"
-#include "sphere_tree_collision/workers.hpp"
+#include "pair_test.hpp"
+#include "scheduler.hpp"
+#include "workers.hpp"
 
 #include <cstdint>
 #include <memory>

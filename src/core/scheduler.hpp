@@ -2,9 +2,10 @@
 // every PairTest resolves or the Budget ends.
 #pragma once
 
+#include "pair_test.hpp"
 #include "sphere_tree_collision/budget.hpp"
-#include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/perception.hpp"
+#include "sphere_tree_collision/phase_options.hpp"
 
 #include <array>
 #include <memory>
@@ -12,42 +13,6 @@
 #include <vector>
 
 namespace stc {
-
-enum class SchedulerKind : std::uint8_t {
-  RoundRobin,            // Hubbard: every pair one level, then again
-  Sequential,            // pairs resolved fully one by one, in list order
-  PerceptualSequential,  // sorted by perceptual priority, then sequential
-  PriorityQueues,        // model picks one of K queues; round-robin inside; highest first
-};
-// "round_robin" | "sequential" | "perceptual_sequential" | "priority_queues";
-// throws InputError("scheduler") otherwise.
-SchedulerKind parseScheduler(const std::string& name);
-const char* toString(SchedulerKind kind);
-
-enum class UnresolvedPolicy : std::uint8_t { Accept, Reject };
-// "accept" | "reject"; throws InputError("unresolved_policy") otherwise.
-UnresolvedPolicy parseUnresolvedPolicy(const std::string& name);
-const char* toString(UnresolvedPolicy policy);
-
-// Defaults: priority queues with 16 queues a factor 2 apart and the priority
-// per sphere test (cost_exponent 1), the best measured here
-// (docs/error_vs_runtime.md). The paper's variant: queue_count 4,
-// queue_ratio 4, cost_exponent 0.
-struct SchedulerOptions {
-  SchedulerKind kind = SchedulerKind::PriorityQueues;
-  int queue_count = 16;  // priority queues only; 1..64
-  // Priority queues only; > 1. Log-scale bins relative to the largest priority
-  // at the start of the run: the top queue holds f >= fmax / ratio, the next
-  // f >= fmax / ratio^2, ..., the bottom queue the rest (and f = 0).
-  double queue_ratio = 2.0;
-  // Priority queues only: the priority is f(e, g) / c^cost_exponent, c the
-  // sphere tests the pair's next step will take (1 at the roots, about 8 per
-  // intersecting sphere pair below). 0: the paper's f(e, g). 1: expected
-  // error removed per unit of budget, so cheap steps that may resolve a pair go first.
-  double cost_exponent = 1.0;
-};
-// Throws InputError("queue_count"), ("queue_ratio") or ("cost_exponent").
-void validateSchedulerOptions(const SchedulerOptions& options);
 
 struct ScheduleStats {
   std::int64_t sphere_tests = 0;

@@ -5,8 +5,8 @@
 // contacts again at the bodies' new poses, from points fixed in each body.
 #pragma once
 
+#include "pair_test.hpp"
 #include "sphere_tree_collision/contact.hpp"
-#include "sphere_tree_collision/pair_test.hpp"
 #include "sphere_tree_collision/types.hpp"
 
 #include <cstdint>

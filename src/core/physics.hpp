@@ -3,14 +3,14 @@
 // step context its phases read.
 #pragma once
 
-#include "sphere_tree_collision/contact_builder.hpp"
-#include "sphere_tree_collision/contact_solver.hpp"
-#include "sphere_tree_collision/continuous.hpp"
-#include "sphere_tree_collision/pair_contact_cache.hpp"
+#include "contact_builder.hpp"
+#include "contact_solver.hpp"
+#include "continuous.hpp"
+#include "pair_contact_cache.hpp"
+#include "shape_bounds.hpp"
 #include "sphere_tree_collision/response_options.hpp"
-#include "sphere_tree_collision/shape_bounds.hpp"
-#include "sphere_tree_collision/static_cover.hpp"
-#include "sphere_tree_collision/workers.hpp"
+#include "static_cover.hpp"
+#include "workers.hpp"
 
 #include <array>
 #include <cstdint>

@@ -23,28 +23,16 @@
 // per tick once the arrays have their size.
 #pragma once
 
+#include "rest_test.hpp"
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/contact.hpp"
-#include "sphere_tree_collision/rest_test.hpp"
+#include "sphere_tree_collision/phase_options.hpp"
 
 #include <array>
 #include <cstdint>
 #include <vector>
 
 namespace stc {
-
-struct SleepOptions {
-  bool enabled = true;
-  // m/s: a body whose centre and surface points moved on average slower than
-  // this over time_to_sleep is resting (a spin counts by the surface speed it
-  // gives, reach * |w|): each point stays in a ball of radius
-  // linear_speed * time_to_sleep / 2 (5 mm), whatever its speed of the moment.
-  double linear_speed = 0.02;
-  double time_to_sleep = 0.5;  // s: an island whose bodies all rested this long sleeps
-};
-// Throws InputError naming the field ("sleeping.linear_speed",
-// "sleeping.time_to_sleep"): each finite and >= 0.
-void validateSleepOptions(const SleepOptions& options);
 
 // An awake body's rest test and timer (a saved world's: CarriedState).
 struct BodyRest {

@@ -8,9 +8,9 @@
 // Everything but physics.hpp also works without a World, on flat arrays.
 #pragma once
 
-#include "sphere_tree_collision/contact_builder.hpp"
-#include "sphere_tree_collision/contact_solver.hpp"
-#include "sphere_tree_collision/continuous.hpp"
-#include "sphere_tree_collision/physics.hpp"
+#include "contact_builder.hpp"
+#include "contact_solver.hpp"
+#include "continuous.hpp"
+#include "physics.hpp"
+#include "shape_bounds.hpp"
 #include "sphere_tree_collision/response_options.hpp"
-#include "sphere_tree_collision/shape_bounds.hpp"

@@ -2,10 +2,10 @@
 // of collision), after the broad phase.
 #pragma once
 
+#include "shape_bounds.hpp"
 #include "sphere_tree_collision/body.hpp"
-#include "sphere_tree_collision/shape_bounds.hpp"
 #include "sphere_tree_collision/types.hpp"
-#include "sphere_tree_collision/workers.hpp"
+#include "workers.hpp"
 
 #include <array>
 #include <cstdint>

@@ -5,6 +5,8 @@
 // the result does not depend on how the range was cut.
 #pragma once
 
+#include "sphere_tree_collision/phase_options.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -13,13 +15,9 @@
 
 namespace stc {
 
-// WorldConfig::threads and ~threads: 0 (all cores) .. kMaxThreads.
-constexpr int kMaxThreads = 256;
 // Work done body by body (boxes, integration, the solver's store): a task
 // takes at least this many bodies, so its hand-over costs little beside it.
 constexpr std::size_t kBodiesPerTask = 256;
-// Throws InputError("threads") outside [0, kMaxThreads].
-void validateThreads(int threads);
 // The thread count `threads` stands for: 0 -> the cores the process may use.
 int resolveThreads(int threads);
 

@@ -6,11 +6,12 @@
 // the tick reads its arrays by their names.
 #pragma once
 
-#include "sphere_tree_collision/shape_bounds.hpp"
+#include "shape_bounds.hpp"
+#include "sphere_tree_collision/shape_info.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
-#include "sphere_tree_collision/static_cover.hpp"
 #include "sphere_tree_collision/types.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
+#include "static_cover.hpp"
 
 #include <deque>
 #include <optional>
@@ -19,30 +20,6 @@
 #include <vector>
 
 namespace stc {
-
-// How a shape was made, so a saved world makes it again (scene_file.hpp
-// writes it): a preset by name and parameters, a mesh by its resource as
-// requested and how it was voxelised, or, with neither (a grid of a spawn
-// message, a fracture piece), its voxels as they are.
-struct ShapeRecipe {
-  std::string preset;            // e.g. "rock"
-  PresetParams preset_params;    // a preset's; of a mesh, the resolution
-  std::string mesh_resource;     // package://, file:// or a path, unresolved
-  Vec3 mesh_scale = Vec3::Ones();
-  double mesh_voxel_size = 0.0;  // 0: by resolution
-  std::uint8_t mesh_up_axis = 0; // ColladaUpAxis (mesh_loader.hpp)
-};
-
-struct ShapeInfo {
-  std::string key;
-  ShapeRecipe recipe;         // empty (preset and mesh_resource ""): its voxels
-  VoxelShape voxels;
-  MassProperties unit_mass;   // density 1
-  Vec3 body_origin;           // centre of mass in the grid frame
-  SphereTree tree;
-  double bounding_radius = 0; // max distance from the body origin to the shape
-  bool elongated = false;     // Auto box mode picks Dynamic
-};
 
 class ShapeLibrary {
  public:

@@ -6,13 +6,13 @@
 // std::vector<Contact> arrays, without a World.
 #pragma once
 
+#include "contact_partition.hpp"
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
-#include "sphere_tree_collision/contact_partition.hpp"
 #include "sphere_tree_collision/response_options.hpp"
 #include "sphere_tree_collision/types.hpp"
-#include "sphere_tree_collision/workers.hpp"
+#include "workers.hpp"
 
 #include <algorithm>
 #include <array>

@@ -4,6 +4,7 @@
 // part, on a VoxelShape in its grid frame; World::breakEntity places the pieces.
 #pragma once
 
+#include "sphere_tree_collision/phase_options.hpp"
 #include "sphere_tree_collision/voxel_shape.hpp"
 
 #include <cstdint>
@@ -11,27 +12,6 @@
 #include <vector>
 
 namespace stc {
-
-// What happens to the components smaller than FractureOptions::min_piece_voxels.
-enum class SmallPieces : std::uint8_t {
-  Attach,  // they stay with the largest piece (mass and momentum kept)
-  Vanish,  // they are dropped, as dust (their mass and momentum leave the world)
-};
-// "attach" | "vanish"; throws InputError("fracture.small_pieces").
-SmallPieces parseSmallPieces(const std::string& name);
-
-struct FractureOptions {
-  int min_piece_voxels = 8;  // >= 1; the largest piece is kept whatever its size
-  SmallPieces small_pieces = SmallPieces::Attach;
-  // A piece's strength is the parent's times (piece volume / parent volume)
-  // to this power (pieceStrength). 5/6: the energy balance of a crack
-  // (docs/fracture.md); 0: pieces keep the parent's strength; >= 0.
-  double strength_exponent = 5.0 / 6.0;
-};
-// Throws InputError("fracture.min_piece_voxels") (< 1),
-// InputError("fracture.small_pieces") (not a known value) or
-// InputError("fracture.strength_exponent") (not finite and >= 0).
-void validateFractureOptions(const FractureOptions& options);
 
 // The strength of a piece of `piece_voxels` cut from a body of
 // `parent_voxels` whose strength is `parent_strength`: the impulse that
