@@ -6,8 +6,8 @@
 // What else is kept per entity follows each add and remove in one place,
 // World::addEntity / World::removeEntity: Islands, IslandLevels and
 // StaticCover (by dense index, with the same swap-remove) and the broad
-// phase (by id). The World derives from the table privately, so the tick
-// reads the arrays by their names.
+// phase (by id). World::Parts holds the table (world_parts.hpp); the tick
+// reads the arrays through the inline calls below.
 #pragma once
 
 #include "sphere_tree_collision/body.hpp"
@@ -48,8 +48,12 @@ class EntityTable {
   std::optional<EntityId> findByName(const std::string& name) const;
   // Whether one more entity can get an id (they are never reused).
   bool idsLeft() const { return next_id_ != kInvalidEntity; }
+  // Entity id -> dense index, open addressing on flat arrays
+  // (flat_hash_map.hpp: find gives kMissing for an unknown id): the pair
+  // walk of every tick looks up two per broad-phase pair (a settled pile of
+  // 5,000 rocks: ~50,000 pairs; docs/sleeping.md).
+  const detail::FlatHashMap& indexMap() const { return *index_of_; }
 
- protected:
   // A row at the end (dense index entityCount() - 1) with the next id, or
   // `id` (unused; later ids count on from it), which is returned. The name
   // is empty or unused (checked by the caller).
@@ -62,6 +66,7 @@ class EntityTable {
   // The arrays and maps cut to what the rows hold (after a flood of removals).
   void releaseRowMemory();
 
+ private:
   // By dense index; ids_ maps dense -> id.
   std::vector<EntityId> ids_;
   std::vector<BodyState> bodies_;
@@ -69,12 +74,7 @@ class EntityTable {
   std::vector<BoxMode> box_modes_;
   std::vector<double> densities_;
   std::vector<std::string> names_;
-  // Entity id -> dense index, open addressing on flat arrays: the pair walk
-  // of every tick looks up two per broad-phase pair (a settled pile of 5,000
-  // rocks: ~50,000 pairs; docs/sleeping.md).
-  std::unique_ptr<detail::FlatHashMap> index_of_;
-
- private:
+  std::unique_ptr<detail::FlatHashMap> index_of_;  // indexMap()
   std::unordered_map<std::string, EntityId> id_by_name_;
   EntityId next_id_ = 0;
 };

@@ -2,8 +2,8 @@
 // once: its voxels, exact mass properties, sphere-tree, and the bounds the
 // tick reads of every node (shape_bounds.hpp, static_cover.hpp). Every
 // entity of a shape shares them (EntitySpec::shape); the body frame is the
-// shape's centre of mass. The World derives from the library privately, so
-// the tick reads its arrays by their names.
+// shape's centre of mass. World::Parts holds the library (world_parts.hpp);
+// the tick reads its arrays through the inline calls below.
 #pragma once
 
 #include "shape_bounds.hpp"
@@ -36,14 +36,18 @@ class ShapeLibrary {
   // of a shape stays (a shape found again by its key was made by it).
   void setShapeRecipe(ShapeId id, const ShapeRecipe& recipe);
 
- protected:
+  // For the tick, by a shape id of a row (not checked, as shape() does): the
+  // shape, the bounds of its nodes, and what StaticCover reads of each shape.
+  const ShapeInfo& shapeAt(ShapeId id) const { return shapes_[id]; }
+  const std::deque<ShapeBounds>& shapeBounds() const { return shape_bounds_; }
+  const std::vector<CoverShape>& coverShapes() const { return cover_shapes_; }
+
+ private:
   // By shape id. Deques: a shape (and its tree) keeps its address as shapes
   // are added, so the bounds can point at the trees and the cover shapes at both.
   std::deque<ShapeInfo> shapes_;
   std::deque<ShapeBounds> shape_bounds_;
   std::vector<CoverShape> cover_shapes_;  // what StaticCover reads of each
-
- private:
   std::unordered_map<std::string, ShapeId> shape_by_key_;
 };
 

@@ -1,8 +1,7 @@
 // World::Parts: what a World is made of (world.hpp holds it by pointer): the
 // shapes (ShapeLibrary) and the entities' rows (EntityTable), what follows
 // each add and remove, fracture (WorldFracture) and the phases, in tick
-// order. World's calls forward here (one pointer hop each); the tick's
-// phases read the arrays by their names.
+// order. World's calls forward here (one pointer hop each).
 #pragma once
 
 #include "sphere_tree_collision/world.hpp"
@@ -27,7 +26,7 @@ namespace stc {
 class WorldFracture;  // world_fracture.hpp
 struct TickContext;   // tick_context.hpp
 
-struct World::Parts : ShapeLibrary, EntityTable {
+struct World::Parts {
   Parts(World& owner, const WorldConfig& config);
   ~Parts();
   Parts(const Parts&) = delete;
@@ -90,9 +89,8 @@ struct World::Parts : ShapeLibrary, EntityTable {
   World* world;
   WorldConfig config_;
   Workers workers_;  // before the phases that use it
-  // The shapes: the ShapeLibrary base (shapes_, shape_bounds_, cover_shapes_).
-  // The entities' rows: the EntityTable base (ids_, bodies_, body_shapes_,
-  // box_modes_, densities_, names_, index_of_).
+  ShapeLibrary shapes;  // by shape id
+  EntityTable rows;     // the entities' rows, by dense index
   StaticCover static_cover_;  // static bodies' faces other static bodies cover, by dense index
 
   SweepAndPrune broad_phase_;
