@@ -39,7 +39,7 @@ bool narrowPhaseLimited(const Budget& budget, const Deadline& tick_end) {
 }  // namespace
 
 World::Parts::Parts(World& owner, const WorldConfig& config)
-    : world(&owner),
+    : world_(&owner),
       config_(config),
       workers_(config.threads),
       narrow_chunks_(makeNarrowChunks(narrowChunkCount(static_cast<std::size_t>(workers_.threads()), false),
@@ -60,24 +60,24 @@ World::Parts::~Parts() = default;
 World::World(const WorldConfig& config) : parts_(std::make_unique<Parts>(*this, config)) {}
 World::~World() = default;
 World::World(World&& other) noexcept : parts_(std::move(other.parts_)) {
-  if (parts_) parts_->world = this;
+  if (parts_) parts_->world_ = this;
 }
 World& World::operator=(World&& other) noexcept {
   parts_ = std::move(other.parts_);
-  if (parts_) parts_->world = this;
+  if (parts_) parts_->world_ = this;
   return *this;
 }
 
 ShapeId World::addShape(const std::string& key, VoxelShape shape) { return parts_->addShape(key, std::move(shape)); }
-std::optional<ShapeId> World::findShape(const std::string& key) const { return parts_->shapes.findShape(key); }
-const ShapeInfo& World::shape(ShapeId id) const { return parts_->shapes.shape(id); }
-std::size_t World::shapeCount() const { return parts_->shapes.shapeCount(); }
-void World::setShapeRecipe(ShapeId id, const ShapeRecipe& recipe) { parts_->shapes.setShapeRecipe(id, recipe); }
+std::optional<ShapeId> World::findShape(const std::string& key) const { return parts_->shapes_.findShape(key); }
+const ShapeInfo& World::shape(ShapeId id) const { return parts_->shapes_.shape(id); }
+std::size_t World::shapeCount() const { return parts_->shapes_.shapeCount(); }
+void World::setShapeRecipe(ShapeId id, const ShapeRecipe& recipe) { parts_->shapes_.setShapeRecipe(id, recipe); }
 
 EntityId World::addEntity(const EntitySpec& spec) { return parts_->addEntity(spec); }
 void World::validateEntity(const EntitySpec& spec) const { parts_->validateEntity(spec); }
 bool World::removeEntity(EntityId id) { return parts_->removeEntity(id); }
-std::optional<EntityId> World::findByName(const std::string& name) const { return parts_->rows.findByName(name); }
+std::optional<EntityId> World::findByName(const std::string& name) const { return parts_->rows_.findByName(name); }
 void World::clear() { parts_->clear(); }
 void World::releaseMemory() { parts_->releaseMemory(); }
 std::vector<EntityId> World::breakEntity(EntityId id, const Vec3& point, const Vec3& normal) {
@@ -104,16 +104,16 @@ ResponseLevel World::responseLevel(EntityId id) const { return parts_->responseL
 CarriedState World::carriedState() const { return parts_->carriedState(); }
 void World::restoreCarried(const CarriedState& state) { parts_->restoreCarried(state); }
 
-std::size_t World::entityCount() const { return parts_->rows.entityCount(); }
-const std::vector<EntityId>& World::entityIds() const { return parts_->rows.entityIds(); }
-const std::vector<BodyState>& World::bodies() const { return parts_->rows.bodies(); }
-std::vector<BodyState>& World::bodies() { return parts_->rows.bodies(); }
-const std::vector<ShapeId>& World::bodyShapes() const { return parts_->rows.bodyShapes(); }
-const std::vector<std::string>& World::bodyNames() const { return parts_->rows.bodyNames(); }
-const std::vector<double>& World::bodyDensities() const { return parts_->rows.bodyDensities(); }
-const std::vector<BoxMode>& World::bodyBoxModes() const { return parts_->rows.bodyBoxModes(); }
+std::size_t World::entityCount() const { return parts_->rows_.entityCount(); }
+const std::vector<EntityId>& World::entityIds() const { return parts_->rows_.entityIds(); }
+const std::vector<BodyState>& World::bodies() const { return parts_->rows_.bodies(); }
+std::vector<BodyState>& World::bodies() { return parts_->rows_.bodies(); }
+const std::vector<ShapeId>& World::bodyShapes() const { return parts_->rows_.bodyShapes(); }
+const std::vector<std::string>& World::bodyNames() const { return parts_->rows_.bodyNames(); }
+const std::vector<double>& World::bodyDensities() const { return parts_->rows_.bodyDensities(); }
+const std::vector<BoxMode>& World::bodyBoxModes() const { return parts_->rows_.bodyBoxModes(); }
 std::uint8_t World::closedFaces(std::size_t index) const { return parts_->static_cover_.closedFaces(index); }
-std::optional<std::size_t> World::indexOf(EntityId id) const { return parts_->rows.indexOf(id); }
+std::optional<std::size_t> World::indexOf(EntityId id) const { return parts_->rows_.indexOf(id); }
 
 const std::vector<PairTest>& World::pairTests() const { return parts_->pair_tests_; }
 std::size_t World::pairCount() const { return parts_->pair_count_; }
@@ -128,7 +128,7 @@ const PhysicsReport& World::physicsReport() const { return parts_->physics_.last
 // Shapes
 
 ShapeId World::Parts::addShape(const std::string& key, VoxelShape voxels) {
-  return shapes.addShape(key, std::move(voxels), config_.voxel_limits, config_.tree);
+  return shapes_.addShape(key, std::move(voxels), config_.voxel_limits, config_.tree);
 }
 
 // ---------------------------------------------------------------------------------
@@ -137,7 +137,7 @@ ShapeId World::Parts::addShape(const std::string& key, VoxelShape voxels) {
 void World::Parts::validateEntity(const EntitySpec& spec) const {
   validateBodyInput(spec.pose, spec.linear_velocity, spec.angular_velocity, spec.density,
                     spec.material, config_.limits);
-  if (!spec.name.empty() && rows.findByName(spec.name)) {
+  if (!spec.name.empty() && rows_.findByName(spec.name)) {
     throw InputError("name", "'" + spec.name + "' is already used");
   }
   if (spec.exact_orientation && !(std::abs(spec.pose.orientation.norm() - 1.0) <= kExactOrientationTolerance)) {
@@ -151,10 +151,10 @@ void World::Parts::validateEntity(const EntitySpec& spec) const {
     throw InputError("closed_faces", "static bodies only, a mask of faceBit values (at most " +
                                          std::to_string(kAllFaces) + ")");
   }
-  if (spec.id != kInvalidEntity && rows.indexOf(spec.id)) {
+  if (spec.id != kInvalidEntity && rows_.indexOf(spec.id)) {
     throw InputError("id", std::to_string(spec.id) + " is already used");
   }
-  if (rows.entityCount() >= config_.max_entities || (spec.id == kInvalidEntity && !rows.idsLeft())) {
+  if (rows_.entityCount() >= config_.max_entities || (spec.id == kInvalidEntity && !rows_.idsLeft())) {
     throw InputError("max_entities", "the world holds " + std::to_string(config_.max_entities) +
                                          " entities at most");
   }
@@ -162,7 +162,7 @@ void World::Parts::validateEntity(const EntitySpec& spec) const {
 
 EntityId World::Parts::addEntity(const EntitySpec& spec) {
   // Validate everything first: on throw nothing has changed.
-  const ShapeInfo& info = shapes.shape(spec.shape);  // throws InputError("shape") for an unknown id
+  const ShapeInfo& info = shapes_.shape(spec.shape);  // throws InputError("shape") for an unknown id
   validateEntity(spec);
 
   BodyState body;
@@ -182,8 +182,8 @@ EntityId World::Parts::addEntity(const EntitySpec& spec) {
   if (mode == BoxMode::Auto) mode = info.elongated ? BoxMode::Dynamic : BoxMode::FixedCube;
 
   // The row, then what follows it.
-  const EntityId id = rows.addRow(body, spec.shape, mode, spec.density, spec.name, spec.id);
-  const std::size_t index = rows.entityCount() - 1;
+  const EntityId id = rows_.addRow(body, spec.shape, mode, spec.density, spec.name, spec.id);
+  const std::size_t index = rows_.entityCount() - 1;
   static_cover_.add(body, spec.closed_faces);
   broad_phase_.add(id, boxOf(index));  // static boxes are set here, once
   islands_.add(info.bounding_radius);
@@ -198,28 +198,28 @@ EntityId World::Parts::addEntity(const EntitySpec& spec) {
 }
 
 bool World::Parts::removeEntity(EntityId id) {
-  const std::uint32_t found = rows.indexMap().find(id);
+  const std::uint32_t found = rows_.indexMap().find(id);
   if (found == detail::FlatHashMap::kMissing) return false;
   const std::size_t index = found;
-  const std::size_t last = rows.entityCount() - 1;
+  const std::size_t last = rows_.entityCount() - 1;
   broad_phase_.partnersOf(id, &partners_);  // its own pairs, not all
   for (const EntityId partner : partners_) {  // what it touched loses it: wakes
-    const std::uint32_t other = rows.indexMap().find(partner);
+    const std::uint32_t other = rows_.indexMap().find(partner);
     if (other != detail::FlatHashMap::kMissing) islands_.wake(other);  // missing: removed since the last update
   }
-  if (rows.bodies()[index].is_static) physics_.forgetReuse();  // its neighbours' covered faces change
+  if (rows_.bodies()[index].is_static) physics_.forgetReuse();  // its neighbours' covered faces change
   islands_.remove(index, last);
   levels_.remove(index, last);
   static_cover_.remove(index, last);
   broad_phase_.remove(id);
-  rows.removeRow(index);  // swap-remove, as the three above
+  rows_.removeRow(index);  // swap-remove, as the three above
   pairs_seen_.clear();  // a dense index moved
   invalidateLastTick();
   return true;
 }
 
 void World::Parts::clear() {
-  rows.clearRows();
+  rows_.clearRows();
   pairs_seen_.clear();
   broad_phase_ = SweepAndPrune();
   islands_.clear();
@@ -230,7 +230,7 @@ void World::Parts::clear() {
 }
 
 void World::Parts::releaseMemory() {
-  rows.releaseRowMemory();
+  rows_.releaseRowMemory();
   dropSpareCapacity(static_cover_);
   broad_phase_.releaseMemory();
   dropSpareCapacity(boxes_);
@@ -271,18 +271,18 @@ void World::Parts::setGravity(const Vec3& gravity) {
 }
 
 bool World::Parts::wake(EntityId id) {
-  const auto index = rows.indexOf(id);
+  const auto index = rows_.indexOf(id);
   if (index) islands_.wake(*index);
   return index.has_value();
 }
 
 bool World::Parts::isSleeping(EntityId id) const {
-  const auto index = rows.indexOf(id);
+  const auto index = rows_.indexOf(id);
   return index && islands_.isSleeping(*index);
 }
 
 bool World::Parts::isRestless(EntityId id) const {
-  const auto index = rows.indexOf(id);
+  const auto index = rows_.indexOf(id);
   return index && islands_.isRestless(*index);
 }
 
@@ -304,7 +304,7 @@ void World::Parts::setClock(SecondsClock clock) {
 TickReport World::Parts::step(double dt, const Budget& budget) {
   if (!(std::isfinite(dt) && dt >= 0.0)) throw InputError("dt", "must be finite and >= 0");
   TickReport report;
-  report.bodies.entities = rows.entityCount();
+  report.bodies.entities = rows_.entityCount();
   quarantined_.clear();
   fracture_->newStep();
   quarantine(report);  // states edited through bodies() since the last step
@@ -312,7 +312,7 @@ TickReport World::Parts::step(double dt, const Budget& budget) {
   // is tested (and reports its contacts) every tick.
   SleepOptions sleeping = config_.sleeping;
   sleeping.enabled = sleeping.enabled && config_.response.enabled;
-  islands_.beginTick(rows.bodies(), sleeping);  // sleepers held as static until endTick
+  islands_.beginTick(rows_.bodies(), sleeping);  // sleepers held as static until endTick
   TickContext tick = beginTick(dt, budget, report);
   // One team for the phases: the workers stay awake from loop to loop
   // (waking one costs more than many a loop here: docs/parallel.md).
@@ -333,16 +333,16 @@ TickReport World::Parts::step(double dt, const Budget& budget) {
   report.phases.team_wait_s = loops_after.wait_s - loops_before.wait_s;
   report.phases.total_s = tick.time.now - tick.time.start;
   report.response.contacts = contacts_.size();
-  report.bodies.entities = rows.entityCount();
+  report.bodies.entities = rows_.entityCount();
   // What followed the scheduler could not be cut: the next ticks keep it in reserve.
   const double mandatory_s = tick.response_end - tick.scheduled - report.response.response_refinement_s;
   reserve_s_ = std::max(mandatory_s, kReserveDecay * reserve_s_);
   // Held through the tick, a sleeper was neither moved nor solved: its state
   // passed the first check unchanged (endTick releases the holds).
   held_through_tick_ = islands_.held();
-  islands_.endTick(rows.bodies(), contacts_, dt, sleeping);  // held islands are not movable: no rest, no sleep
+  islands_.endTick(rows_.bodies(), contacts_, dt, sleeping);  // held islands are not movable: no rest, no sleep
   if (tick.levelled) {
-    levels_.release(rows.bodies(), report.response.levels);
+    levels_.release(rows_.bodies(), report.response.levels);
     const double must_run_s = (tick.narrow_start - tick.time.start) + (tick.time.now - tick.response_end);
     if (tick.timed) learnLevelCosts(must_run_s, mandatory_s, report);
   } else {
@@ -372,9 +372,9 @@ TickContext World::Parts::beginTick(double dt, const Budget& budget, TickReport&
   step.dt = dt;
   step.gravity = config_.gravity;
   step.options = &config_.response;
-  step.bodies = &rows.bodies();
-  step.body_shapes = &rows.bodyShapes();
-  step.shape_bounds = &shapes.shapeBounds();
+  step.bodies = &rows_.bodies();
+  step.body_shapes = &rows_.bodyShapes();
+  step.shape_bounds = &shapes_.shapeBounds();
   step.tests = &pair_tests_;
   step.pair_count = &pair_count_;
   step.pair_bodies = &pair_bodies_;
@@ -386,7 +386,7 @@ TickContext World::Parts::beginTick(double dt, const Budget& budget, TickReport&
   step.budget.deadline = tick_end;
   step.contacts = &contacts_;
   step.workers = &workers_;
-  step.ids = &rows.entityIds();
+  step.ids = &rows_.entityIds();
   step.held_asleep = &islands_.held();
   step.static_cover = &static_cover_;
   return tick;
@@ -401,10 +401,10 @@ void World::Parts::integrate(TickContext& tick) {
 }
 
 Aabb World::Parts::boxOf(std::size_t index) const {
-  const BodyState& body = rows.bodies()[index];
-  const ShapeInfo& info = shapes.shapeAt(rows.bodyShapes()[index]);
+  const BodyState& body = rows_.bodies()[index];
+  const ShapeInfo& info = shapes_.shapeAt(rows_.bodyShapes()[index]);
   Aabb box;
-  if (rows.bodyBoxModes()[index] != BoxMode::Dynamic) {
+  if (rows_.bodyBoxModes()[index] != BoxMode::Dynamic) {
     // Fixed cube: holds the shape in any orientation, only follows the centre of mass.
     const Vec3 half = Vec3::Constant(info.bounding_radius);
     box.min = body.pose.position - half;
@@ -432,9 +432,9 @@ Aabb World::Parts::boxOf(std::size_t index) const {
 // in any orientation, at its start and at its end), so its sweep partners
 // are among its broad-phase pairs.
 Aabb World::Parts::sweptBoxOf(std::size_t index) const {
-  const double radius = shapes.shapeAt(rows.bodyShapes()[index]).bounding_radius;
+  const double radius = shapes_.shapeAt(rows_.bodyShapes()[index]).bounding_radius;
   const Vec3 start = physics_.startPose(index).position;
-  const Vec3 end = rows.bodies()[index].pose.position;
+  const Vec3 end = rows_.bodies()[index].pose.position;
   Aabb box;
   box.min = start.cwiseMin(end) - Vec3::Constant(radius);
   box.max = start.cwiseMax(end) + Vec3::Constant(radius);
@@ -447,18 +447,18 @@ void World::Parts::broadPhase(TickContext& tick) {
   // The boxes in parallel (each body alone), then handed over in order. A
   // body held by its island's level gets the box of where it would go.
   const bool held = levels_.anyHeld();
-  boxes_.resize(rows.entityCount());
-  workers_.forEach(rows.entityCount(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
+  boxes_.resize(rows_.entityCount());
+  workers_.forEach(rows_.entityCount(), kBodiesPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      if (!rows.bodies()[i].is_static) {
+      if (!rows_.bodies()[i].is_static) {
         boxes_[i] = physics_.isFast(i) ? sweptBoxOf(i) : boxOf(i);
       } else if (held && levels_.isHeld(i)) {
-        boxes_[i] = IslandLevels::heldBox(rows.bodies()[i], shapes.shapeAt(rows.bodyShapes()[i]).bounding_radius, dt);
+        boxes_[i] = IslandLevels::heldBox(rows_.bodies()[i], shapes_.shapeAt(rows_.bodyShapes()[i]).bounding_radius, dt);
       }
     }
   });
-  for (std::size_t i = 0; i < rows.entityCount(); ++i) {
-    if (!rows.bodies()[i].is_static || (held && levels_.isHeld(i))) broad_phase_.setBox(rows.entityIds()[i], boxes_[i]);
+  for (std::size_t i = 0; i < rows_.entityCount(); ++i) {
+    if (!rows_.bodies()[i].is_static || (held && levels_.isHeld(i))) broad_phase_.setBox(rows_.entityIds()[i], boxes_[i]);
   }
   broad_phase_.update();
   tick.report.detection.broad_pairs = broad_phase_.pairs().size();
@@ -493,14 +493,14 @@ bool World::Parts::setUpPairTests() {
       SeenPair& seen = pairs_seen_[k];
       if (!(seen.ids == pair)) {
         seen.ids = pair;
-        seen.indices = {static_cast<std::uint32_t>(rows.indexMap().find(pair.first)),
-                        static_cast<std::uint32_t>(rows.indexMap().find(pair.second))};
+        seen.indices = {static_cast<std::uint32_t>(rows_.indexMap().find(pair.first)),
+                        static_cast<std::uint32_t>(rows_.indexMap().find(pair.second))};
       }
       const std::array<std::uint32_t, 2>& indices = seen.indices;
-      assert(indices[0] == rows.indexMap().find(pair.first) && indices[1] == rows.indexMap().find(pair.second));
+      assert(indices[0] == rows_.indexMap().find(pair.first) && indices[1] == rows_.indexMap().find(pair.second));
       pair_bodies_[k] = indices;
       // Two static (or held) bodies: nothing can change.
-      pair_tested_[k] = !(rows.bodies()[indices[0]].is_static && rows.bodies()[indices[1]].is_static);
+      pair_tested_[k] = !(rows_.bodies()[indices[0]].is_static && rows_.bodies()[indices[1]].is_static);
     }
   });
   // In pair order: the wakes, and the tested pairs packed to the front
@@ -508,10 +508,10 @@ bool World::Parts::setUpPairTests() {
   bool woke = false;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const std::array<std::uint32_t, 2> bodies = pair_bodies_[k];
-    woke |= islands_.noteOverlap(bodies[0], bodies[1], rows.bodies());
+    woke |= islands_.noteOverlap(bodies[0], bodies[1], rows_.bodies());
     if (pair_tested_[k] != 0) pair_bodies_[pair_count_++] = bodies;
   }
-  if (woke) islands_.releaseWoken(rows.bodies());
+  if (woke) islands_.releaseWoken(rows_.bodies());
   return woke;
 }
 
@@ -543,7 +543,7 @@ void World::Parts::narrowPhase(TickContext& tick) {
   // The static bodies' covered faces, measured again only when a static body
   // came, went or moved (for the contacts; here, before any pair's contacts
   // are carried over, since those were built with the faces before).
-  if (static_cover_.update(rows.bodies(), rows.bodyShapes(), shapes.coverShapes())) physics_.forgetReuse();
+  if (static_cover_.update(rows_.bodies(), rows_.bodyShapes(), shapes_.coverShapes())) physics_.forgetReuse();
   // A pair whose contacts last tick left valid resumes Colliding: no sphere
   // test, its contacts carried over (pair_contact_cache.hpp).
   const StepContext& step = tick.physics;
@@ -557,8 +557,8 @@ void World::Parts::narrowPhase(TickContext& tick) {
     chunk.arena.clear();
     for (std::size_t i = first; i < last; ++i) {
       const std::uint32_t ia = pair_bodies_[i][0], ib = pair_bodies_[i][1];
-      const PairBody a{rows.entityIds()[ia], &shapes.shapeAt(rows.bodyShapes()[ia]).tree, &rows.bodies()[ia].pose};
-      const PairBody b{rows.entityIds()[ib], &shapes.shapeAt(rows.bodyShapes()[ib]).tree, &rows.bodies()[ib].pose};
+      const PairBody a{rows_.entityIds()[ia], &shapes_.shapeAt(rows_.bodyShapes()[ia]).tree, &rows_.bodies()[ia].pose};
+      const PairBody b{rows_.entityIds()[ib], &shapes_.shapeAt(rows_.bodyShapes()[ib]).tree, &rows_.bodies()[ib].pose};
       const std::uint32_t entry =
           step.reused != nullptr ? physics_.reusableEntry(step, ia, ib) : PairContactCache::kNone;
       pair_reused_[i] = entry;
@@ -571,7 +571,7 @@ void World::Parts::narrowPhase(TickContext& tick) {
     }
     BudgetTracker tracker(chunkShare(budget.sphere_tests, k, chunks), Deadline(&clock_, end), clock_check_every_);
     chunk.stats = chunk.scheduler->run(pair_tests_.data() + first, last - first,
-                                       PairBodies{pair_bodies_.data() + first, rows.bodies().size()},
+                                       PairBodies{pair_bodies_.data() + first, rows_.bodies().size()},
                                        gaze ? &perception_ : nullptr, tracker);
   }, limited ? Team::Claim::OwnShareWhole : Team::Claim::Balanced);
   const ScheduleStats stats = mergedStats(narrow_chunks_, chunks);
@@ -635,17 +635,17 @@ void World::Parts::response(TickContext& tick) {
 // contacts (they name dense indices); the rest of the world is untouched.
 void World::Parts::quarantine(TickReport& report, const std::vector<std::uint8_t>* unchanged) {
   const std::size_t first = quarantined_.size();
-  for (std::size_t i = 0; i < rows.bodies().size(); ++i) {
+  for (std::size_t i = 0; i < rows_.bodies().size(); ++i) {
     if (unchanged != nullptr && (*unchanged)[i] != 0) continue;
-    if (rows.bodies()[i].is_static) continue;  // never moves: checked at input
-    const Quarantine reason = quarantineReason(rows.bodies()[i], config_.limits);
+    if (rows_.bodies()[i].is_static) continue;  // never moves: checked at input
+    const Quarantine reason = quarantineReason(rows_.bodies()[i], config_.limits);
     if (reason == Quarantine::None) continue;
-    quarantined_.push_back({rows.entityIds()[i], rows.bodyNames()[i], rows.bodyShapes()[i], reason});
+    quarantined_.push_back({rows_.entityIds()[i], rows_.bodyNames()[i], rows_.bodyShapes()[i], reason});
     ++(reason == Quarantine::LeftWorld ? report.bodies.left_world : report.bodies.quarantined);
   }
   if (quarantined_.size() == first) return;
   for (std::size_t q = first; q < quarantined_.size(); ++q) removeEntity(quarantined_[q].id);
-  report.bodies.entities = rows.entityCount();
+  report.bodies.entities = rows_.entityCount();
   report.response.contacts = contacts_.size();
 }
 

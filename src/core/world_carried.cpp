@@ -29,18 +29,18 @@ void requireRange(std::uint32_t first, std::uint32_t count, std::size_t size, st
 
 CarriedState World::Parts::carriedState() const {
   CarriedState out;
-  const std::size_t n = rows.entityCount();
+  const std::size_t n = rows_.entityCount();
   for (std::size_t i = 0; i < n; ++i) {
-    if (!rows.bodies()[i].is_static && !islands_.isSleeping(i)) {
+    if (!rows_.bodies()[i].is_static && !islands_.isSleeping(i)) {
       out.rest.push_back({static_cast<std::uint32_t>(i), islands_.rest(i)});
     }
   }
   out.next_group = islands_.nextGroup();
-  const auto indexOfId = [&](EntityId id) { return rows.indexMap().find(id); };
+  const auto indexOfId = [&](EntityId id) { return rows_.indexMap().find(id); };
   constexpr std::uint32_t kMissing = detail::FlatHashMap::kMissing;
   if (broad_phase_.settled()) {
     out.boxes.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) out.boxes.push_back(broad_phase_.box(rows.entityIds()[i]));
+    for (std::size_t i = 0; i < n; ++i) out.boxes.push_back(broad_phase_.box(rows_.entityIds()[i]));
     out.banding = broad_phase_.banding();
     for (EntityId& id : out.banding.slots) id = indexOfId(id);  // ids to dense indices
     for (auto& list : out.banding.endpoints) {
@@ -79,11 +79,11 @@ CarriedState World::Parts::carriedState() const {
 }
 
 void World::Parts::restoreCarried(const CarriedState& state) {
-  const std::size_t n = rows.entityCount();
+  const std::size_t n = rows_.entityCount();
   // Everything checked before anything changes.
   for (std::size_t k = 0; k < state.rest.size(); ++k) {
     const CarriedState::Rest& r = state.rest[k];
-    require(r.body < n && !rows.bodies()[r.body].is_static && !islands_.isSleeping(r.body), at("rest", k) + ".body",
+    require(r.body < n && !rows_.bodies()[r.body].is_static && !islands_.isSleeping(r.body), at("rest", k) + ".body",
             "not an awake movable body");
     bool ok = std::isfinite(r.state.rest_time) && r.state.rest_time >= 0.0 && std::isfinite(r.state.age) &&
               r.state.age >= 0.0;
@@ -104,18 +104,18 @@ void World::Parts::restoreCarried(const CarriedState& state) {
   for (std::size_t k = 0; k < state.broad_pairs.size(); ++k) {
     const auto& p = state.broad_pairs[k];
     require(p[0] < n && p[1] < n && p[0] != p[1], at("broad_pairs", k), "two bodies of the world");
-    pairs.push_back({std::min(rows.entityIds()[p[0]], rows.entityIds()[p[1]]), std::max(rows.entityIds()[p[0]], rows.entityIds()[p[1]])});
+    pairs.push_back({std::min(rows_.entityIds()[p[0]], rows_.entityIds()[p[1]]), std::max(rows_.entityIds()[p[0]], rows_.entityIds()[p[1]])});
   }
   SweepAndPrune::Banding banding = state.banding;
   for (EntityId& body : banding.slots) {  // dense indices to ids
     require(body < n, "banding.slots", "a body of the world");
-    body = rows.entityIds()[body];
+    body = rows_.entityIds()[body];
   }
   for (auto& list : banding.endpoints) {  // dense indices to ids
     for (std::vector<std::uint64_t>& band : list) {
       for (std::uint64_t& e : band) {
         require(e >> 1 < n, "banding.endpoints", "a body of the world");
-        e = std::uint64_t{rows.entityIds()[e >> 1]} << 1 | (e & 1u);
+        e = std::uint64_t{rows_.entityIds()[e >> 1]} << 1 | (e & 1u);
       }
     }
   }
@@ -129,15 +129,15 @@ void World::Parts::restoreCarried(const CarriedState& state) {
             "not finite");
     requireRange(e.first, e.count, state.carried_points.size(), 0xffffffffu, at("carried", k) + ".points");
     // The leaf pair a resumed test starts from: nodes of the two trees.
-    const SphereTree& tree_a = shapes.shapeAt(rows.bodyShapes()[c.a]).tree;
-    const SphereTree& tree_b = shapes.shapeAt(rows.bodyShapes()[c.b]).tree;
+    const SphereTree& tree_a = shapes_.shapeAt(rows_.bodyShapes()[c.a]).tree;
+    const SphereTree& tree_b = shapes_.shapeAt(rows_.bodyShapes()[c.b]).tree;
     require(e.leaf.a >= 0 && static_cast<std::size_t>(e.leaf.a) < tree_a.nodes().size() && e.leaf.b >= 0 &&
                 static_cast<std::size_t>(e.leaf.b) < tree_b.nodes().size(),
             at("carried", k) + ".leaf", "not a node of each body's tree");
     require(e.level >= 0 && e.level < std::max(tree_a.levelCount(), tree_b.levelCount()), at("carried", k) + ".level",
             "not a level of the trees");
     entries.push_back(e);
-    entries.back().key = entityPairKey(rows.entityIds()[c.a], rows.entityIds()[c.b]);
+    entries.back().key = entityPairKey(rows_.entityIds()[c.a], rows_.entityIds()[c.b]);
   }
   for (std::size_t k = 0; k < state.carried_points.size(); ++k) {
     const PairContactCache::Point& p = state.carried_points[k];
@@ -155,7 +155,7 @@ void World::Parts::restoreCarried(const CarriedState& state) {
                  at("warm", k) + ".points");
     std::vector<ContactSolver::CachedPoint>& points = w.held ? held_points : solved_points;
     ContactSolver::CachedManifold m = w.manifold;
-    m.pair = entityPairKey(rows.entityIds()[w.a], rows.entityIds()[w.b]);
+    m.pair = entityPairKey(rows_.entityIds()[w.a], rows_.entityIds()[w.b]);
     m.index_a = w.a;
     m.index_b = w.b;
     m.first = static_cast<std::uint32_t>(points.size());
@@ -173,12 +173,12 @@ void World::Parts::restoreCarried(const CarriedState& state) {
   if (broad) {
     std::vector<Aabb> had;
     had.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) had.push_back(broad_phase_.box(rows.entityIds()[i]));
+    for (std::size_t i = 0; i < n; ++i) had.push_back(broad_phase_.box(rows_.entityIds()[i]));
     try {
-      for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(rows.entityIds()[i], state.boxes[i]);
+      for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(rows_.entityIds()[i], state.boxes[i]);
       broad_phase_.restore(banding, pairs);
     } catch (const InputError& e) {
-      for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(rows.entityIds()[i], had[i]);
+      for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(rows_.entityIds()[i], had[i]);
       throw InputError(e.field() == "pairs" ? "broad_pairs" : e.field(), e.reason());
     }
   }
@@ -187,7 +187,7 @@ void World::Parts::restoreCarried(const CarriedState& state) {
   islands_.setNextGroup(state.next_group);
   // The static bodies' covered faces measured now, as the saved world had
   // them: measured at the first tick, they would drop the carried contacts.
-  static_cover_.update(rows.bodies(), rows.bodyShapes(), shapes.coverShapes());
+  static_cover_.update(rows_.bodies(), rows_.bodyShapes(), shapes_.coverShapes());
   physics_.restoreCarried(entries, state.carried_points);
   physics_.solver().restore(std::move(solved), std::move(solved_points), std::move(held), std::move(held_points));
   invalidateLastTick();

@@ -15,17 +15,17 @@ namespace stc {
 // World: its calls into the part
 
 std::vector<EntityId> World::Parts::breakEntity(EntityId id, const Vec3& point, const Vec3& normal) {
-  return fracture_->breakEntity(*world, id, point, normal);
+  return fracture_->breakEntity(*world_, id, point, normal);
 }
 
 const std::vector<BrokenEntity>& World::broken() const { return parts_->fracture_->broken(); }
 
 void World::Parts::fracture(TickContext& tick) {
-  tick.time.now = fracture_->fracture(*world, clock_, tick.time.now, tick.tick_end, tick.report);
+  tick.time.now = fracture_->fracture(*world_, clock_, tick.time.now, tick.tick_end, tick.report);
 }
 
 void World::Parts::breakPending(TickContext& tick) {
-  tick.time.now = fracture_->breakPending(*world, clock_, tick.time.now, tick.tick_end, tick.report);
+  tick.time.now = fracture_->breakPending(*world_, clock_, tick.time.now, tick.tick_end, tick.report);
 }
 
 // ---------------------------------------------------------------------------------

@@ -53,7 +53,7 @@ void World::Parts::chooseLevels(const Budget& budget, TickReport& report) {
     allowance = std::min(allowance, kResponseShare * left / cost_unit_s_);
   }
   IslandLevels::Inputs in;
-  in.bodies = &rows.bodies();
+  in.bodies = &rows_.bodies();
   in.contacts = &contacts_;  // last tick's (emptied when entities came or went)
   in.perception = &perception_;
   in.allowance = allowance;
@@ -78,8 +78,8 @@ void World::Parts::joinHeldIslands(TickContext& tick) {
   // midpoints nearer than the radii plus the half paths.
   const auto near = [&](std::uint32_t a, std::uint32_t b) {
     const auto path = [&](std::uint32_t i, Vec3& mid, double& half) {
-      const Vec3 end = rows.bodies()[i].pose.position;
-      const Vec3 start = levels_.isHeld(i) ? Vec3(end + rows.bodies()[i].linear_velocity * dt)
+      const Vec3 end = rows_.bodies()[i].pose.position;
+      const Vec3 start = levels_.isHeld(i) ? Vec3(end + rows_.bodies()[i].linear_velocity * dt)
                                           : physics_.startPose(i).position;
       mid = 0.5 * (start + end);
       half = 0.5 * (end - start).norm();
@@ -88,11 +88,11 @@ void World::Parts::joinHeldIslands(TickContext& tick) {
     double ha = 0.0, hb = 0.0;
     path(a, ma, ha);
     path(b, mb, hb);
-    const double reach = reachOf(shapes.shapeAt(rows.bodyShapes()[a])) + reachOf(shapes.shapeAt(rows.bodyShapes()[b])) + ha + hb + kJoinMargin;
+    const double reach = reachOf(shapes_.shapeAt(rows_.bodyShapes()[a])) + reachOf(shapes_.shapeAt(rows_.bodyShapes()[b])) + ha + hb + kJoinMargin;
     return (ma - mb).squaredNorm() <= reach * reach;
   };
   bool joined = false;
-  while (levels_.join(rows.bodies(), pairs.size(), pair_at, near, tick.report.response.levels)) {
+  while (levels_.join(rows_.bodies(), pairs.size(), pair_at, near, tick.report.response.levels)) {
     joined = true;
     if (setUpPairTests()) setUpPairTests();
   }
@@ -112,15 +112,15 @@ void World::Parts::learnLevelCosts(double must_run_s, double response_mandatory_
 
 const std::vector<std::uint8_t>& World::Parts::outOfStep() {
   const std::vector<std::uint8_t>& asleep = islands_.held();
-  out_of_step_.resize(rows.bodies().size());
-  for (std::size_t i = 0; i < rows.bodies().size(); ++i) out_of_step_[i] = (asleep[i] != 0 || levels_.isHeld(i)) ? 1 : 0;
+  out_of_step_.resize(rows_.bodies().size());
+  for (std::size_t i = 0; i < rows_.bodies().size(); ++i) out_of_step_[i] = (asleep[i] != 0 || levels_.isHeld(i)) ? 1 : 0;
   return out_of_step_;
 }
 
 ResponseLevel World::Parts::responseLevel(EntityId id) const {
-  const auto index = rows.indexOf(id);
+  const auto index = rows_.indexOf(id);
   if (!index) return ResponseLevel::Full;
-  if (rows.bodies()[*index].is_static) return ResponseLevel::Static;
+  if (rows_.bodies()[*index].is_static) return ResponseLevel::Static;
   if (islands_.isSleeping(*index)) return ResponseLevel::Asleep;
   return levels_.isHeld(*index) ? ResponseLevel::Held : ResponseLevel::Full;
 }

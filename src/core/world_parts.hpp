@@ -86,11 +86,11 @@ struct World::Parts {
 
   // The World that holds these parts, set again when it moves: WorldFracture
   // works through its public calls.
-  World* world;
+  World* world_;
   WorldConfig config_;
   Workers workers_;  // before the phases that use it
-  ShapeLibrary shapes;  // by shape id
-  EntityTable rows;     // the entities' rows, by dense index
+  ShapeLibrary shapes_;  // by shape id
+  EntityTable rows_;     // the entities' rows, by dense index
   StaticCover static_cover_;  // static bodies' faces other static bodies cover, by dense index
 
   SweepAndPrune broad_phase_;

@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace stc {
 namespace {
@@ -186,6 +187,21 @@ std::vector<std::array<double, 3>> worldVoxelCentres(const World& w, std::size_t
     out.push_back({c.x(), c.y(), c.z()});
   }
   return out;
+}
+
+// A World's parts call back the World that holds them (fracture adds and
+// removes bodies through its public calls): after a move, the World moved into.
+TEST(FractureWorld, AMovedWorldBreaksItsBodiesThroughItsOwnCalls) {
+  World first;
+  const EntityId id = first.addEntity(spec(rockShape(first), Vec3::Zero(), "rock", 5.0));
+  World moved(std::move(first));
+  World assigned;
+  assigned = std::move(moved);
+  const Vec3 impact = assigned.bodies()[0].pose.position + Vec3(0.05, 0.02, -0.15);
+  const std::vector<EntityId> pieces = assigned.breakEntity(id, impact, Vec3::UnitZ());
+  ASSERT_GE(pieces.size(), 2u);
+  EXPECT_FALSE(assigned.indexOf(id).has_value());
+  EXPECT_EQ(assigned.entityCount(), pieces.size());
 }
 
 TEST(FractureWorld, BreakKeepsMomentumEnergyAndEveryVoxelInPlace) {
