@@ -211,6 +211,13 @@ class World {
   // "banding", "broad_pairs", "carried[0].leaf", "warm[3]", ...) and then
   // changes nothing.
   void restoreCarried(const CarriedState& state);
+  // Brings the broad phase up to the entities added and removed since the
+  // last step (before the first: all of them), as the next step's broad
+  // phase would do first, so that carriedState() holds its part: call it
+  // before saving (the node's ~save does). Its pairs may then come in
+  // another order than without it, so later ticks may differ in their last
+  // bits, as after any spawn; what it finds is the same set of pairs.
+  void settleBroadPhase();
 
   // Dense views, valid until the next add/remove/step. Adding or removing an
   // entity (or clear()) also empties pairTests()/contacts() of the last step.

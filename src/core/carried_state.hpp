@@ -2,11 +2,13 @@
 // bodies' rows, for a saved world (scene_file.hpp, contact_state) to go on
 // as it would have: the awake bodies' rest timers and balls, the broad
 // phase's boxes, bands and pair order, the contacts carried between ticks
-// (PairContactCache) and the solver's warm-start impulses. Bodies by dense
+// (PairContactCache), the solver's warm-start impulses and the fractures
+// waiting for their pieces' trees. Bodies by dense
 // index, so that a World loaded in the same order takes it whatever its ids.
 #pragma once
 
 #include "contact_solver.hpp"
+#include "fracture.hpp"
 #include "islands.hpp"
 #include "pair_contact_cache.hpp"
 #include "sphere_tree_collision/types.hpp"
@@ -29,8 +31,9 @@ struct CarriedState {
 
   // Per body, the box the broad phase holds; its bands (SweepAndPrune::Banding);
   // its pairs in their order, as dense indices. No boxes: the broad phase
-  // starts afresh (saved before its first update, or with entities added or
-  // removed since its last: SweepAndPrune::settled).
+  // starts afresh (saved with entities added or removed since its last
+  // update: SweepAndPrune::settled; World::settleBroadPhase brings it up to
+  // them first).
   std::vector<Aabb> boxes;
   SweepAndPrune::Banding banding;
   std::vector<std::array<std::uint32_t, 2>> broad_pairs;
@@ -54,6 +57,15 @@ struct CarriedState {
   };
   std::vector<Warm> warm;
   std::vector<ContactSolver::CachedPoint> warm_points;
+
+  // Fractures waiting for their pieces' trees (a tick budget ran out),
+  // oldest first: the body and its fracture plane in its grid frame
+  // (WorldFracture), made at the loaded world's next tick.
+  struct Break {
+    std::uint32_t body = 0;
+    SplitPlane plane;
+  };
+  std::vector<Break> breaks;
 };
 
 }  // namespace stc

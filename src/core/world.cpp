@@ -103,6 +103,7 @@ ResponseLevel World::responseLevel(EntityId id) const { return parts_->responseL
 
 CarriedState World::carriedState() const { return parts_->carriedState(); }
 void World::restoreCarried(const CarriedState& state) { parts_->restoreCarried(state); }
+void World::settleBroadPhase() { parts_->settleBroadPhase(); }
 
 std::size_t World::entityCount() const { return parts_->rows_.entityCount(); }
 const std::vector<EntityId>& World::entityIds() const { return parts_->rows_.entityIds(); }

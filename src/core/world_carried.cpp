@@ -4,6 +4,7 @@
 
 #include "carried_state.hpp"
 #include "flat_hash_map.hpp"
+#include "world_fracture.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -75,7 +76,17 @@ CarriedState World::Parts::carriedState() const {
       out.warm.push_back(warm);
     }
   }
+  for (const WorldFracture::PendingBreak& b : fracture_->pendingBreaks()) {
+    const std::uint32_t body = indexOfId(b.id);
+    if (body != kMissing) out.breaks.push_back({body, b.plane});
+  }
   return out;
+}
+
+void World::Parts::settleBroadPhase() {
+  if (broad_phase_.settled()) return;
+  broad_phase_.update();
+  pairs_seen_.clear();  // its pairs' places moved
 }
 
 void World::Parts::restoreCarried(const CarriedState& state) {
@@ -168,6 +179,19 @@ void World::Parts::restoreCarried(const CarriedState& state) {
     require(allFinite(p.local_a) && std::isfinite(p.normal) && allFinite(p.friction), at("warm_points", k), "not finite");
   }
 
+  std::vector<WorldFracture::PendingBreak> breaks;
+  for (std::size_t k = 0; k < state.breaks.size(); ++k) {
+    const CarriedState::Break& b = state.breaks[k];
+    require(b.body < n && !rows_.bodies()[b.body].is_static && rows_.bodies()[b.body].material.strength > 0.0,
+            at("breaks", k) + ".body", "not a movable body with a strength");
+    require(allFinite(b.plane.point) && allFinite(b.plane.normal) && b.plane.normal.norm() > 0.0, at("breaks", k),
+            "plane point and normal finite, normal not zero");
+    const bool twice = std::any_of(breaks.begin(), breaks.end(),
+                                   [&](const WorldFracture::PendingBreak& p) { return p.id == rows_.entityIds()[b.body]; });
+    require(!twice, at("breaks", k) + ".body", "queued twice");
+    breaks.push_back({rows_.entityIds()[b.body], b.plane});
+  }
+
   // The broad phase last: its pairs must be those of the boxes (else it
   // throws, and the boxes it had are put back).
   if (broad) {
@@ -190,6 +214,7 @@ void World::Parts::restoreCarried(const CarriedState& state) {
   static_cover_.update(rows_.bodies(), rows_.bodyShapes(), shapes_.coverShapes());
   physics_.restoreCarried(entries, state.carried_points);
   physics_.solver().restore(std::move(solved), std::move(solved_points), std::move(held), std::move(held_points));
+  fracture_->restorePending(std::move(breaks));
   invalidateLastTick();
 }
 

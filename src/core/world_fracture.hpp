@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace stc {
@@ -37,6 +38,16 @@ class WorldFracture {
   void releaseMemory() { dropSpareCapacity(hits_); }
   const std::vector<BrokenEntity>& broken() const { return broken_; }
 
+  // A break waiting for its pieces' trees: the plane in the body's grid
+  // frame, so the split is the same whenever it is made.
+  struct PendingBreak {
+    EntityId id = kInvalidEntity;
+    SplitPlane plane;
+  };
+  // Oldest first; a saved world carries them (World::carriedState).
+  const std::vector<PendingBreak>& pendingBreaks() const { return pending_breaks_; }
+  void restorePending(std::vector<PendingBreak> breaks) { pending_breaks_ = std::move(breaks); }
+
  private:
   void breakQueued(World& world, const SecondsClock& clock, const Deadline& trees_until, bool one_tree_anyway,
                    TickReport& report);
@@ -51,12 +62,6 @@ class WorldFracture {
   // Replaces body `index` by `pieces`; their trees are built here if missing.
   std::vector<EntityId> placePieces(World& world, std::size_t index, std::vector<VoxelPiece>& pieces);
 
-  // A break waiting for its pieces' trees: the plane in the body's grid
-  // frame, so the split is the same whenever it is made.
-  struct PendingBreak {
-    EntityId id = kInvalidEntity;
-    SplitPlane plane;
-  };
   std::vector<PendingBreak> pending_breaks_;
   TreeCostEstimate tree_cost_;  // of the pieces' trees built so far
   std::vector<BrokenEntity> broken_;  // since the last step began

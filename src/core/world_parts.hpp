@@ -51,6 +51,7 @@ struct World::Parts {
   ResponseLevel responseLevel(EntityId id) const;
   CarriedState carriedState() const;
   void restoreCarried(const CarriedState& state);
+  void settleBroadPhase();
 
   // The tick's context, made once at its start (tick_context.hpp), then the
   // phases in tick order; each times itself into the report (PhaseTimer).

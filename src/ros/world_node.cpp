@@ -629,6 +629,9 @@ std::string WorldNode::writeWorld(const std::string& file) {
   std::filesystem::create_directories(params_.save_dir, error);
   if (error) throw stc::InputError("file", "cannot make ~save_dir '" + params_.save_dir + "': " + error.message());
   const std::string path = params_.save_dir + "/" + name;
+  // Spawns and despawns since the last tick into the broad phase first, so
+  // the file holds its pairs in their order (docs/ros_interface.md, Saved worlds).
+  world_.settleBroadPhase();
   const std::string yaml = stc::writeSceneYaml(world_, [this](stc::EntityId id) -> std::optional<Rgba> {
     const auto color = colors_.find(id);
     return color == colors_.end() ? std::nullopt : std::optional<Rgba>(color->second);

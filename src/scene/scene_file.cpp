@@ -403,7 +403,7 @@ CarriedState readCarried(const YAML::Node& node, std::size_t bodies) {
   const std::string p = "contact_state.";
   if (!node.IsMap()) throw InputError("contact_state", "expected a map");
   checkKeys(node, p, {"next_group", "rest", "banding", "slot_order", "band_order", "boxes", "broad_pairs", "carried",
-                      "carried_points", "warm", "warm_points"});
+                      "carried_points", "warm", "warm_points", "breaks"});
   if (!node["next_group"]) throw InputError(p + "next_group", "missing");
   // The broad phase's parts come together, or none (it starts afresh).
   for (const char* key : {"banding", "slot_order", "band_order", "broad_pairs"}) {
@@ -471,6 +471,9 @@ CarriedState readCarried(const YAML::Node& node, std::size_t bodies) {
   });
   countPoints(c.warm, c.warm_points.size(), p + "warm",
               [](CarriedState::Warm& w) { return std::tie(w.manifold.first, w.manifold.count); });
+  readEachRow(node, p, "breaks", 7, [&](const double* r, const std::string& field) {
+    c.breaks.push_back({body(r[0], field + ".body"), SplitPlane{vec3At(r + 1), vec3At(r + 4)}});
+  });
   return c;
 }
 
@@ -727,6 +730,12 @@ void putCarried(std::string& out, const CarriedState& c) {
   putRows(out, "warm_points", c.warm_points, [&](const ContactSolver::CachedPoint& p) {
     putRow(out, {double(p.node_a), double(p.node_b), p.local_a.x(), p.local_a.y(), p.local_a.z(), p.normal,
                  p.friction.x(), p.friction.y(), p.friction.z()});
+  });
+  // Written only when a break waits (a tick budget ran out): most files have none.
+  if (c.breaks.empty()) return;
+  putRows(out, "breaks", c.breaks, [&](const CarriedState::Break& b) {
+    const SplitPlane& q = b.plane;
+    putRow(out, {double(b.body), q.point.x(), q.point.y(), q.point.z(), q.normal.x(), q.normal.y(), q.normal.z()});
   });
 }
 

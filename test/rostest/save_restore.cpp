@@ -130,6 +130,35 @@ TEST_F(SaveRestore, ASavedWorldLoadsBackAndGoesOnTheSame) {
   EXPECT_TRUE(trigger("unpause").response.success);  // tick_stats flows again for the next test
 }
 
+// A save that falls between a spawn and the next tick (paused here) holds
+// the broad phase with the spawned body in it (World::settleBroadPhase), so
+// the loaded world writes the same file and goes on the same.
+TEST_F(SaveRestore, ASaveRightAfterASpawnHoldsTheBroadPhase) {
+  ASSERT_TRUE(trigger("pause").response.success);
+  stepTicks(1);
+  Spawn cube;
+  cube.request.entity.name = "just_spawned";
+  cube.request.entity.preset = "cube";
+  cube.request.entity.pose.position.x = 1.5;
+  cube.request.entity.pose.position.z = 0.5;
+  cube = call("spawn", cube);
+  ASSERT_TRUE(cube.response.success) << cube.response.message;
+  const SaveWorld saved = save("spawned.yaml");  // no tick since the spawn
+  ASSERT_TRUE(saved.response.success) << saved.response.message;
+  const std::string text = readFile(saved.response.path);
+  EXPECT_NE(text.find("name: just_spawned"), std::string::npos);
+  EXPECT_NE(text.find("\n  boxes:\n"), std::string::npos) << text.substr(text.find("contact_state:"));
+  stepTicks(5);
+  const SaveWorld went_on = save("spawned_on.yaml");
+  nh_.setParam(kNode + "scene", saved.response.path);
+  ASSERT_TRUE(trigger("reset").response.success);
+  EXPECT_TRUE(stc_test::spinUntil([&] { return listedNames().count("just_spawned") == 1; }, stc_test::kLivenessSeconds));
+  EXPECT_EQ(readFile(save("spawned_again.yaml").response.path), text);
+  stepTicks(5);
+  EXPECT_EQ(readFile(save("spawned_again_on.yaml").response.path), readFile(went_on.response.path));
+  EXPECT_TRUE(trigger("unpause").response.success);
+}
+
 // ~autosave_period 0.1 s at 30 Hz (the launch): every 3rd tick the world goes
 // to autosave.yaml as ~save writes it.
 TEST_F(SaveRestore, AutosaveWritesTheWorldEveryPeriod) {

@@ -40,6 +40,7 @@
 //                       node a, node b, level, normal of b, resolved], ...]   # the entries' points in turn
 //     warm: [[a, b, held, rolling x, y, z, points], ...]   # the solver's warm start
 //     warm_points: [[node a, node b, local a x, y, z, normal, friction x, y, z], ...]
+//     breaks: [[body, point x, y, z, normal x, y, z], ...]   # fractures waiting for their pieces' trees, oldest first
 #pragma once
 
 #include "sphere_tree_collision/scene/entity_request.hpp"
@@ -82,7 +83,9 @@ using ColorOf = std::function<std::optional<Rgba>(EntityId)>;
 // to 17 significant digits: they read back as the same bits. Then what the
 // next tick carries over (World::carriedState) as contact_state: the
 // contacts carried between ticks, the warm start, awake bodies' rest timers
-// and the broad phase's boxes, bands and pair order. The new World's
+// and the broad phase's boxes, bands and pair order (written when the
+// broad phase is settled: World::settleBroadPhase), and the fractures waiting
+// for their pieces' trees. The new World's
 // entities keep their ids (docs/ros_interface.md, "Saved worlds").
 std::string writeSceneYaml(const World& world, const ColorOf& color_of = nullptr);
 
