@@ -7,12 +7,12 @@
 // index, so that a World loaded in the same order takes it whatever its ids.
 #pragma once
 
-#include "contact_solver.hpp"
 #include "fracture.hpp"
 #include "islands.hpp"
 #include "pair_contact_cache.hpp"
 #include "sphere_tree_collision/types.hpp"
 #include "sweep_and_prune.hpp"
+#include "warm_start_cache.hpp"
 
 #include <array>
 #include <cstdint>
@@ -53,10 +53,10 @@ struct CarriedState {
   struct Warm {
     std::uint32_t a = 0, b = 0;
     bool held = false;
-    ContactSolver::CachedManifold manifold;
+    WarmStartCache::Manifold manifold;
   };
   std::vector<Warm> warm;
-  std::vector<ContactSolver::CachedPoint> warm_points;
+  std::vector<WarmStartCache::Point> warm_points;
 
   // Fractures waiting for their pieces' trees (a tick budget ran out),
   // oldest first: the body and its fracture plane in its grid frame

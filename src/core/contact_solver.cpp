@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cassert>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -32,7 +31,8 @@ constexpr std::size_t kManifoldsPerTask = 128;  // manifolds' rolling resistance
 // manifold a solver stage needs (a bounce step is about a row's work).
 constexpr std::size_t kWaveRowsPerManifold = 4;
 // A pair's points kept for the warm start: one bit each in warmStart's `used`.
-constexpr std::uint32_t kCachedPointsPerPair = ContactSolver::kMaxCachedPoints;
+constexpr std::uint32_t kCachedPointsPerPair = WarmStartCache::kMaxPoints;
+static_assert(kCachedPointsPerPair <= 32, "warmStart's `used` has 32 bits");
 
 // Appends to `out`, ascending, the indices whose flag is set; eight flags
 // at a time, as a wave's rows are few among many.
@@ -129,8 +129,7 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   growCapacityRewritten(wave_runs_, pass_runs_.size());
   resizeRewritten(row_bodies_, rows_.size());
   resizeRewritten(wave_flag_, rows_.size());
-  for (std::vector<CachedManifold>* v : {&cache_manifolds_, &next_manifolds_}) growCapacity(*v, rows_.size());
-  for (std::vector<CachedPoint>* v : {&cache_, &next_cache_}) growCapacity(*v, rows_.size());
+  warm_.reserve(rows_.size());
   // Each row from its contact alone: in pieces on the workers.
   const auto prepareRow = [&](std::size_t r) {
     const std::uint32_t ci = order_[r];
@@ -361,7 +360,7 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
 // nearest unused old point within half the gap bound (in A's frame).
 void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<BodyState>& bodies,
                               SolveStats& stats) {
-  if (cache_manifolds_.empty() && held_manifolds_.empty()) return;
+  if (warm_.empty()) return;
   std::atomic<std::size_t> by_feature{0}, started{0};
   // Stage by stage, as a pass: each body meets its manifolds in the same
   // order whatever the thread count, and a block's bodies stay on its thread.
@@ -372,8 +371,8 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
       const std::uint32_t last = manifold_start_[m + 1];
       const Contact& c0 = contacts[info_[first].contact];
       const std::uint64_t key = entityPairKey(c0.a, c0.b);
-      const CachedPoint* old = nullptr;
-      const CachedManifold* found = findCached(key, old);
+      const WarmStartCache::Point* old = nullptr;
+      const WarmStartCache::Manifold* found = warm_.find(key, old);
       if (found == nullptr) continue;
       Motion a = motion_[rows_[first].a];
       Motion b = motion_[rows_[first].b];
@@ -745,11 +744,10 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
   // tick's warm start. A manifold's points go where its rows are (at most
   // kCachedPointsPerPair of them), so manifolds fill in parallel.
   const std::size_t manifolds = manifold_start_.size() - 1;
-  next_cache_.resize(rows_.size());
-  next_manifolds_.resize(manifolds);
+  warm_.beginNext(rows_.size(), manifolds);
   forEachIndex(workers_, manifolds, kManifoldsPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t m = begin; m < end; ++m) {
-      CachedManifold manifold;
+      WarmStartCache::Manifold manifold;
       manifold.first = manifold_start_[m];
       const std::uint32_t stop = std::min(manifold_start_[m + 1], manifold_start_[m] + kCachedPointsPerPair);
       for (std::uint32_t r = manifold_start_[m]; r < manifold_start_[m + 1]; ++r) {
@@ -763,107 +761,16 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
           manifold.index_b = row.b;
         }
         if (r >= stop) continue;
-        CachedPoint& point = next_cache_[r];
-        point.node_a = c.node_a;
-        point.node_b = c.node_b;
-        const BodyState& ba = bodies[row.a];
-        point.local_a = ba.pose.orientation.conjugate() * (c.point - ba.pose.position);
-        point.normal = info_[r].lambda_main;
-        point.friction = info_[r].friction_main[0] * row.t1 + info_[r].friction_main[1] * row.t2;
+        const RowInfo& info = info_[r];
+        warm_.keepPoint(r, c, bodies[row.a].pose, info.lambda_main,
+                        info.friction_main[0] * row.t1 + info.friction_main[1] * row.t2);
       }
       manifold.count = stop - manifold.first;
       if (any_rolling_) manifold.rolling = rolling_[m].lambda;
-      next_manifolds_[m] = manifold;
+      warm_.keepManifold(m, manifold);
     }
   });
-  std::sort(next_manifolds_.begin(), next_manifolds_.end(), byPair);
-  keepHeldManifolds(bodies);
-}
-
-const ContactSolver::CachedManifold* ContactSolver::findCached(std::uint64_t pair,
-                                                              const CachedPoint*& points) const {
-  const auto byKey = [](const CachedManifold& x, std::uint64_t k) { return x.pair < k; };
-  const auto solved = std::lower_bound(cache_manifolds_.begin(), cache_manifolds_.end(), pair, byKey);
-  if (solved != cache_manifolds_.end() && solved->pair == pair) {
-    points = cache_.data() + solved->first;
-    return &*solved;
-  }
-  const auto held = std::lower_bound(held_manifolds_.begin(), held_manifolds_.end(), pair, byKey);
-  if (held != held_manifolds_.end() && held->pair == pair) {
-    points = held_points_.data() + held->first;
-    return &*held;
-  }
-  return nullptr;
-}
-
-void ContactSolver::keepHeldManifolds(const std::vector<BodyState>& bodies) {
-  if (held_ids_ == nullptr || held_ == nullptr) {
-    held_manifolds_.clear();
-    held_points_.clear();
-  } else {
-    // Kept while both bodies are still there (a despawn moves indices: the
-    // ids must match) and out of the solve, one of them asleep; tested
-    // first, so an awake world pays two look-ups a manifold. A pair solved
-    // this tick has a movable body, so it never qualifies: the held store
-    // and the solved cache never share a pair.
-    const auto stillHeld = [&](const CachedManifold& m) {
-      const std::uint32_t ia = m.index_a, ib = m.index_b;
-      return ia < bodies.size() && ib < bodies.size() && ((*held_)[ia] != 0 || (*held_)[ib] != 0) &&
-             out_of_solve_[ia] != 0 && out_of_solve_[ib] != 0 &&
-             (*held_ids_)[ia] == static_cast<EntityId>(m.pair >> 32) &&
-             (*held_ids_)[ib] == static_cast<EntityId>(m.pair & 0xffffffffu);
-    };
-    // What no longer sleeps (woken, despawned) leaves the store; the rest
-    // stays where it is unless something left.
-    const std::size_t stored = held_manifolds_.size();
-    std::size_t kept = 0;
-    while (kept < stored && stillHeld(held_manifolds_[kept])) ++kept;
-    if (kept < stored) {
-      held_points_scratch_.clear();
-      std::size_t out = 0;
-      for (std::size_t k = 0; k < stored; ++k) {
-        CachedManifold m = held_manifolds_[k];
-        if (!stillHeld(m)) continue;
-        const std::uint32_t first = static_cast<std::uint32_t>(held_points_scratch_.size());
-        held_points_scratch_.insert(held_points_scratch_.end(), held_points_.begin() + m.first,
-                                    held_points_.begin() + m.first + m.count);
-        m.first = first;
-        held_manifolds_[out++] = m;
-      }
-      held_manifolds_.resize(out);
-      held_points_.swap(held_points_scratch_);
-    }
-    // Last solve's manifolds whose pairs now sleep join it (both lists are
-    // sorted by pair: one merge).
-    const std::size_t before = held_manifolds_.size();
-    for (const CachedManifold& old : cache_manifolds_) {
-      if (!stillHeld(old)) continue;
-      CachedManifold m = old;
-      m.first = static_cast<std::uint32_t>(held_points_.size());
-      held_points_.insert(held_points_.end(), cache_.begin() + old.first, cache_.begin() + old.first + old.count);
-      held_manifolds_.push_back(m);
-    }
-    if (before > 0 && held_manifolds_.size() > before) {
-      held_merge_.resize(held_manifolds_.size());
-      std::merge(held_manifolds_.begin(), held_manifolds_.begin() + static_cast<std::ptrdiff_t>(before),
-                 held_manifolds_.begin() + static_cast<std::ptrdiff_t>(before), held_manifolds_.end(),
-                 held_merge_.begin(), byPair);
-      held_manifolds_.swap(held_merge_);
-    }
-    assert(std::is_sorted(held_manifolds_.begin(), held_manifolds_.end(), byPair));
-  }
-  cache_.swap(next_cache_);
-  cache_manifolds_.swap(next_manifolds_);
-}
-
-void ContactSolver::restore(std::vector<CachedManifold> solved, std::vector<CachedPoint> solved_points,
-                            std::vector<CachedManifold> held, std::vector<CachedPoint> held_points) {
-  std::sort(solved.begin(), solved.end(), byPair);
-  std::sort(held.begin(), held.end(), byPair);
-  cache_manifolds_ = std::move(solved);
-  cache_ = std::move(solved_points);
-  held_manifolds_ = std::move(held);
-  held_points_ = std::move(held_points);
+  warm_.commitNext(out_of_solve_);
 }
 
 SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
@@ -876,9 +783,7 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
   }
   prepare(bodies, contacts, options, dt, stats);
   if (rows_.empty()) {
-    next_cache_.clear();
-    next_manifolds_.clear();
-    keepHeldManifolds(bodies);  // only the sleepers' manifolds stay
+    warm_.commitNone(out_of_solve_);
     return stats;
   }
   // Refineable: the first velocity pass always runs; timed, it prices the

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "contact_partition.hpp"
+#include "warm_start_cache.hpp"
 #include "sphere_tree_collision/body.hpp"
 #include "sphere_tree_collision/budget.hpp"
 #include "sphere_tree_collision/contact.hpp"
@@ -111,12 +112,7 @@ class ContactSolver {
   SolveStats solveSoft(std::vector<BodyState>& bodies, std::vector<Contact>& contacts,
                        const ResponseOptions& options, double dt, const TickStart& start,
                        const SolveBudget& budget = SolveBudget{});
-  void forget() {  // drop warm-start impulses
-    cache_.clear();
-    cache_manifolds_.clear();
-    held_points_.clear();
-    held_manifolds_.clear();
-  }
+  void forget() { warm_.clear(); }  // drop warm-start impulses
   // Threads of the velocity, shock and position iterations (nullptr: the
   // caller's alone); the result is the same whatever they are
   // (contact_partition.hpp: a body pair's manifold is one group). A stage
@@ -127,47 +123,11 @@ class ContactSolver {
     task_manifolds_ = std::max<std::size_t>(1, task_manifolds);
   }
 
-  // Bodies held out of the solve because they sleep (by dense index, non-zero:
-  // held) and the bodies' entity ids: a manifold of last tick's cache that
-  // this tick did not solve is kept while both its bodies are out of the
-  // solve and one of them sleeps, so a woken pile starts from the impulses
-  // it fell asleep with, not cold (nullptr: none kept). Valid for the
-  // following solve calls.
-  void keepWhileHeld(const std::vector<EntityId>* ids, const std::vector<std::uint8_t>* held) {
-    held_ids_ = ids;
-    held_ = held;
-  }
-
-  // Last tick's manifold of a body pair: its points' impulses, by feature id
-  // (the leaf sphere pair a point was built from) and position in A's frame.
-  struct CachedPoint {
-    std::int32_t node_a = 0, node_b = 0;
-    Vec3 local_a = Vec3::Zero();
-    double normal = 0.0;
-    Vec3 friction = Vec3::Zero();  // world frame
-  };
-  struct CachedManifold {
-    std::uint64_t pair = 0;              // entity ids a, b packed: the sort key
-    std::uint32_t first = 0, count = 0;  // its points in cache_
-    std::uint32_t index_a = 0, index_b = 0;  // the bodies' dense indices when it was solved
-    Vec3 rolling = Vec3::Zero();             // its rolling-resistance impulse, world frame
-  };
-  // At most this many points of a manifold are kept for the warm start.
-  static constexpr std::uint32_t kMaxCachedPoints = 32;
-  // The warm start the next solve starts from, for a saved world
-  // (CarriedState): last solve's manifolds and the held store's (sorted by
-  // pair), each with its points [first, first + count) of the points given.
-  struct WarmStart {
-    const std::vector<CachedManifold>* manifolds = nullptr;
-    const std::vector<CachedPoint>* points = nullptr;
-  };
-  WarmStart solved() const { return {&cache_manifolds_, &cache_}; }
-  WarmStart held() const { return {&held_manifolds_, &held_points_}; }
-  // Both put back: pairs and indices as the loaded world's ids and dense
-  // indices give them, sorted here; counts of at most kMaxCachedPoints
-  // (checked by the caller).
-  void restore(std::vector<CachedManifold> solved, std::vector<CachedPoint> solved_points,
-               std::vector<CachedManifold> held, std::vector<CachedPoint> held_points);
+  // What the next solve warm-starts from (the sleeping pairs' manifolds kept
+  // with WarmStartCache::keepWhileHeld; a saved world's through solved(),
+  // held() and restore()).
+  const WarmStartCache& warmStartCache() const { return warm_; }
+  WarmStartCache& warmStartCache() { return warm_; }
 
   // A body's velocities as the solver sees them: one cache line per body.
   // A cache line each: bodies next to each other in the array may belong to
@@ -275,14 +235,6 @@ class ContactSolver {
     double soft_bounce = 0.0;
     double soft_kept[3] = {0.0, 0.0, 0.0};  // its impulses before a substep's shock sweep
   };
-  static bool byPair(const CachedManifold& x, const CachedManifold& y) { return x.pair < y.pair; }
-  // The held store (keepWhileHeld) keeps what still sleeps and gains last
-  // solve's manifolds whose pairs now do; then this solve's cache replaces
-  // last solve's.
-  void keepHeldManifolds(const std::vector<BodyState>& bodies);
-  // A pair's manifold for the warm start: of last solve, else of the held
-  // store (the two never hold one pair); nullptr when neither has it.
-  const CachedManifold* findCached(std::uint64_t pair, const CachedPoint*& points) const;
   void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
                const ResponseOptions& options, double dt, SolveStats& stats);
   void orderFromTheGround();  // from active_, contact_bodies_ and immovable_
@@ -456,16 +408,7 @@ class ContactSolver {
   std::vector<int> depth_, adjacency_start_, fill_;  // contact graph, for the row order
   std::vector<int> contact_level_;  // orderFromTheGround: per active contact, the lower body's depth
   std::vector<std::uint32_t> adjacency_, queue_;  // adjacency_: the other body of each contact at a body
-  std::vector<CachedPoint> cache_, next_cache_;
-  std::vector<CachedManifold> cache_manifolds_, next_manifolds_;  // last solve's and this one's, sorted by pair
-  // Manifolds of sleeping pairs, sorted by pair, their points in held_points_.
-  // Kept apart from the solved ones, so a tick of a mostly sleeping pile
-  // copies none of them: only a wake or a despawn (an entry that no longer
-  // qualifies) compacts the store, and only a pair falling asleep adds to it.
-  std::vector<CachedPoint> held_points_, held_points_scratch_;
-  std::vector<CachedManifold> held_manifolds_, held_merge_;
-  const std::vector<EntityId>* held_ids_ = nullptr;
-  const std::vector<std::uint8_t>* held_ = nullptr;
+  WarmStartCache warm_;  // last solve's manifolds and the sleeping pairs'
   const Workers* workers_ = nullptr;
   std::size_t task_manifolds_ = 1;  // read only with workers_
   Team* team_ = nullptr;  // while the passes run on workers_ (solve)

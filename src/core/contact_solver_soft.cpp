@@ -434,9 +434,7 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
         bodies[i].angular_velocity = motion_[i].w;
       }
     });
-    next_cache_.clear();
-    next_manifolds_.clear();
-    keepHeldManifolds(bodies);
+    warm_.commitNone(out_of_solve_);  // only the sleepers' manifolds stay
     return stats;
   }
   store(bodies, contacts, dt);  // pseudo-velocities are zero: velocities and the cache alone

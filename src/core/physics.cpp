@@ -375,7 +375,7 @@ void Physics::solve(const StepContext& step) {
   ResponseOptions run = options;
   run.restitution_threshold = std::max(options.restitution_threshold, kRestingFallTicks * gravity_speed_);
   solver_.setWorkers(step.workers, static_cast<std::size_t>(options.solver_task_manifolds));
-  solver_.keepWhileHeld(step.ids, step.held_asleep);
+  solver_.warmStartCache().keepWhileHeld(step.ids, step.held_asleep);
   if (options.solver == SolverKind::Soft) {
     ContactSolver::TickStart start{&start_, &start_v_, &start_w_, &sweep_scratch_.clamped};
     report_.solve = solver_.solveSoft(*step.bodies, contacts, run, step.dt, start, step.budget);

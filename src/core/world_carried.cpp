@@ -62,10 +62,10 @@ CarriedState World::Parts::carriedState() const {
                               cache.points().begin() + e.first + e.count);
     out.carried.push_back(entry);
   }
-  const ContactSolver& solver = physics_.solver();
-  for (const ContactSolver::WarmStart& store : {solver.solved(), solver.held()}) {
-    const bool held = store.manifolds == solver.held().manifolds;
-    for (const ContactSolver::CachedManifold& m : *store.manifolds) {
+  const WarmStartCache& warm_start = physics_.solver().warmStartCache();
+  for (const WarmStartCache::Store& store : {warm_start.solved(), warm_start.held()}) {
+    const bool held = store.manifolds == warm_start.held().manifolds;
+    for (const WarmStartCache::Manifold& m : *store.manifolds) {
       const std::uint32_t a = indexOfId(static_cast<EntityId>(m.pair >> 32));
       const std::uint32_t b = indexOfId(static_cast<EntityId>(m.pair & 0xffffffffu));
       if (a == kMissing || b == kMissing) continue;
@@ -156,16 +156,16 @@ void World::Parts::restoreCarried(const CarriedState& state) {
                 std::isfinite(p.separation) && std::isfinite(p.sphere_bound),
             at("carried_points", k), "not finite");
   }
-  std::vector<ContactSolver::CachedManifold> solved, held;
-  std::vector<ContactSolver::CachedPoint> solved_points, held_points;
+  std::vector<WarmStartCache::Manifold> solved, held;
+  std::vector<WarmStartCache::Point> solved_points, held_points;
   for (std::size_t k = 0; k < state.warm.size(); ++k) {
     const CarriedState::Warm& w = state.warm[k];
     require(w.a < n && w.b < n && w.a != w.b, at("warm", k), "two bodies of the world");
     require(allFinite(w.manifold.rolling), at("warm", k), "not finite");
-    requireRange(w.manifold.first, w.manifold.count, state.warm_points.size(), ContactSolver::kMaxCachedPoints,
+    requireRange(w.manifold.first, w.manifold.count, state.warm_points.size(), WarmStartCache::kMaxPoints,
                  at("warm", k) + ".points");
-    std::vector<ContactSolver::CachedPoint>& points = w.held ? held_points : solved_points;
-    ContactSolver::CachedManifold m = w.manifold;
+    std::vector<WarmStartCache::Point>& points = w.held ? held_points : solved_points;
+    WarmStartCache::Manifold m = w.manifold;
     m.pair = entityPairKey(rows_.entityIds()[w.a], rows_.entityIds()[w.b]);
     m.index_a = w.a;
     m.index_b = w.b;
@@ -175,7 +175,7 @@ void World::Parts::restoreCarried(const CarriedState& state) {
     (w.held ? held : solved).push_back(m);
   }
   for (std::size_t k = 0; k < state.warm_points.size(); ++k) {
-    const ContactSolver::CachedPoint& p = state.warm_points[k];
+    const WarmStartCache::Point& p = state.warm_points[k];
     require(allFinite(p.local_a) && std::isfinite(p.normal) && allFinite(p.friction), at("warm_points", k), "not finite");
   }
 
@@ -213,7 +213,7 @@ void World::Parts::restoreCarried(const CarriedState& state) {
   // them: measured at the first tick, they would drop the carried contacts.
   static_cover_.update(rows_.bodies(), rows_.bodyShapes(), shapes_.coverShapes());
   physics_.restoreCarried(entries, state.carried_points);
-  physics_.solver().restore(std::move(solved), std::move(solved_points), std::move(held), std::move(held_points));
+  physics_.solver().warmStartCache().restore(std::move(solved), std::move(solved_points), std::move(held), std::move(held_points));
   fracture_->restorePending(std::move(breaks));
   invalidateLastTick();
 }

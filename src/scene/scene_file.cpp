@@ -457,11 +457,11 @@ CarriedState readCarried(const YAML::Node& node, std::size_t bodies) {
     w.b = body(r[1], field + ".b");
     w.held = flagAt(r[2], field + ".held");
     w.manifold.rolling = vec3At(r + 3);
-    w.manifold.count = wholeAt(r[6], field + ".points", ContactSolver::kMaxCachedPoints);
+    w.manifold.count = wholeAt(r[6], field + ".points", WarmStartCache::kMaxPoints);
     c.warm.push_back(w);
   });
   readEachRow(node, p, "warm_points", 9, [&](const double* r, const std::string& field) {
-    ContactSolver::CachedPoint pt;
+    WarmStartCache::Point pt;
     pt.node_a = nodeAt(r[0], field + ".node_a");
     pt.node_b = nodeAt(r[1], field + ".node_b");
     pt.local_a = vec3At(r + 2);
@@ -727,7 +727,7 @@ void putCarried(std::string& out, const CarriedState& c) {
     const Vec3& r = w.manifold.rolling;
     putRow(out, {double(w.a), double(w.b), flag(w.held), r.x(), r.y(), r.z(), double(w.manifold.count)});
   });
-  putRows(out, "warm_points", c.warm_points, [&](const ContactSolver::CachedPoint& p) {
+  putRows(out, "warm_points", c.warm_points, [&](const WarmStartCache::Point& p) {
     putRow(out, {double(p.node_a), double(p.node_b), p.local_a.x(), p.local_a.y(), p.local_a.z(), p.normal,
                  p.friction.x(), p.friction.y(), p.friction.z()});
   });
