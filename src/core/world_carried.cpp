@@ -29,10 +29,12 @@ void requireRange(std::uint32_t first, std::uint32_t count, std::size_t size, st
 }  // namespace
 
 CarriedState World::Parts::carriedState() const {
+  const std::vector<EntityId>& ids = rows_.entityIds();
+  const std::vector<BodyState>& bodies = rows_.bodies();
   CarriedState out;
   const std::size_t n = rows_.entityCount();
   for (std::size_t i = 0; i < n; ++i) {
-    if (!rows_.bodies()[i].is_static && !islands_.isSleeping(i)) {
+    if (!bodies[i].is_static && !islands_.isSleeping(i)) {
       out.rest.push_back({static_cast<std::uint32_t>(i), islands_.rest(i)});
     }
   }
@@ -41,7 +43,7 @@ CarriedState World::Parts::carriedState() const {
   constexpr std::uint32_t kMissing = detail::FlatHashMap::kMissing;
   if (broad_phase_.settled()) {
     out.boxes.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) out.boxes.push_back(broad_phase_.box(rows_.entityIds()[i]));
+    for (std::size_t i = 0; i < n; ++i) out.boxes.push_back(broad_phase_.box(ids[i]));
     out.banding = broad_phase_.banding();
     for (EntityId& id : out.banding.slots) id = indexOfId(id);  // ids to dense indices
     for (auto& list : out.banding.endpoints) {
@@ -90,11 +92,13 @@ void World::Parts::settleBroadPhase() {
 }
 
 void World::Parts::restoreCarried(const CarriedState& state) {
+  const std::vector<EntityId>& ids = rows_.entityIds();
+  const std::vector<BodyState>& bodies = rows_.bodies();
   const std::size_t n = rows_.entityCount();
   // Everything checked before anything changes.
   for (std::size_t k = 0; k < state.rest.size(); ++k) {
     const CarriedState::Rest& r = state.rest[k];
-    require(r.body < n && !rows_.bodies()[r.body].is_static && !islands_.isSleeping(r.body), at("rest", k) + ".body",
+    require(r.body < n && !bodies[r.body].is_static && !islands_.isSleeping(r.body), at("rest", k) + ".body",
             "not an awake movable body");
     bool ok = std::isfinite(r.state.rest_time) && r.state.rest_time >= 0.0 && std::isfinite(r.state.age) &&
               r.state.age >= 0.0;
@@ -115,18 +119,18 @@ void World::Parts::restoreCarried(const CarriedState& state) {
   for (std::size_t k = 0; k < state.broad_pairs.size(); ++k) {
     const auto& p = state.broad_pairs[k];
     require(p[0] < n && p[1] < n && p[0] != p[1], at("broad_pairs", k), "two bodies of the world");
-    pairs.push_back({std::min(rows_.entityIds()[p[0]], rows_.entityIds()[p[1]]), std::max(rows_.entityIds()[p[0]], rows_.entityIds()[p[1]])});
+    pairs.push_back({std::min(ids[p[0]], ids[p[1]]), std::max(ids[p[0]], ids[p[1]])});
   }
   SweepAndPrune::Banding banding = state.banding;
   for (EntityId& body : banding.slots) {  // dense indices to ids
     require(body < n, "banding.slots", "a body of the world");
-    body = rows_.entityIds()[body];
+    body = ids[body];
   }
   for (auto& list : banding.endpoints) {  // dense indices to ids
     for (std::vector<std::uint64_t>& band : list) {
       for (std::uint64_t& e : band) {
         require(e >> 1 < n, "banding.endpoints", "a body of the world");
-        e = std::uint64_t{rows_.entityIds()[e >> 1]} << 1 | (e & 1u);
+        e = std::uint64_t{ids[e >> 1]} << 1 | (e & 1u);
       }
     }
   }
@@ -148,7 +152,7 @@ void World::Parts::restoreCarried(const CarriedState& state) {
     require(e.level >= 0 && e.level < std::max(tree_a.levelCount(), tree_b.levelCount()), at("carried", k) + ".level",
             "not a level of the trees");
     entries.push_back(e);
-    entries.back().key = entityPairKey(rows_.entityIds()[c.a], rows_.entityIds()[c.b]);
+    entries.back().key = entityPairKey(ids[c.a], ids[c.b]);
   }
   for (std::size_t k = 0; k < state.carried_points.size(); ++k) {
     const PairContactCache::Point& p = state.carried_points[k];
@@ -166,7 +170,7 @@ void World::Parts::restoreCarried(const CarriedState& state) {
                  at("warm", k) + ".points");
     std::vector<WarmStartCache::Point>& points = w.held ? held_points : solved_points;
     WarmStartCache::Manifold m = w.manifold;
-    m.pair = entityPairKey(rows_.entityIds()[w.a], rows_.entityIds()[w.b]);
+    m.pair = entityPairKey(ids[w.a], ids[w.b]);
     m.index_a = w.a;
     m.index_b = w.b;
     m.first = static_cast<std::uint32_t>(points.size());
@@ -182,14 +186,14 @@ void World::Parts::restoreCarried(const CarriedState& state) {
   std::vector<WorldFracture::PendingBreak> breaks;
   for (std::size_t k = 0; k < state.breaks.size(); ++k) {
     const CarriedState::Break& b = state.breaks[k];
-    require(b.body < n && !rows_.bodies()[b.body].is_static && rows_.bodies()[b.body].material.strength > 0.0,
+    require(b.body < n && !bodies[b.body].is_static && bodies[b.body].material.strength > 0.0,
             at("breaks", k) + ".body", "not a movable body with a strength");
     require(allFinite(b.plane.point) && allFinite(b.plane.normal) && b.plane.normal.norm() > 0.0, at("breaks", k),
             "plane point and normal finite, normal not zero");
     const bool twice = std::any_of(breaks.begin(), breaks.end(),
-                                   [&](const WorldFracture::PendingBreak& p) { return p.id == rows_.entityIds()[b.body]; });
+                                   [&](const WorldFracture::PendingBreak& p) { return p.id == ids[b.body]; });
     require(!twice, at("breaks", k) + ".body", "queued twice");
-    breaks.push_back({rows_.entityIds()[b.body], b.plane});
+    breaks.push_back({ids[b.body], b.plane});
   }
 
   // The broad phase last: its pairs must be those of the boxes (else it
@@ -197,12 +201,12 @@ void World::Parts::restoreCarried(const CarriedState& state) {
   if (broad) {
     std::vector<Aabb> had;
     had.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) had.push_back(broad_phase_.box(rows_.entityIds()[i]));
+    for (std::size_t i = 0; i < n; ++i) had.push_back(broad_phase_.box(ids[i]));
     try {
-      for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(rows_.entityIds()[i], state.boxes[i]);
+      for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(ids[i], state.boxes[i]);
       broad_phase_.restore(banding, pairs);
     } catch (const InputError& e) {
-      for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(rows_.entityIds()[i], had[i]);
+      for (std::size_t i = 0; i < n; ++i) broad_phase_.setBox(ids[i], had[i]);
       throw InputError(e.field() == "pairs" ? "broad_pairs" : e.field(), e.reason());
     }
   }

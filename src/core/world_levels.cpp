@@ -76,10 +76,12 @@ void World::Parts::joinHeldIslands(TickContext& tick) {
   // unresolved pair accepted there does) only if balls about their centres
   // holding shape and root sphere (reachOf) come within reach along them: the
   // midpoints nearer than the radii plus the half paths.
+  const std::vector<BodyState>& bodies = rows_.bodies();
+  const auto reachOfBody = [&](std::uint32_t i) { return reachOf(shapes_.shapeAt(rows_.bodyShapes()[i])); };
   const auto near = [&](std::uint32_t a, std::uint32_t b) {
     const auto path = [&](std::uint32_t i, Vec3& mid, double& half) {
-      const Vec3 end = rows_.bodies()[i].pose.position;
-      const Vec3 start = levels_.isHeld(i) ? Vec3(end + rows_.bodies()[i].linear_velocity * dt)
+      const Vec3 end = bodies[i].pose.position;
+      const Vec3 start = levels_.isHeld(i) ? Vec3(end + bodies[i].linear_velocity * dt)
                                           : physics_.startPose(i).position;
       mid = 0.5 * (start + end);
       half = 0.5 * (end - start).norm();
@@ -88,7 +90,7 @@ void World::Parts::joinHeldIslands(TickContext& tick) {
     double ha = 0.0, hb = 0.0;
     path(a, ma, ha);
     path(b, mb, hb);
-    const double reach = reachOf(shapes_.shapeAt(rows_.bodyShapes()[a])) + reachOf(shapes_.shapeAt(rows_.bodyShapes()[b])) + ha + hb + kJoinMargin;
+    const double reach = reachOfBody(a) + reachOfBody(b) + ha + hb + kJoinMargin;
     return (ma - mb).squaredNorm() <= reach * reach;
   };
   bool joined = false;
@@ -112,8 +114,9 @@ void World::Parts::learnLevelCosts(double must_run_s, double response_mandatory_
 
 const std::vector<std::uint8_t>& World::Parts::outOfStep() {
   const std::vector<std::uint8_t>& asleep = islands_.held();
-  out_of_step_.resize(rows_.bodies().size());
-  for (std::size_t i = 0; i < rows_.bodies().size(); ++i) out_of_step_[i] = (asleep[i] != 0 || levels_.isHeld(i)) ? 1 : 0;
+  const std::size_t n = rows_.entityCount();
+  out_of_step_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) out_of_step_[i] = (asleep[i] != 0 || levels_.isHeld(i)) ? 1 : 0;
   return out_of_step_;
 }
 
