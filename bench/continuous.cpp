@@ -12,6 +12,7 @@
 #include "physics.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "world_access.hpp"
 
 #include <ctime>
 #include <cstdio>
@@ -59,7 +60,7 @@ void runScene(SceneKind kind, int count, double seconds) {  // count 0: the scen
     broad += r.phases.broad_s;
     narrow += r.phases.narrow_s;
     response += r.phases.response_s;
-    const SweepStats& st = world.physicsReport().sweep;
+    const SweepStats& st = physicsReport(world).sweep;
     fast += static_cast<double>(st.fast_bodies);
     pairs += static_cast<double>(st.pairs);
     leaves += static_cast<double>(st.leaf_tests);

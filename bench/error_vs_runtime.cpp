@@ -41,6 +41,7 @@
 #include "fcl_mesh.hpp"
 #include "pair_test.hpp"
 #include "tick_clock.hpp"
+#include "world_access.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -253,7 +254,7 @@ class Evaluator {
     e.est_p = rep.accuracy.perceived_inaccuracy;
     const Perception& perception = world.perception();
     for (std::size_t i = 0; i < world.pairCount(); ++i) {
-      const PairTest& test = world.pairTests()[i];
+      const PairTest& test = pairTests(world)[i];
       const bool unresolved = test.status() == PairStatus::Unresolved;
       if (!unresolved && test.status() != PairStatus::Colliding) continue;  // separate: rejected
       e.accepted += 1;

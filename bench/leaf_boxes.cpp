@@ -19,6 +19,7 @@
 #include "shape_bounds.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "world_access.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -150,7 +151,7 @@ int main(int argc, char** argv) {
   long colliding = 0, leaf_pairs = 0, overlapping = 0, within_margin = 0;
   long model_tests[2] = {0, 0}, model_leaves[2] = {0, 0}, model_box_tests = 0;  // the tree walk without / with the box test
   for (std::size_t k = 0; k < world.pairCount(); ++k) {
-    const PairTest& test = world.pairTests()[k];
+    const PairTest& test = pairTests(world)[k];
     if (test.status() != PairStatus::Colliding) continue;
     ++colliding;
     const ShapeBounds& bounds_a = bounds.at(test.bodyA().tree);

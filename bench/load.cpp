@@ -22,6 +22,7 @@
 #include "physics.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
+#include "world_access.hpp"
 
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/narrowphase/collision_object.h>
@@ -225,7 +226,7 @@ BurstRun runBursts(int max_entities, int settle_ticks, double budget_ms) {
     band.broad_pairs += static_cast<double>(r.detection.broad_pairs);
     band.unresolved += static_cast<double>(r.detection.unresolved);
     band.contacts += static_cast<double>(r.response.contacts);
-    band.fast_bodies += static_cast<double>(world.physicsReport().sweep.fast_bodies);
+    band.fast_bodies += static_cast<double>(physicsReport(world).sweep.fast_bodies);
     band.interrupted += r.detection.interrupted;
     ++tick;
     if (static_cast<int>(world.entityCount() - floor_count) >= max_entities) ++settle;

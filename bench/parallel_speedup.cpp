@@ -41,6 +41,7 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
+#include "world_access.hpp"
 
 #include <atomic>
 #include <chrono>
@@ -109,9 +110,9 @@ void timedTicks(World& world, double dt, int ticks, Run& run) {
     run.team_wait.push_back(r.phases.team_wait_s);
     run.team_loops += static_cast<double>(r.phases.team_loops);
     run.contacts += static_cast<double>(r.response.contacts);
-    run.slabs += world.physicsReport().solve.slabs;
-    run.crossing += static_cast<double>(world.physicsReport().solve.crossing_manifolds);
-    run.manifolds += static_cast<double>(world.physicsReport().solve.manifolds);
+    run.slabs += physicsReport(world).solve.slabs;
+    run.crossing += static_cast<double>(physicsReport(world).solve.crossing_manifolds);
+    run.manifolds += static_cast<double>(physicsReport(world).solve.manifolds);
   }
 }
 

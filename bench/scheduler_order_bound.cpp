@@ -40,10 +40,12 @@
 #include "sphere_tree_collision/world.hpp"
 
 #include "bench_args.hpp"
+#include "deadline.hpp"
 #include "fcl_mesh.hpp"
 #include "pair_test.hpp"
 #include "scene_sim.hpp"
 #include "scheduler.hpp"
+#include "world_access.hpp"
 
 #include <algorithm>
 #include <array>
@@ -320,7 +322,7 @@ int main(int argc, char** argv) {
     const Perception& perception = eval.perception();
     facts.assign(eval.pairCount(), PairFacts{});
     for (std::size_t i = 0; i < facts.size(); ++i) {
-      const PairTest& test = eval.pairTests()[i];
+      const PairTest& test = pairTests(eval)[i];
       PairFacts& f = facts[i];
       f.a = test.bodyA();
       f.b = test.bodyB();

@@ -106,14 +106,6 @@ struct BrokenEntity {
   std::vector<EntityId> pieces;
 };
 
-// The internal types a few of World's accessors return: declared here, defined
-// in headers that stay in src/core (tests and benches see them; a user of the
-// installed headers does not need them).
-class PairTest;        // src/core/pair_test.hpp
-class SweepAndPrune;   // src/core/sweep_and_prune.hpp
-struct PhysicsReport;  // src/core/physics.hpp
-struct CarriedState;   // src/core/carried_state.hpp
-
 // The shapes (a ShapeLibrary), the entities' rows (an EntityTable), what
 // follows each add and remove, fracture and the phases are World::Parts
 // (src/core/world_parts.hpp), held by pointer: this header names none of
@@ -199,28 +191,16 @@ class World {
   // Static. Full for an unknown id.
   ResponseLevel responseLevel(EntityId id) const;
 
-  // What the next tick carries over from the last besides the bodies' rows
-  // (carried_state.hpp, internal: the saved world's scene file reads it), by
-  // dense index: a saved world's contact_state.
-  CarriedState carriedState() const;
-  // The same put back into a World that holds the saved world's entities in
-  // the same dense order with the same ids (EntitySpec::id), before its
-  // first step: its next ticks at an unlimited budget are then the saved
-  // world's, bit for bit (docs/ros_interface.md, Saved worlds). Throws
-  // InputError naming the part and the field ("rest[2].body", "boxes",
-  // "banding", "broad_pairs", "carried[0].leaf", "warm[3]", ...) and then
-  // changes nothing.
-  void restoreCarried(const CarriedState& state);
   // Brings the broad phase up to the entities added and removed since the
   // last step (before the first: all of them), as the next step's broad
-  // phase would do first, so that carriedState() holds its part: call it
-  // before saving (the node's ~save does). Its pairs may then come in
+  // phase would do first, so that a saved world holds its part: call it
+  // before writeSceneYaml (the node's ~save does). Its pairs may then come in
   // another order than without it, so later ticks may differ in their last
   // bits, as after any spawn; what it finds is the same set of pairs.
   void settleBroadPhase();
 
   // Dense views, valid until the next add/remove/step. Adding or removing an
-  // entity (or clear()) also empties pairTests()/contacts() of the last step.
+  // entity (or clear()) also empties the last step's pair tests and contacts().
   // A sleeping body's pose or velocity edited here wakes its island at the next step.
   std::size_t entityCount() const;
   const std::vector<EntityId>& entityIds() const;
@@ -237,9 +217,7 @@ class World {
   std::uint8_t closedFaces(std::size_t index) const;
   std::optional<std::size_t> indexOf(EntityId id) const;
 
-  // Narrow-phase results of the last step: pairTests()[0..pairCount()).
-  // PairTest is internal (pair_test.hpp): for tests and benches.
-  const std::vector<PairTest>& pairTests() const;
+  // Pairs the last step's narrow phase tested.
   std::size_t pairCount() const;
   // The last narrow phase's chunks (narrow_chunks.hpp; threads() before the
   // first): pairs chunkRange(pairCount(), k, narrowChunks()) were stepped by
@@ -251,16 +229,13 @@ class World {
   // clock reads a loop, about 200 loops a tick of 500 bodies); off by default.
   void timeTeamLoops(bool on);
   const std::vector<Contact>& contacts() const;
-  // The broad phase: its pairs and boxes as of the last step (checks and
-  // tests; SweepAndPrune is internal).
-  const SweepAndPrune& broadPhase() const;
-  // What the physics did in the last step: fast bodies swept back, solver
-  // stats (PhysicsReport is internal: physics.hpp).
-  const PhysicsReport& physicsReport() const;
 
  private:
   struct Parts;  // src/core/world_parts.hpp
   std::unique_ptr<Parts> parts_;
+  // The internal views tests, benches and the saved world's file read
+  // (src/core/world_access.hpp).
+  friend struct WorldAccess;
 };
 
 }  // namespace stc

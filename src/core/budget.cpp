@@ -1,5 +1,5 @@
-// Budget: the steady clock and the narrow-phase-only tracker.
-#include "sphere_tree_collision/budget.hpp"
+// Budget: the steady clock and the narrow phase's tracker (deadline.hpp).
+#include "deadline.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -9,7 +9,7 @@
 #include "contact_partition.hpp"
 #include "warm_start_cache.hpp"
 #include "sphere_tree_collision/body.hpp"
-#include "sphere_tree_collision/budget.hpp"
+#include "deadline.hpp"
 #include "sphere_tree_collision/contact.hpp"
 #include "sphere_tree_collision/response_options.hpp"
 #include "sphere_tree_collision/types.hpp"

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "pair_test.hpp"
-#include "sphere_tree_collision/budget.hpp"
+#include "deadline.hpp"
 #include "sphere_tree_collision/perception.hpp"
 #include "sphere_tree_collision/phase_options.hpp"
 

@@ -5,7 +5,7 @@
 #pragma once
 
 #include "physics.hpp"
-#include "sphere_tree_collision/budget.hpp"
+#include "deadline.hpp"
 #include "sphere_tree_collision/tick_report.hpp"
 
 namespace stc {

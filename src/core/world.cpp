@@ -6,6 +6,7 @@
 #include "flat_hash_map.hpp"
 #include "grow_capacity.hpp"
 #include "tick_context.hpp"
+#include "world_access.hpp"
 #include "world_fracture.hpp"
 
 #include <algorithm>
@@ -101,8 +102,6 @@ std::uint32_t World::sleepGroup(std::size_t index) const { return parts_->island
 bool World::isRestless(EntityId id) const { return parts_->isRestless(id); }
 ResponseLevel World::responseLevel(EntityId id) const { return parts_->responseLevel(id); }
 
-CarriedState World::carriedState() const { return parts_->carriedState(); }
-void World::restoreCarried(const CarriedState& state) { parts_->restoreCarried(state); }
 void World::settleBroadPhase() { parts_->settleBroadPhase(); }
 
 std::size_t World::entityCount() const { return parts_->rows_.entityCount(); }
@@ -116,14 +115,18 @@ const std::vector<BoxMode>& World::bodyBoxModes() const { return parts_->rows_.b
 std::uint8_t World::closedFaces(std::size_t index) const { return parts_->static_cover_.closedFaces(index); }
 std::optional<std::size_t> World::indexOf(EntityId id) const { return parts_->rows_.indexOf(id); }
 
-const std::vector<PairTest>& World::pairTests() const { return parts_->pair_tests_; }
 std::size_t World::pairCount() const { return parts_->pair_count_; }
 std::size_t World::narrowChunks() const { return parts_->narrow_chunks_used_; }
 int World::threads() const { return parts_->workers_.threads(); }
 void World::timeTeamLoops(bool on) { parts_->workers_.timeLoops(on); }
 const std::vector<Contact>& World::contacts() const { return parts_->contacts_; }
-const SweepAndPrune& World::broadPhase() const { return parts_->broad_phase_; }
-const PhysicsReport& World::physicsReport() const { return parts_->physics_.lastReport(); }
+
+// Internal views (world_access.hpp).
+const std::vector<PairTest>& pairTests(const World& world) { return WorldAccess::parts(world).pair_tests_; }
+const SweepAndPrune& broadPhase(const World& world) { return WorldAccess::parts(world).broad_phase_; }
+const PhysicsReport& physicsReport(const World& world) { return WorldAccess::parts(world).physics_.lastReport(); }
+CarriedState carriedState(const World& world) { return WorldAccess::parts(world).carriedState(); }
+void restoreCarried(World& world, const CarriedState& state) { WorldAccess::parts(world).restoreCarried(state); }
 
 // ---------------------------------------------------------------------------------
 // Shapes

@@ -8,7 +8,7 @@
 
 #include "fracture.hpp"
 #include "grow_capacity.hpp"
-#include "sphere_tree_collision/budget.hpp"
+#include "deadline.hpp"
 #include "sphere_tree_collision/world.hpp"
 
 #include <cstdint>
@@ -44,7 +44,7 @@ class WorldFracture {
     EntityId id = kInvalidEntity;
     SplitPlane plane;
   };
-  // Oldest first; a saved world carries them (World::carriedState).
+  // Oldest first; a saved world carries them (carriedState, world_access.hpp).
   const std::vector<PendingBreak>& pendingBreaks() const { return pending_breaks_; }
   void restorePending(std::vector<PendingBreak> breaks) { pending_breaks_ = std::move(breaks); }
 

@@ -23,6 +23,7 @@
 
 namespace stc {
 
+struct CarriedState;  // carried_state.hpp
 class WorldFracture;  // world_fracture.hpp
 struct TickContext;   // tick_context.hpp
 

@@ -1,6 +1,7 @@
 #include "sphere_tree_collision/scene/scene_file.hpp"
 
 #include "carried_state.hpp"
+#include "world_access.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -396,7 +397,7 @@ void readBroadPhase(const YAML::Node& node, std::size_t bodies, CarriedState& c)
   }
 }
 
-// contact_state (World::carriedState), `bodies` the scene's entities; the
+// contact_state (carriedState, world_access.hpp), `bodies` the scene's entities; the
 // World checks what it alone knows (which bodies are awake and movable, the
 // pairs of the boxes, the bands' endpoints) when it is put back.
 CarriedState readCarried(const YAML::Node& node, std::size_t bodies) {
@@ -539,7 +540,7 @@ std::vector<EntityId> addScene(World& world, const Scene& scene, const RequestDe
   }
   if (scene.carried) {
     try {
-      world.restoreCarried(*scene.carried);
+      restoreCarried(world, *scene.carried);
     } catch (const InputError& e) {
       for (const EntityId id : ids) world.removeEntity(id);
       throw InputError("contact_state." + e.field(), e.reason());
@@ -701,7 +702,7 @@ void putBroadPhase(std::string& out, const CarriedState& c) {
   out += "]\n";
 }
 
-// What the next tick carries over (World::carriedState), in the order the
+// What the next tick carries over (carriedState, world_access.hpp), in the order the
 // schema gives (scene_file.hpp).
 void putCarried(std::string& out, const CarriedState& c) {
   out += "contact_state:\n  next_group: " + std::to_string(c.next_group) + '\n';
@@ -785,7 +786,7 @@ std::string writeSceneYaml(const World& world, const ColorOf& color_of) {
     }
     out += "}\n";
   }
-  putCarried(out, world.carriedState());
+  putCarried(out, carriedState(world));
   return out;
 }
 

@@ -5,6 +5,7 @@
 
 #include "physics.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "world_access.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -43,7 +44,7 @@ inline CubeOverlapRun deepestCubeOverlap(World& w, int ticks, double dt, double 
   CubeOverlapRun run;
   for (int s = 0; s < ticks; ++s) {
     w.step(dt, Budget::unlimited());
-    run.held_back += static_cast<int>(w.physicsReport().sweep.clamped);
+    run.held_back += static_cast<int>(physicsReport(w).sweep.clamped);
     const std::vector<BodyState>& b = w.bodies();
     for (const Contact& c : w.contacts()) {
       if (b[c.index_a].is_static || b[c.index_b].is_static) continue;

@@ -4,6 +4,7 @@
 #include "dynamics.hpp"
 #include "physics.hpp"
 #include "sphere_tree_collision/scenes.hpp"
+#include "world_access.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -216,7 +217,7 @@ Metrics run(Scene& scene, const std::function<void(const World&, int step)>& obs
       for (const std::size_t i : scene.movers) settled[i] = world.bodies()[i].pose.position;
     }
     world.step(dt, scene.budget);
-    m.max_penetration = std::max(m.max_penetration, world.physicsReport().solve.max_penetration / scene.voxel);
+    m.max_penetration = std::max(m.max_penetration, physicsReport(world).solve.max_penetration / scene.voxel);
     for (const BodyState& b : world.bodies()) {
       if (!isFinite(b)) ++m.nan_count;
       m.max_speed = std::max(m.max_speed, b.linear_velocity.norm());

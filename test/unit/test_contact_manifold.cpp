@@ -7,6 +7,7 @@
 #include "contact_solver.hpp"
 #include "dynamics.hpp"
 #include "physics.hpp"
+#include "world_access.hpp"
 
 #include <gtest/gtest.h>
 
@@ -37,7 +38,7 @@ double runAwake(Scene& scene, const std::function<void(const World&, int step)>&
   for (int step = 0; step < scene.steps; ++step) {
     for (const std::size_t i : scene.movers) world.wake(world.entityIds()[i]);
     world.step(scene.dt, scene.budget);
-    deepest = std::max(deepest, world.physicsReport().solve.max_penetration / scene.voxel);
+    deepest = std::max(deepest, physicsReport(world).solve.max_penetration / scene.voxel);
     if (observe) observe(world, step);
   }
   return deepest;
@@ -59,7 +60,7 @@ TEST(ContactManifold, EveryBodyPairHasAtMostFourPointsSpreadOverTheFace) {
   std::size_t face_pairs = 0;
   runAwake(scene, [&](const World& world, int) {
     const PairPoints pairs = pointsByPair(world);
-    EXPECT_EQ(world.physicsReport().solve.manifolds, pairs.size());
+    EXPECT_EQ(physicsReport(world).solve.manifolds, pairs.size());
     for (const auto& [key, points] : pairs) {
       EXPECT_LE(points.size(), 4u);
       // A cube face down on a face: four points reaching out to its corners
@@ -152,7 +153,7 @@ TEST(ContactManifold, FeatureIdsCarryTheImpulsesOfARestingBoxFromTickToTick) {
     std::vector<double> now;
     for (const Contact& c : w.contacts()) now.push_back(c.normal_impulse);
     if (step >= 60) {  // settled after a second
-      const SolveStats& stats = w.physicsReport().solve;
+      const SolveStats& stats = physicsReport(w).solve;
       ASSERT_EQ(stats.contacts, 4u);
       // Every point found last tick's point by its leaf sphere pair.
       EXPECT_EQ(stats.warm_started, stats.contacts);
@@ -174,7 +175,7 @@ TEST(ContactManifold, WithoutWarmStartingNoPointIsMatched) {
   ResponseOptions response;
   response.warm_starting = false;
   Scene scene = stack(1, 0.05, 1.0 / 60.0, 0.5, 0.2, response);
-  runAwake(scene, [&](const World& w, int) { EXPECT_EQ(w.physicsReport().solve.warm_started, 0u); });
+  runAwake(scene, [&](const World& w, int) { EXPECT_EQ(physicsReport(w).solve.warm_started, 0u); });
 }
 
 // Positions of the movers now.

@@ -12,6 +12,7 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "world_access.hpp"
 
 #include <gtest/gtest.h>
 
@@ -121,7 +122,7 @@ TEST(Continuous, RockHittingARavineLedgeComesToRestOnIt) {
     const std::size_t index = *w.indexOf(w.addEntity(spec));
     for (int s = 0; s < static_cast<int>(3.0 / kDt); ++s) {
       w.step(kDt, Budget::unlimited());
-      clamped += static_cast<int>(w.physicsReport().sweep.clamped);
+      clamped += static_cast<int>(physicsReport(w).sweep.clamped);
     }
     const BodyState& b = w.bodies()[index];
     EXPECT_LT(b.linear_velocity.norm(), 0.05);
@@ -175,7 +176,7 @@ TEST(Continuous, RockFallingNearOtherBodiesAcceleratesAtG) {
   std::size_t most_pairs = 0;
   for (int s = 0; s < steps; ++s) {
     w.step(kDt, Budget::unlimited());
-    most_pairs = std::max(most_pairs, w.physicsReport().sweep.pairs);
+    most_pairs = std::max(most_pairs, physicsReport(w).sweep.pairs);
   }
   const double t = steps * kDt;
   for (const std::size_t i : {a, b}) {
@@ -282,7 +283,7 @@ TEST(Continuous, AHitWithoutANarrowPhaseContactIsTheContact) {
   for (int s = 0; s < 30; ++s) {
     const TickReport r = w.step(scene.dt, Budget::ofSphereTests(0));
     EXPECT_EQ(r.detection.colliding, 0u);
-    clamped += static_cast<int>(w.physicsReport().sweep.clamped);
+    clamped += static_cast<int>(physicsReport(w).sweep.clamped);
     lowest = std::min(lowest, w.bodies()[ball].pose.position.z());
   }
   EXPECT_GT(clamped, 0);

@@ -9,6 +9,7 @@
 #include "solid_cube.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "world_access.hpp"
 
 #include <gtest/gtest.h>
 
@@ -338,7 +339,7 @@ TEST(PairContactCache, ARestingCubeReusesItsContactsAndRestsWhereItWouldHave) {
     built_tests += b.detection.sphere_tests;
     if (r.detection.reused > 0) {
       // The solver matched every carried point to last tick's impulse.
-      EXPECT_EQ(reusing.physicsReport().solve.warm_started, reusing.physicsReport().solve.contacts);
+      EXPECT_EQ(physicsReport(reusing).solve.warm_started, physicsReport(reusing).solve.contacts);
     }
   }
   EXPECT_GT(reused, 50u);  // of 60 resting ticks

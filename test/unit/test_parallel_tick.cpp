@@ -5,6 +5,7 @@
 // deadline stops every worker. No timing is asserted: budgets are counts, and
 // the deadline runs on a fake clock.
 #include "contact_partition.hpp"
+#include "deadline.hpp"
 #include "narrow_chunks.hpp"
 #include "pair_test.hpp"
 #include "physics.hpp"
@@ -13,6 +14,7 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "workers.hpp"
+#include "world_access.hpp"
 
 #include <gtest/gtest.h>
 
@@ -78,7 +80,7 @@ TEST(ParallelTick, UnlimitedBudgetGivesTheSameBitsWhateverTheThreadCount) {
     std::size_t contacts = 0, most_bounced = 0;
     for (int t = 0; t < kTicks; ++t) {
       const TickReport r1 = one.step(1.0 / 60.0, Budget::unlimited());
-      most_bounced = std::max(most_bounced, one.physicsReport().solve.bounced);
+      most_bounced = std::max(most_bounced, physicsReport(one).solve.bounced);
       const TickReport r2 = two.step(1.0 / 60.0, Budget::unlimited());
       const TickReport r4 = four.step(1.0 / 60.0, Budget::unlimited());
       ASSERT_TRUE(sameState(one, two)) << toString(kind) << " 1 vs 2 threads, tick " << t;
@@ -170,7 +172,7 @@ TEST(ParallelTick, EachChunkRunsTheSchedulerOverItsPairsWithinItsShare) {
       std::vector<PairTest> again(last - first);
       std::vector<std::array<std::uint32_t, 2>> bodies(last - first);
       for (std::size_t i = first; i < last; ++i) {
-        const PairTest& done = w.pairTests()[i];
+        const PairTest& done = pairTests(w)[i];
         again[i - first].reset(done.bodyA(), done.bodyB());
         bodies[i - first] = {static_cast<std::uint32_t>(*w.indexOf(done.bodyA().id)),
                              static_cast<std::uint32_t>(*w.indexOf(done.bodyB().id))};
@@ -182,7 +184,7 @@ TEST(ParallelTick, EachChunkRunsTheSchedulerOverItsPairsWithinItsShare) {
       total += stats.sphere_tests;
       std::int64_t largest = 0;
       for (std::size_t i = first; i < last; ++i) {
-        const PairTest& done = w.pairTests()[i];
+        const PairTest& done = pairTests(w)[i];
         ASSERT_EQ(done.status(), again[i - first].status()) << "tick " << t << " pair " << i;
         ASSERT_EQ(done.stepsDone(), again[i - first].stepsDone()) << "tick " << t << " pair " << i;
         ASSERT_EQ(done.sphereTests(), again[i - first].sphereTests()) << "tick " << t << " pair " << i;
@@ -225,7 +227,7 @@ TEST(ParallelTick, TheDeadlineStopsEveryWorker) {
   for (std::size_t k = 0; k < w.narrowChunks(); ++k) {
     const auto [first, last] = chunkRange(w.pairCount(), k, w.narrowChunks());
     std::size_t unresolved = 0;
-    for (std::size_t i = first; i < last; ++i) unresolved += !w.pairTests()[i].resolved();
+    for (std::size_t i = first; i < last; ++i) unresolved += !pairTests(w)[i].resolved();
     EXPECT_GT(unresolved, 0u) << "chunk " << k << " ran on past the deadline";
   }
 }

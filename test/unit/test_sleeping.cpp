@@ -8,6 +8,7 @@
 #include "sphere_tree_collision/gaze_model.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "world_access.hpp"
 
 #include <gtest/gtest.h>
 
@@ -291,7 +292,7 @@ TEST(Sleeping, WokenPileStartsFromTheImpulsesItFellAsleepWith) {
   for (EntityId id : pile.spec.movers) before.push_back(world.bodies()[indexOf(world, id)].pose.position);
   ASSERT_TRUE(world.wake(pile.spec.movers.front()));
   world.step(kDt, Budget::unlimited());
-  const SolveStats& solve = world.physicsReport().solve;
+  const SolveStats& solve = physicsReport(world).solve;
   ASSERT_GT(solve.contacts, 0u);
   EXPECT_GE(static_cast<double>(solve.warm_started), 0.9 * static_cast<double>(solve.contacts));
   for (int t = 0; t < 29; ++t) world.step(kDt, Budget::unlimited());  // half a second

@@ -8,6 +8,7 @@
 #include "stepping_clock.hpp"
 
 #include "contact_solver.hpp"
+#include "deadline.hpp"
 #include "dynamics.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 

@@ -6,6 +6,7 @@
 #include "stepping_clock.hpp"
 
 #include "contact_solver.hpp"
+#include "deadline.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 

@@ -7,6 +7,7 @@
 #include "same_state.hpp"
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
+#include "world_access.hpp"
 
 #include <gtest/gtest.h>
 
@@ -40,9 +41,9 @@ void expectSameBits(SceneKind kind, int entities, const std::string& variant,
     wide.step(1.0 / 60.0, Budget::unlimited());
     narrow.step(1.0 / 60.0, Budget::unlimited());
     ASSERT_TRUE(sameState(wide, narrow)) << toString(kind) << " " << variant << ", tick " << t;
-    ASSERT_EQ(narrow.physicsReport().solve.wide_batches, 0u);
-    manifolds += wide.physicsReport().solve.manifolds;
-    batches += wide.physicsReport().solve.wide_batches;
+    ASSERT_EQ(physicsReport(narrow).solve.wide_batches, 0u);
+    manifolds += physicsReport(wide).solve.manifolds;
+    batches += physicsReport(wide).solve.wide_batches;
   }
   // The wide passes did run, and mostly with more than one manifold a batch
   // (a stack's manifolds share bodies and must go one by one).
@@ -78,8 +79,8 @@ TEST(WidePasses, JacobiStaysOneAtATime) {
   std::size_t manifolds = 0;
   for (int t = 0; t < 60; ++t) {
     w.step(1.0 / 60.0, Budget::unlimited());
-    manifolds += w.physicsReport().solve.manifolds;
-    ASSERT_EQ(w.physicsReport().solve.wide_batches, 0u) << "tick " << t;
+    manifolds += physicsReport(w).solve.manifolds;
+    ASSERT_EQ(physicsReport(w).solve.wide_batches, 0u) << "tick " << t;
   }
   EXPECT_GT(manifolds, 0u);
 }

@@ -4,6 +4,7 @@
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "sweep_and_prune.hpp"
+#include "world_access.hpp"
 
 #include <gtest/gtest.h>
 
@@ -251,7 +252,7 @@ TEST(World, RemovingEntitiesLeavesThePairsOfAWorldBuiltWithoutThem) {
   };
   const auto namedPairs = [](const World& w) {
     std::set<std::pair<std::string, std::string>> out;
-    for (const BroadPair& p : w.broadPhase().pairs()) {
+    for (const BroadPair& p : broadPhase(w).pairs()) {
       const std::string& a = w.bodyNames()[*w.indexOf(p.first)];
       const std::string& b = w.bodyNames()[*w.indexOf(p.second)];
       out.emplace(std::min(a, b), std::max(a, b));
@@ -263,7 +264,7 @@ TEST(World, RemovingEntitiesLeavesThePairsOfAWorldBuiltWithoutThem) {
   build(big, removed);
   const double dt = 1.0 / 60.0;
   big.step(dt, Budget::unlimited());
-  const std::size_t pairs_before = big.broadPhase().pairs().size();
+  const std::size_t pairs_before = broadPhase(big).pairs().size();
   EXPECT_GT(pairs_before, static_cast<std::size_t>(10 * n * n * n));
   std::mt19937 rng(3);
   std::vector<int> order(n * n * n);
@@ -282,7 +283,7 @@ TEST(World, RemovingEntitiesLeavesThePairsOfAWorldBuiltWithoutThem) {
   build(fresh, removed);
   fresh.step(dt, Budget::unlimited());
   ASSERT_EQ(big.entityCount(), fresh.entityCount());
-  EXPECT_LT(big.broadPhase().pairs().size(), pairs_before);
+  EXPECT_LT(broadPhase(big).pairs().size(), pairs_before);
   EXPECT_EQ(namedPairs(big), namedPairs(fresh));
 }
 
@@ -298,7 +299,7 @@ TEST(World, PairTestsReadTheirOwnBodiesThroughRemovals) {
     w.step(1.0 / 60.0, Budget::unlimited());
     ASSERT_GT(w.pairCount(), 0u);
     for (std::size_t k = 0; k < w.pairCount(); ++k) {
-      const PairTest& test = w.pairTests()[k];
+      const PairTest& test = pairTests(w)[k];
       for (const PairBody* body : {&test.bodyA(), &test.bodyB()}) {
         const std::optional<std::size_t> index = w.indexOf(body->id);
         ASSERT_TRUE(index.has_value()) << "tick " << t << ": pair " << k << " of a removed body";
@@ -326,11 +327,11 @@ TEST(World, ReleaseMemoryChangesNoState) {
     }
     s->world.step(1.0 / 60.0, Budget::unlimited());
   }
-  ASSERT_GT(released.world.broadPhase().pairs().size(), 0u);
+  ASSERT_GT(broadPhase(released.world).pairs().size(), 0u);
   released.world.releaseMemory();
   const auto pairSet = [](const World& w) {
     std::set<std::pair<EntityId, EntityId>> out;
-    for (const BroadPair& p : w.broadPhase().pairs()) out.insert({std::min(p.first, p.second), std::max(p.first, p.second)});
+    for (const BroadPair& p : broadPhase(w).pairs()) out.insert({std::min(p.first, p.second), std::max(p.first, p.second)});
     return out;
   };
   EXPECT_EQ(pairSet(released.world), pairSet(kept.world));
@@ -432,7 +433,7 @@ std::set<std::pair<EntityId, EntityId>> pairsWithContacts(const World& w) {
 std::set<std::pair<EntityId, EntityId>> pairsThatShouldTouch(const World& w, bool accept) {
   std::set<std::pair<EntityId, EntityId>> out;
   for (std::size_t i = 0; i < w.pairCount(); ++i) {
-    const PairTest& t = w.pairTests()[i];
+    const PairTest& t = pairTests(w)[i];
     if (t.status() == PairStatus::Colliding || (accept && t.status() == PairStatus::Unresolved))
       out.emplace(t.bodyA().id, t.bodyB().id);
   }
@@ -502,7 +503,7 @@ TEST(World, UnlimitedBudgetResolvesEveryPair) {
     EXPECT_EQ(pairsWithContacts(w).size(), r.detection.colliding);
     EXPECT_EQ(r.accuracy.geometric_inaccuracy, 0.0);
     std::int64_t tests = 0;
-    for (std::size_t i = 0; i < w.pairCount(); ++i) tests += w.pairTests()[i].sphereTests();
+    for (std::size_t i = 0; i < w.pairCount(); ++i) tests += pairTests(w)[i].sphereTests();
     EXPECT_EQ(r.detection.sphere_tests, tests);
     for (const Contact& c : w.contacts()) {
       EXPECT_TRUE(c.resolved);
@@ -584,7 +585,7 @@ TEST(World, PerceivedInaccuracyOnlyWithAFixation) {
   double sum = 0.0;
   std::map<std::pair<EntityId, EntityId>, double> priority;
   for (std::size_t i = 0; i < w.pairCount(); ++i) {
-    const PairTest& t = w.pairTests()[i];
+    const PairTest& t = pairTests(w)[i];
     priority[{t.bodyA().id, t.bodyB().id}] = w.perception().measure(t).priority;
     sum += priority[{t.bodyA().id, t.bodyB().id}];
   }

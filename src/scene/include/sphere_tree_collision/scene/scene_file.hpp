@@ -27,7 +27,7 @@
 //       resolution: 32           # voxels along the mesh's longest side, unless voxel_size is given
 //     - grid: {size: [2, 1, 1], voxel_size: 0.05, runs: [0, 2]}   # instead of preset: voxels, x fastest,
 //                                # as run lengths alternating empty and solid, empty first
-//   contact_state:               # a saved world's (World::carriedState), bodies by place in entities:
+//   contact_state:               # a saved world's (carriedState, world_access.hpp), bodies by place in entities:
 //     next_group: 4              # the group the next island to fall asleep takes
 //     rest: [[body, moving, rest_time, age, 3 x (ball centre x, y, z, radius)], ...]   # awake bodies
 //     banding: [origin x, y, z, scale x, y, z, top x, y, z, boxes]   # the broad phase's bands
@@ -52,6 +52,8 @@
 #include <vector>
 
 namespace stc {
+
+struct CarriedState;  // the core's, internal (src/core/carried_state.hpp)
 
 struct SceneEntry {
   std::string path;  // "entities[3]" or "entities[3].repeat[5]", for error messages
@@ -81,7 +83,7 @@ using ColorOf = std::function<std::optional<Rgba>(EntityId)>;
 // bit), velocities, density, material, colour (by `color_of`), static flag,
 // box mode (as resolved), closed faces and sleep group. Numbers are written
 // to 17 significant digits: they read back as the same bits. Then what the
-// next tick carries over (World::carriedState) as contact_state: the
+// next tick carries over (carriedState, world_access.hpp) as contact_state: the
 // contacts carried between ticks, the warm start, awake bodies' rest timers
 // and the broad phase's boxes, bands and pair order (written when the
 // broad phase is settled: World::settleBroadPhase), and the fractures waiting
@@ -100,7 +102,7 @@ const std::string& defaultSceneYaml();
 // Adds every entity (addRequest, with `defaults` for the fields left out or
 // at 0), returns their ids in scene order. Throws
 // InputError("entities[i].<field>") on the first bad one. A contact_state
-// is then put back (World::restoreCarried; into a World that held no entity);
+// is then put back (restoreCarried, world_access.hpp; into a World that held no entity);
 // refused, InputError("contact_state.<field>"), the entities are removed again.
 std::vector<EntityId> addScene(World& world, const Scene& scene, const RequestDefaults& defaults = {},
                                MeshResolver resolve_mesh = meshPathWithinRoots);
