@@ -1,6 +1,6 @@
 // Spatial partition of the solver's contacts into blocks that may run side by
 // side, so a pass waits for the other threads a few times (once or twice:
-// ContactSolver::planStages), not once per graph colour (a small scene's
+// SolverThreadPlan::planStages), not once per graph colour (a small scene's
 // colours are too small to split: docs/parallel.md).
 //
 // The unit is a group: the contacts of one body pair, solved one after the

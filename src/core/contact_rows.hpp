@@ -82,17 +82,19 @@ void ContactSolver::overManifolds(std::size_t first, std::size_t end, std::vecto
 template <typename Step, typename After>
 void ContactSolver::overManifolds(std::size_t first, std::size_t end, std::vector<Motion>& motion, Step&& step,
                                   After&& after) {
+  const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
+  const std::vector<SolverGroup>& manifolds = plan_.manifolds();
   for (std::size_t m = first; m < end; ++m) {
-    const std::uint32_t begin = manifold_start_[m];
-    const std::uint32_t stop = manifold_start_[m + 1];
+    const std::uint32_t begin = manifold_start[m];
+    const std::uint32_t stop = manifold_start[m + 1];
     const std::uint32_t ia = rows_[begin].a;
     const std::uint32_t ib = rows_[begin].b;
     Motion a = motion[ia];
     Motion b = motion[ib];
     for (std::uint32_t r = begin; r < stop; ++r) step(r, a, b);
     after(m, a, b);
-    if (manifolds_[m].a != SolverGroup::kStatic) motion[ia] = a;
-    if (manifolds_[m].b != SolverGroup::kStatic) motion[ib] = b;
+    if (manifolds[m].a != SolverGroup::kStatic) motion[ia] = a;
+    if (manifolds[m].b != SolverGroup::kStatic) motion[ib] = b;
   }
 }
 

@@ -114,9 +114,9 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     active_.push_back(ci);
   }
   orderFromTheGround();
-  blockManifolds(bodies);  // order_ now block by block, manifold by manifold
-  stats.slabs = partition_.slabs();
-  stats.crossing_manifolds = partition_.crossing();
+  plan_.assign(order_, contact_bodies_, contact_level_, out_of_solve_, bodies);  // order_ now block by block
+  stats.slabs = plan_.partition().slabs();
+  stats.crossing_manifolds = plan_.partition().crossing();
 
   resizeRewritten(rows_, order_.size());
   resizeRewritten(info_, order_.size());
@@ -126,7 +126,7 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   for (std::vector<std::uint32_t>* v : {&wave_rows_, &last_wave_rows_, &next_wave_rows_}) {
     growCapacityRewritten(*v, rows_.size());
   }
-  growCapacityRewritten(wave_runs_, pass_runs_.size());
+  growCapacityRewritten(wave_runs_, plan_.passRuns().size());
   resizeRewritten(row_bodies_, rows_.size());
   resizeRewritten(wave_flag_, rows_.size());
   warm_.reserve(rows_.size());
@@ -201,7 +201,7 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   });
   for (const std::uint32_t ci : order_) stats.max_penetration = std::max(stats.max_penetration, -contacts[ci].separation);
   stats.contacts = rows_.size();
-  stats.manifolds = manifold_start_.size() - 1;
+  stats.manifolds = plan_.manifoldStart().size() - 1;
   prepareRolling(bodies, jacobi);
   wide_ = options.wide_passes && !jacobi;
   if (wide_) batchManifolds();
@@ -213,7 +213,8 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
 // point to the nearer centre of mass of a movable body (a ball's radius; a
 // rock's, where it touches). Box2D v3 takes the larger coefficient too.
 void ContactSolver::prepareRolling(const std::vector<BodyState>& bodies, bool jacobi) {
-  const std::size_t manifolds = manifold_start_.size() - 1;
+  const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
+  const std::size_t manifolds = manifold_start.size() - 1;
   // Sized by the rows (a manifold has at least one), as they grow: a later
   // tick with more manifolds and no more rows allocates nothing.
   growCapacity(rolling_, rows_.size());
@@ -223,7 +224,7 @@ void ContactSolver::prepareRolling(const std::vector<BodyState>& bodies, bool ja
     Rolling& roll = rolling_[m];
     roll.lambda.setZero();
     roll.per_normal = 0.0;
-    const std::uint32_t begin = manifold_start_[m], stop = manifold_start_[m + 1];
+    const std::uint32_t begin = manifold_start[m], stop = manifold_start[m + 1];
     const BodyState& ba = bodies[rows_[begin].a];
     const BodyState& bb = bodies[rows_[begin].b];
     const double coefficient = std::max(ba.material.rolling_resistance, bb.material.rolling_resistance);
@@ -346,9 +347,9 @@ void ContactSolver::propagateShock(const ResponseOptions& options) {
     row.lambda[0] = normal;
   };
   // Level by level; a level's manifolds stage by stage.
-  for (std::size_t level = 0; level < shockLevels(); ++level) {
+  for (std::size_t level = 0; level < plan_.shockLevels(); ++level) {
     for (int pass = 0; pass < passes; ++pass) {
-      forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) {
+      plan_.forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) {
         overManifolds(first, end, motion_, shockStep);
       });
     }
@@ -362,13 +363,15 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
                               SolveStats& stats) {
   if (warm_.empty()) return;
   std::atomic<std::size_t> by_feature{0}, started{0};
+  const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
+  const std::vector<SolverGroup>& manifolds = plan_.manifolds();
   // Stage by stage, as a pass: each body meets its manifolds in the same
   // order whatever the thread count, and a block's bodies stay on its thread.
-  forEachStage([&](std::size_t first_manifold, std::size_t end_manifold) {
+  plan_.forEachStage([&](std::size_t first_manifold, std::size_t end_manifold) {
     std::size_t feature_hits = 0, warm = 0;
     for (std::size_t m = first_manifold; m < end_manifold; ++m) {
-      const std::uint32_t first = manifold_start_[m];
-      const std::uint32_t last = manifold_start_[m + 1];
+      const std::uint32_t first = manifold_start[m];
+      const std::uint32_t last = manifold_start[m + 1];
       const Contact& c0 = contacts[info_[first].contact];
       const std::uint64_t key = entityPairKey(c0.a, c0.b);
       const WarmStartCache::Point* old = nullptr;
@@ -424,8 +427,8 @@ void ContactSolver::warmStart(std::vector<Contact>& contacts, const std::vector<
         ++warm;
       }
       // A static body's motion is never written: two blocks may share it.
-      if (manifolds_[m].a != SolverGroup::kStatic) motion_[rows_[first].a] = a;
-      if (manifolds_[m].b != SolverGroup::kStatic) motion_[rows_[first].b] = b;
+      if (manifolds[m].a != SolverGroup::kStatic) motion_[rows_[first].a] = a;
+      if (manifolds[m].b != SolverGroup::kStatic) motion_[rows_[first].b] = b;
     }
     by_feature.fetch_add(feature_hits, std::memory_order_relaxed);
     started.fetch_add(warm, std::memory_order_relaxed);
@@ -462,11 +465,11 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
     const auto jacobiRolling = [&](std::size_t m, Motion& delta_a, Motion& delta_b) {
       Rolling& roll = rolling_[m];
       if (roll.per_normal == 0.0) return;
-      const std::uint32_t begin = manifold_start_[m];
+      const std::uint32_t begin = plan_.manifoldStart()[m];
       rollingStep(roll, normalImpulse(m), motion_[rows_[begin].a].w, motion_[rows_[begin].b].w, delta_a, delta_b);
     };
     for (int it = 0; it < passes; ++it) {
-      forEachStage([&](std::size_t first, std::size_t end) {
+      plan_.forEachStage([&](std::size_t first, std::size_t end) {
         if (any_rolling_) {
           overManifolds(first, end, delta_, jacobiStep, jacobiRolling);
         } else {
@@ -489,7 +492,7 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
     if (roll.per_normal != 0.0) resistRolling(roll, normalImpulse(m), a, b);
   };
   for (int it = 0; it < passes; ++it) {
-    forEachStage([&](std::size_t first, std::size_t end) {
+    plan_.forEachStage([&](std::size_t first, std::size_t end) {
       if (any_rolling_) {
         overManifolds(first, end, motion_, relaxStep, relaxRolling);
       } else {
@@ -501,7 +504,8 @@ void ContactSolver::solveVelocities(const ResponseOptions& options, int passes) 
 
 double ContactSolver::normalImpulse(std::size_t m) const {
   double sum = 0.0;
-  for (std::uint32_t r = manifold_start_[m]; r < manifold_start_[m + 1]; ++r) {
+  const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
+  for (std::uint32_t r = manifold_start[m]; r < manifold_start[m + 1]; ++r) {
     sum += rows_[r].lambda[0] + rows_[r].bounce_impulse;
   }
   return sum;
@@ -565,10 +569,7 @@ void ContactSolver::collide(const ResponseOptions& options, SolveStats& stats) {
         commitJacobi(motion_);
         continue;
       }
-      for (std::size_t st = 0; st + 1 < pass_stage_start_.size(); ++st) {
-        runStage(wave_runs_.data() + pass_stage_start_[st], pass_stage_start_[st + 1] - pass_stage_start_[st],
-                 bounceRows, kWaveRowsPerManifold * task_manifolds_);
-      }
+      plan_.forEachStageOfRuns(wave_runs_, bounceRows, kWaveRowsPerManifold);
     }
     // The last wave's rows too: its own rows were not looked at after it.
     for (const auto* list : {&wave_rows_, &last_wave_rows_}) {
@@ -609,10 +610,11 @@ void ContactSolver::collide(const ResponseOptions& options, SolveStats& stats) {
 // For each run of a pass (a non-empty block), its rows in wave_rows_:
 // wave_runs_[k] is [first, end) of wave_rows_ (both ascend).
 void ContactSolver::waveRuns() {
-  wave_runs_.resize(pass_runs_.size());
+  const std::vector<SolverThreadPlan::ManifoldRun>& pass_runs = plan_.passRuns();
+  wave_runs_.resize(pass_runs.size());
   std::size_t i = 0;
-  for (std::size_t k = 0; k < pass_runs_.size(); ++k) {
-    const std::uint32_t row_end = manifold_start_[pass_runs_[k].end];
+  for (std::size_t k = 0; k < pass_runs.size(); ++k) {
+    const std::uint32_t row_end = plan_.manifoldStart()[pass_runs[k].end];
     const std::size_t first = i;
     while (i < wave_rows_.size() && wave_rows_[i] < row_end) ++i;
     wave_runs_[k] = ManifoldRun{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(i)};
@@ -658,7 +660,7 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
   };
   int passes = 0;
   if (wide_ && !turns) {
-    forEachStageBatches([&](std::size_t first, std::size_t end) { packWidePush(first, end); });
+    plan_.forEachStageBatches(batch_start_, [&](std::size_t first, std::size_t end) { packWidePush(first, end); });
     for (int it = 0; it < options.iterations; ++it, ++passes) {
       if (it > 0 && deadline.passed()) break;
       solvePositionsWide();
@@ -668,7 +670,7 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
   for (int it = 0; it < options.iterations; ++it, ++passes) {
     if (it > 0 && deadline.passed()) break;
     // Stage by stage, as the velocity passes.
-    forEachStage([&](std::size_t first, std::size_t end) { overManifolds(first, end, out, positionStep); });
+    plan_.forEachStage([&](std::size_t first, std::size_t end) { overManifolds(first, end, out, positionStep); });
     if (jacobi) commitJacobi(pseudo_);
   }
   return passes;
@@ -694,8 +696,8 @@ void ContactSolver::propagatePositionShock(const ResponseOptions& options) {
     Motion& b = info.move_b ? pair_b : held_b;
     pushStep(row, info, a, b, turns ? info.shock_mass[0] : info.shock_push_mass, turns, a, b);
   };
-  for (std::size_t level = 0; level < shockLevels(); ++level) {
-    forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) {
+  for (std::size_t level = 0; level < plan_.shockLevels(); ++level) {
+    plan_.forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) {
       overManifolds(first, end, pseudo_, shockPush);
     });
   }
@@ -743,19 +745,20 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
   // Report impulses on the contacts and keep each pair's manifold for next
   // tick's warm start. A manifold's points go where its rows are (at most
   // kCachedPointsPerPair of them), so manifolds fill in parallel.
-  const std::size_t manifolds = manifold_start_.size() - 1;
+  const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
+  const std::size_t manifolds = manifold_start.size() - 1;
   warm_.beginNext(rows_.size(), manifolds);
   forEachIndex(workers_, manifolds, kManifoldsPerTask, [&](std::size_t begin, std::size_t end) {
     for (std::size_t m = begin; m < end; ++m) {
       WarmStartCache::Manifold manifold;
-      manifold.first = manifold_start_[m];
-      const std::uint32_t stop = std::min(manifold_start_[m + 1], manifold_start_[m] + kCachedPointsPerPair);
-      for (std::uint32_t r = manifold_start_[m]; r < manifold_start_[m + 1]; ++r) {
+      manifold.first = manifold_start[m];
+      const std::uint32_t stop = std::min(manifold_start[m + 1], manifold_start[m] + kCachedPointsPerPair);
+      for (std::uint32_t r = manifold_start[m]; r < manifold_start[m + 1]; ++r) {
         const Row& row = rows_[r];
         Contact& c = contacts[info_[r].contact];
         c.normal_impulse = row.lambda[0] + row.bounce_impulse;
         c.friction_impulse = row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
-        if (r == manifold_start_[m]) {
+        if (r == manifold_start[m]) {
           manifold.pair = entityPairKey(c.a, c.b);
           manifold.index_a = row.a;
           manifold.index_b = row.b;
@@ -791,7 +794,7 @@ SolveStats ContactSolver::solve(std::vector<BodyState>& bodies, std::vector<Cont
   // afforded to every later stage.
   // The restitution waves, the warm start and the passes run on a team: the
   // workers stay awake from stage to stage.
-  onTeam([&] {
+  plan_.onTeam([&] {
     collide(options, stats);
     if (options.warm_starting) warmStart(contacts, bodies, stats);
     iterate(options, budget, stats);
@@ -805,7 +808,7 @@ void ContactSolver::iterate(const ResponseOptions& options, const SolveBudget& b
   const Deadline& deadline = budget.deadline;
   ResponseOptions run = options;
   run.iterations = std::max(1, std::min(options.iterations, budget.max_iterations));
-  if (wide_) forEachStageBatches([&](std::size_t first, std::size_t end) { packWide(first, end); });
+  if (wide_) plan_.forEachStageBatches(batch_start_, [&](std::size_t first, std::size_t end) { packWide(first, end); });
   const double t_first = deadline.isSet() ? deadline.now() : 0.0;
   solveVelocities(run, 1);
   const double t_more = deadline.isSet() ? deadline.now() : 0.0;
@@ -816,7 +819,7 @@ void ContactSolver::iterate(const ResponseOptions& options, const SolveBudget& b
   stats.velocity_passes = run.iterations;
   const double t_rest = deadline.isSet() ? deadline.now() : 0.0;
   const auto unpack = [&] {
-    if (wide_) forEachStageBatches([&](std::size_t first, std::size_t end) { unpackWide(first, end); });
+    if (wide_) plan_.forEachStageBatches(batch_start_, [&](std::size_t first, std::size_t end) { unpackWide(first, end); });
   };
   // Warm-started, shock propagation's impulses would reach the support it
   // held as well: a heavy cube's weight, once a tick, on a light cube under

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "contact_partition.hpp"
+#include "solver_thread_plan.hpp"
 #include "warm_start_cache.hpp"
 #include "sphere_tree_collision/body.hpp"
 #include "deadline.hpp"
@@ -120,7 +121,7 @@ class ContactSolver {
   // (ResponseOptions::solver_task_manifolds).
   void setWorkers(const Workers* workers, std::size_t task_manifolds) {
     workers_ = workers;
-    task_manifolds_ = std::max<std::size_t>(1, task_manifolds);
+    plan_.setWorkers(workers, task_manifolds);
   }
 
   // What the next solve warm-starts from (the sleeping pairs' manifolds kept
@@ -238,36 +239,7 @@ class ContactSolver {
   void prepare(const std::vector<BodyState>& bodies, const std::vector<Contact>& contacts,
                const ResponseOptions& options, double dt, SolveStats& stats);
   void orderFromTheGround();  // from active_, contact_bodies_ and immovable_
-  // After orderFromTheGround: order_ regrouped block by block, manifold by
-  // manifold; manifold_start_, manifolds_, a pass's and the shock levels'
-  // runs of manifolds (contact_solver_blocks.cpp).
-  void blockManifolds(const std::vector<BodyState>& bodies);
-  struct ManifoldRun {
-    std::uint32_t first = 0, end = 0;
-  };
-  // manifolds(first, end) over every block's manifolds, stage by stage, a
-  // stage's blocks on the workers, each block's manifolds by one thread.
-  void forEachStage(RangeFn manifolds);
-  // Shock propagation's order: the levels from the ground (unreached rows
-  // aside), and a level's manifolds stage by stage, as forEachStage.
-  std::size_t shockLevels() const {
-    return level_stage_start_.empty() ? 0 : (level_stage_start_.size() - 1) / ContactPartition::kStages;
-  }
-  void forEachStageOfLevel(std::size_t level, RangeFn manifolds);
-  // A team's plan of one pass (unit 0) or one level (unit 1 + level): each
-  // member's slabs (a contiguous range) take in one block, in stage order,
-  // the blocks of stages 0-2 that touch no other member's slabs; the rest
-  // (the cuts between members' slabs, the blocks after them on the same
-  // slabs, stage 3) runs stage by stage after. So a pass waits for the team
-  // once or twice, not three times. No two members' blocks share a movable
-  // body, and each body meets its groups in the order of the four stages:
-  // the result is that of forEachStage's stages, bit for bit.
-  void planStages();
-  void runPlan(std::size_t unit, RangeFn manifolds) const;
-  bool planned() const { return team_ != nullptr && plan_members_ >= 2 && plan_members_ == team_->members(); }
-  // The blocks runs[0, count) of one stage: on the team when there are two
-  // or more and they hold `least` (task_manifolds_ when 0) or more, else in turn here.
-  void runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds, std::size_t least = 0) const;
+  using ManifoldRun = SolverThreadPlan::ManifoldRun;
   // step(r, a, b) over the rows r of manifolds [first, end), a and b the
   // pair's entries of `motion` copied in, then written back (a static body's
   // never is: blocks do not hold it apart).
@@ -370,10 +342,6 @@ class ContactSolver {
   void packWidePush(std::size_t first, std::size_t end);
   void solvePositionsWide();
   void propagatePositionShockWide();
-  // batches(first, end) over each block's batches, stage by stage (as forEachStage).
-  void forEachStageBatches(RangeFn batches);
-  // The same over one shock level's batches (as forEachStageOfLevel).
-  void forEachStageBatchesOfLevel(std::size_t level, RangeFn batches);
 
   bool wide_ = false;  // this solve's sequential passes run on the batches
   std::vector<WideBatch> batches_;
@@ -387,8 +355,6 @@ class ContactSolver {
   std::vector<RowInfo> info_;
   std::vector<Rolling> rolling_;  // by manifold (filled only when any_rolling_)
   bool any_rolling_ = false;
-  std::vector<std::uint32_t> manifold_start_;  // rows of one body pair: [start[m], start[m + 1])
-  std::vector<SolverGroup> manifolds_;         // each manifold's movable bodies (kStatic: static)
   std::vector<std::uint32_t> order_, active_, level_start_;
   std::vector<std::uint32_t> wave_rows_, last_wave_rows_, next_wave_rows_;  // collide(): by wave
   std::vector<std::array<std::uint32_t, 2>> row_bodies_;  // collide(): each row's bodies, compact
@@ -410,43 +376,10 @@ class ContactSolver {
   std::vector<std::uint32_t> adjacency_, queue_;  // adjacency_: the other body of each contact at a body
   WarmStartCache warm_;  // last solve's manifolds and the sleeping pairs'
   const Workers* workers_ = nullptr;
-  std::size_t task_manifolds_ = 1;  // read only with workers_
-  Team* team_ = nullptr;  // while the passes run on workers_ (solve)
-  // Runs `passes` on a team of workers_ (awake from stage to stage, team_ set
-  // meanwhile), or on the calling thread without workers.
-  template <typename Passes>
-  void onTeam(Passes&& passes) {
-    if (workers_ == nullptr) {
-      passes();
-      return;
-    }
-    workers_->withTeam([&](Team& team) {
-      team_ = &team;
-      passes();
-      team_ = nullptr;
-    });
-  }
-  // Blocks (contact_solver_blocks.cpp): the manifolds in the order from the
-  // ground (groups_, each one's first place in order_), their blocks, and in
-  // block order where each block's manifolds start.
-  ContactPartition partition_;
-  std::vector<SolverGroup> groups_;
-  std::vector<std::uint32_t> group_first_, group_order_, block_order_, block_manifold_start_;
-  // A pass's non-empty blocks (positions in block order) and each stage's
-  // first; per level from the ground and stage, its runs of manifolds, one
-  // per block, and each (level, stage)'s first run.
-  std::vector<ManifoldRun> pass_runs_, level_runs_;
-  std::vector<std::uint32_t> pass_stage_start_, level_stage_start_, cursor_;
-  std::vector<std::uint32_t> pass_run_block_, level_run_block_;  // each run's block
-  // planStages: a unit's offsets into plan_runs_ (planStride() a unit): the
-  // members' fused blocks, then the 3 stages left, and the end; per unit, the
-  // fused blocks' manifold count. plan_fused_: each run's member (-1: left).
-  std::size_t planStride() const { return static_cast<std::size_t>(plan_members_) + ContactPartition::kStages; }
-  std::vector<ManifoldRun> plan_runs_;
-  std::vector<std::uint32_t> plan_start_, plan_fused_manifolds_;
-  std::vector<long> plan_fused_;
-  int plan_members_ = 0;
-  std::vector<int> levels_;
+  // Which manifolds run together, on which worker (solver_thread_plan.hpp):
+  // the manifolds in block order (order_ is regrouped by it) and the loops
+  // that run a pass's ranges of them stage by stage.
+  SolverThreadPlan plan_;
 };
 
 // One-shot solve without warm starting (tests, tools).

@@ -167,7 +167,7 @@ void ContactSolver::substep(std::vector<BodyState>& bodies, const ResponseOption
     b.w += rl.inv_ib * rl.lambda;
   };
   const auto pass_over = [&](auto& step) {
-    forEachStage([&](std::size_t first_m, std::size_t end) {
+    plan_.forEachStage([&](std::size_t first_m, std::size_t end) {
       if (any_rolling_) {
         overManifolds(first_m, end, motion_, step, roll);
       } else {
@@ -185,7 +185,7 @@ void ContactSolver::substep(std::vector<BodyState>& bodies, const ResponseOption
     }
   });
   if (!first && !rows_.empty()) {
-    forEachStage([&](std::size_t first_m, std::size_t end) {
+    plan_.forEachStage([&](std::size_t first_m, std::size_t end) {
       if (any_rolling_) {
         overManifolds(first_m, end, motion_, warmStep, warmRoll);
       } else {
@@ -355,7 +355,7 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
   if (!rows_.empty()) prepareSoft(contacts, options, dt);
   // A heavy body on a much lighter support (the support nearer the ground).
   std::atomic<bool> heavy_on_light{false};
-  if (options.shock_propagation && !rows_.empty() && shockLevels() > 0) {
+  if (options.shock_propagation && !rows_.empty() && plan_.shockLevels() > 0) {
     forEachIndex(workers_, rows_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
       bool found = false;
       for (std::size_t r = begin; r < end && !found; ++r) {
@@ -401,7 +401,7 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
   run.count = stepped.substeps;
   run.budget = &budget;
   int ran = 0;
-  onTeam([&] {
+  plan_.onTeam([&] {
     if (!rows_.empty()) {
       collide(sequential, stats);
       if (options.warm_starting) warmStart(contacts, bodies, stats);

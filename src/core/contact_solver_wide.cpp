@@ -332,20 +332,23 @@ void ContactSolver::batchManifolds() {
   growCapacityRewritten(wide_rows_, rows_.size());
   growCapacityRewritten(wide_shock_mass_, rows_.size());
   growCapacityRewritten(wide_push_, rows_.size());
-  batch_start_.assign(manifolds_.size() + 1, 0);
+  const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
+  const std::vector<SolverGroup>& manifolds = plan_.manifolds();
+  batch_start_.assign(manifolds.size() + 1, 0);
   body_batch_.assign(motion_.size(), 0);
   // A block's manifolds are in the order from the ground; each level's run
-  // of them (shock propagation's unit, blockManifolds) is batched on its own.
-  const std::uint32_t block_count = partition_.blockCount();
+  // of them (shock propagation's unit, SolverThreadPlan::assign) is batched on its own.
+  const std::uint32_t block_count = plan_.partition().blockCount();
   for (std::uint32_t block = 0; block < block_count; ++block) {
-    const std::uint32_t end_manifold = block_manifold_start_[block + 1];
+    const SolverThreadPlan::ManifoldRun block_manifolds = plan_.block(block);
+    const std::uint32_t end_manifold = block_manifolds.end;
     std::uint32_t open = 0;  // the run's batches before it are full
-    for (std::uint32_t m = block_manifold_start_[block]; m < end_manifold; ++m) {
-      if (m == block_manifold_start_[block] || info_[manifold_start_[m]].level != info_[manifold_start_[m - 1]].level) {
+    for (std::uint32_t m = block_manifolds.first; m < end_manifold; ++m) {
+      if (m == block_manifolds.first || info_[manifold_start[m]].level != info_[manifold_start[m - 1]].level) {
         open = static_cast<std::uint32_t>(batches_.size());
         batch_start_[m] = open;
       }
-      const SolverGroup& group = manifolds_[m];
+      const SolverGroup& group = manifolds[m];
       // After the batches of the run's manifolds so far on either body
       // (body_batch_ from an earlier run is at most the run's first).
       std::uint32_t k = open;
@@ -355,7 +358,7 @@ void ContactSolver::batchManifolds() {
       if (k == batches_.size()) batches_.emplace_back();
       WideBatch& batch = batches_[k];
       batch.manifold[batch.lanes] = m;
-      batch.manifold_rows[batch.lanes] = manifold_start_[m + 1] - manifold_start_[m];
+      batch.manifold_rows[batch.lanes] = manifold_start[m + 1] - manifold_start[m];
       batch.rows = std::max(batch.rows, batch.manifold_rows[batch.lanes]);
       ++batch.lanes;
       if (group.a != SolverGroup::kStatic) body_batch_[group.a] = k + 1;
@@ -370,12 +373,12 @@ void ContactSolver::batchManifolds() {
     wide_rows += batch.rows;
     for (std::uint32_t l = 0; l < batch.lanes; ++l) {
       const std::uint32_t m = batch.manifold[l];
-      batch.body_a[l] = rows_[manifold_start_[m]].a;
-      batch.body_b[l] = rows_[manifold_start_[m]].b;
-      batch.write_a[l] = manifolds_[m].a != SolverGroup::kStatic;
-      batch.write_b[l] = manifolds_[m].b != SolverGroup::kStatic;
-      batch.move_a[l] = info_[manifold_start_[m]].move_a;
-      batch.move_b[l] = info_[manifold_start_[m]].move_b;
+      batch.body_a[l] = rows_[manifold_start[m]].a;
+      batch.body_b[l] = rows_[manifold_start[m]].b;
+      batch.write_a[l] = manifolds[m].a != SolverGroup::kStatic;
+      batch.write_b[l] = manifolds[m].b != SolverGroup::kStatic;
+      batch.move_a[l] = info_[manifold_start[m]].move_a;
+      batch.move_b[l] = info_[manifold_start[m]].move_b;
     }
   }
   wide_rows_.resize(wide_rows);
@@ -384,6 +387,7 @@ void ContactSolver::batchManifolds() {
 }
 
 void ContactSolver::packWide(std::size_t first, std::size_t end) {
+  const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
   for (std::size_t k = first; k < end; ++k) {
     const WideBatch& batch = batches_[k];
     for (std::uint32_t s = 0; s < batch.rows; ++s) {
@@ -393,8 +397,8 @@ void ContactSolver::packWide(std::size_t first, std::size_t end) {
       std::memset(&shock, 0, sizeof shock);
       for (std::uint32_t l = 0; l < batch.lanes; ++l) {
         if (s >= batch.manifold_rows[l]) continue;
-        const Row& row = rows_[manifold_start_[batch.manifold[l]] + s];
-        const RowInfo& info = info_[manifold_start_[batch.manifold[l]] + s];
+        const Row& row = rows_[manifold_start[batch.manifold[l]] + s];
+        const RowInfo& info = info_[manifold_start[batch.manifold[l]] + s];
         for (int i = 0; i < 3; ++i) {
           wide.ra[i][l] = row.ra[i];
           wide.rb[i][l] = row.rb[i];
@@ -419,6 +423,7 @@ void ContactSolver::packWide(std::size_t first, std::size_t end) {
 }
 
 void ContactSolver::packWidePush(std::size_t first, std::size_t end) {
+  const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
   for (std::size_t k = first; k < end; ++k) {
     const WideBatch& batch = batches_[k];
     for (std::uint32_t s = 0; s < batch.rows; ++s) {
@@ -426,7 +431,7 @@ void ContactSolver::packWidePush(std::size_t first, std::size_t end) {
       std::memset(&wide, 0, sizeof wide);
       for (std::uint32_t l = 0; l < batch.lanes; ++l) {
         if (s >= batch.manifold_rows[l]) continue;
-        const std::uint32_t r = manifold_start_[batch.manifold[l]] + s;
+        const std::uint32_t r = manifold_start[batch.manifold[l]] + s;
         const Row& row = rows_[r];
         const RowInfo& info = info_[r];
         for (int i = 0; i < 3; ++i) wide.n[i][l] = row.n[i];
@@ -443,30 +448,23 @@ void ContactSolver::packWidePush(std::size_t first, std::size_t end) {
 }
 
 void ContactSolver::unpackWide(std::size_t first, std::size_t end) {
+  const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
   for (std::size_t k = first; k < end; ++k) {
     const WideBatch& batch = batches_[k];
     for (std::uint32_t l = 0; l < batch.lanes; ++l) {
       for (std::uint32_t s = 0; s < batch.manifold_rows[l]; ++s) {
         const WideRow& wide = wide_rows_[batch.first_row + s];
-        Row& row = rows_[manifold_start_[batch.manifold[l]] + s];
+        Row& row = rows_[manifold_start[batch.manifold[l]] + s];
         for (int i = 0; i < 3; ++i) row.lambda[i] = wide.lambda[i][l];
       }
     }
   }
 }
 
-void ContactSolver::forEachStageBatches(RangeFn batches) {
-  forEachStage([&](std::size_t first, std::size_t end) { batches(batch_start_[first], batch_start_[end]); });
-}
-
-void ContactSolver::forEachStageBatchesOfLevel(std::size_t level, RangeFn batches) {
-  forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) { batches(batch_start_[first], batch_start_[end]); });
-}
-
 void ContactSolver::propagateShockWide(int passes) {
-  for (std::size_t level = 0; level < shockLevels(); ++level) {
+  for (std::size_t level = 0; level < plan_.shockLevels(); ++level) {
     for (int pass = 0; pass < passes; ++pass) {
-      forEachStageBatchesOfLevel(level, [&](std::size_t first, std::size_t end) {
+      plan_.forEachStageBatchesOfLevel(level, batch_start_, [&](std::size_t first, std::size_t end) {
         shockBatches(wide_rows_.data(), wide_shock_mass_.data(), batches_.data() + first, end - first, motion_.data());
       });
     }
@@ -474,14 +472,14 @@ void ContactSolver::propagateShockWide(int passes) {
 }
 
 void ContactSolver::solvePositionsWide() {
-  forEachStageBatches([&](std::size_t first, std::size_t end) {
+  plan_.forEachStageBatches(batch_start_, [&](std::size_t first, std::size_t end) {
     pushBatches(wide_push_.data(), batches_.data() + first, end - first, pseudo_.data());
   });
 }
 
 void ContactSolver::propagatePositionShockWide() {
-  for (std::size_t level = 0; level < shockLevels(); ++level) {
-    forEachStageBatchesOfLevel(level, [&](std::size_t first, std::size_t end) {
+  for (std::size_t level = 0; level < plan_.shockLevels(); ++level) {
+    plan_.forEachStageBatchesOfLevel(level, batch_start_, [&](std::size_t first, std::size_t end) {
       shockPushBatches(wide_push_.data(), batches_.data() + first, end - first, pseudo_.data());
     });
   }
@@ -489,7 +487,7 @@ void ContactSolver::propagatePositionShockWide() {
 
 void ContactSolver::solveVelocitiesWide(int passes) {
   for (int it = 0; it < passes; ++it) {
-    forEachStageBatches([&](std::size_t first, std::size_t end) {
+    plan_.forEachStageBatches(batch_start_, [&](std::size_t first, std::size_t end) {
       relaxBatches(wide_rows_.data(), any_rolling_ ? rolling_.data() : nullptr, batches_.data() + first, end - first,
                    motion_.data());
     });

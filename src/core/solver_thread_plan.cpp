@@ -1,6 +1,7 @@
-// The solver's manifolds in block order (contact_partition.hpp) and the loop
-// that runs a pass over them stage by stage, each stage's blocks in parallel.
-#include "contact_solver.hpp"
+// The solver's thread plan (solver_thread_plan.hpp): the manifolds in block
+// order (contact_partition.hpp) and the loops that run a pass over them stage
+// by stage, each stage's blocks in parallel.
+#include "solver_thread_plan.hpp"
 
 #include "grow_capacity.hpp"
 
@@ -9,8 +10,11 @@
 
 namespace stc {
 
-void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
-  // Groups: the manifolds, runs of one body pair in order_ (a pair's contacts
+void SolverThreadPlan::assign(std::vector<std::uint32_t>& order,
+                              const std::vector<std::array<std::uint32_t, 2>>& contact_bodies,
+                              const std::vector<int>& contact_level, const std::vector<std::uint8_t>& out_of_solve,
+                              const std::vector<BodyState>& bodies) {
+  // Groups: the manifolds, runs of one body pair in order (a pair's contacts
   // are adjacent, as ContactBuilder emits them, and stay so in the order from
   // the ground, which is stable).
   groups_.clear();
@@ -19,31 +23,31 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
   // Sized by the contacts, in the tick they grow (no allocation in a later
   // tick with more manifolds or levels and no more contacts).
   for (std::vector<std::uint32_t>* v : {&group_first_, &group_order_, &block_order_, &manifold_start_, &cursor_}) {
-    growCapacity(*v, order_.size() + 1);
+    growCapacity(*v, order.size() + 1);
   }
-  growCapacity(groups_, order_.size());
-  partition_.reserve(order_.size(), bodies.size());
+  growCapacity(groups_, order.size());
+  partition_.reserve(order.size(), bodies.size());
   // Shock propagation's runs: at most one a manifold, and at most kStages
   // stage starts a level from the ground (a level is at most the body count),
   // sized here and not in the tick whose contacts first reach the ground.
-  growCapacity(level_runs_, order_.size());
-  growCapacity(level_run_block_, order_.size());
+  growCapacity(level_runs_, order.size());
+  growCapacity(level_run_block_, order.size());
   growCapacity(pass_run_block_, ContactPartition::kStages * ContactPartition::kMaxSlabs);
   growCapacity(level_stage_start_, ContactPartition::kStages * (bodies.size() + 1) + 1);
-  growCapacity(manifolds_, order_.size());
-  growCapacity(levels_, order_.size());
-  for (std::size_t p = 0; p < order_.size(); ++p) {
-    const std::array<std::uint32_t, 2> c = contact_bodies_[order_[p]];
-    const int level = contact_level_[order_[p]];
+  growCapacity(manifolds_, order.size());
+  growCapacity(levels_, order.size());
+  for (std::size_t p = 0; p < order.size(); ++p) {
+    const std::array<std::uint32_t, 2> c = contact_bodies[order[p]];
+    const int level = contact_level[order[p]];
     if (levels_.empty() || levels_.back() != level) levels_.push_back(level);
-    if (p > 0 && c == contact_bodies_[order_[p - 1]]) continue;
+    if (p > 0 && c == contact_bodies[order[p - 1]]) continue;
     SolverGroup group;
-    group.a = out_of_solve_[c[0]] != 0 ? SolverGroup::kStatic : c[0];
-    group.b = out_of_solve_[c[1]] != 0 ? SolverGroup::kStatic : c[1];
+    group.a = out_of_solve[c[0]] != 0 ? SolverGroup::kStatic : c[0];
+    group.b = out_of_solve[c[1]] != 0 ? SolverGroup::kStatic : c[1];
     groups_.push_back(group);
     group_first_.push_back(static_cast<std::uint32_t>(p));
   }
-  group_first_.push_back(static_cast<std::uint32_t>(order_.size()));
+  group_first_.push_back(static_cast<std::uint32_t>(order.size()));
   for (std::size_t g = 0; g < groups_.size(); ++g) groups_[g].rows = group_first_[g + 1] - group_first_[g];
   partition_.assign(groups_, bodies);
 
@@ -62,10 +66,10 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
   for (const std::uint32_t g : group_order_) {
     manifold_start_.push_back(static_cast<std::uint32_t>(block_order_.size()));
     manifolds_.push_back(groups_[g]);
-    for (std::uint32_t p = group_first_[g]; p < group_first_[g + 1]; ++p) block_order_.push_back(order_[p]);
+    for (std::uint32_t p = group_first_[g]; p < group_first_[g + 1]; ++p) block_order_.push_back(order[p]);
   }
   manifold_start_.push_back(static_cast<std::uint32_t>(block_order_.size()));
-  order_.swap(block_order_);
+  order.swap(block_order_);
 
   // A pass's runs: the non-empty blocks, stage by stage.
   const std::uint32_t slabs = partition_.slabs();
@@ -95,7 +99,7 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
     for (std::uint32_t b = 0; b < block_count; ++b) {
       if (b % slabs == 0) level_stage_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
       std::uint32_t end = cursor_[b];
-      while (end < block_manifold_start_[b + 1] && contact_level_[order_[manifold_start_[end]]] == level) ++end;
+      while (end < block_manifold_start_[b + 1] && contact_level[order[manifold_start_[end]]] == level) ++end;
       if (end > cursor_[b]) {
         level_runs_.push_back(ManifoldRun{cursor_[b], end});
         level_run_block_.push_back(b);
@@ -104,10 +108,10 @@ void ContactSolver::blockManifolds(const std::vector<BodyState>& bodies) {
     }
   }
   if (!level_stage_start_.empty()) level_stage_start_.push_back(static_cast<std::uint32_t>(level_runs_.size()));
-  planStages();
+  planStages(order.size(), bodies.size());
 }
 
-void ContactSolver::planStages() {
+void SolverThreadPlan::planStages(std::size_t contacts, std::size_t body_count) {
   const std::uint32_t slabs = partition_.slabs();
   const int members = workers_ != nullptr ? workers_->threads() : 1;
   plan_members_ = (members >= 2 && slabs >= 2) ? members : 0;
@@ -157,7 +161,7 @@ void ContactSolver::planStages() {
     // Every run placed once, and no movable body in two members' blocks.
     assert(plan_runs_.size() - first_run == count);
     static thread_local std::vector<long> member_of;  // debug scratch, kept: no allocation once grown
-    member_of.assign(motion_.size(), -1);
+    member_of.assign(body_count, -1);
     for (std::size_t m = 0; m < m_count; ++m) {
       for (std::uint32_t k = plan_start_[unit + m]; k < plan_start_[unit + m + 1]; ++k) {
         for (std::uint32_t g = plan_runs_[k].first; g < plan_runs_[k].end; ++g) {
@@ -171,11 +175,11 @@ void ContactSolver::planStages() {
     }
 #endif
   };
-  // Sized as the runs and the level starts are (blockManifolds).
-  growCapacity(plan_runs_, ContactPartition::kStages * ContactPartition::kMaxSlabs + order_.size());
-  growCapacity(plan_fused_, ContactPartition::kStages * ContactPartition::kMaxSlabs + order_.size());
-  growCapacity(plan_start_, planStride() * (motion_.size() + 2));
-  growCapacity(plan_fused_manifolds_, motion_.size() + 2);
+  // Sized as the runs and the level starts are (assign).
+  growCapacity(plan_runs_, ContactPartition::kStages * ContactPartition::kMaxSlabs + contacts);
+  growCapacity(plan_fused_, ContactPartition::kStages * ContactPartition::kMaxSlabs + contacts);
+  growCapacity(plan_start_, planStride() * (body_count + 2));
+  growCapacity(plan_fused_manifolds_, body_count + 2);
   plan(pass_runs_.data(), pass_run_block_.data(), pass_runs_.size());
   for (std::size_t level = 0; level < shockLevels(); ++level) {
     const std::uint32_t first = level_stage_start_[level * ContactPartition::kStages];
@@ -184,7 +188,7 @@ void ContactSolver::planStages() {
   }
 }
 
-void ContactSolver::runPlan(std::size_t unit, RangeFn manifolds) const {
+void SolverThreadPlan::runPlan(std::size_t unit, RangeFn manifolds) const {
   const std::size_t m_count = static_cast<std::size_t>(plan_members_);
   const std::uint32_t* start = plan_start_.data() + unit * planStride();
   const std::size_t total = plan_fused_manifolds_[unit];  // the members' manifolds
@@ -201,7 +205,7 @@ void ContactSolver::runPlan(std::size_t unit, RangeFn manifolds) const {
   }
 }
 
-void ContactSolver::runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds, std::size_t least) const {
+void SolverThreadPlan::runStage(const ManifoldRun* runs, std::size_t count, RangeFn manifolds, std::size_t least) const {
   std::size_t total = 0;
   for (std::size_t k = 0; k < count; ++k) total += runs[k].end - runs[k].first;
   if (team_ == nullptr || count < 2 || total < (least > 0 ? least : task_manifolds_)) {
@@ -211,7 +215,7 @@ void ContactSolver::runStage(const ManifoldRun* runs, std::size_t count, RangeFn
   team_->forBlocks(count, [&](std::size_t k, std::size_t) { manifolds(runs[k].first, runs[k].end); });
 }
 
-void ContactSolver::forEachStage(RangeFn manifolds) {
+void SolverThreadPlan::forEachStage(RangeFn manifolds) const {
   if (planned()) {
     runPlan(0, manifolds);
     return;
@@ -221,7 +225,7 @@ void ContactSolver::forEachStage(RangeFn manifolds) {
   }
 }
 
-void ContactSolver::forEachStageOfLevel(std::size_t level, RangeFn manifolds) {
+void SolverThreadPlan::forEachStageOfLevel(std::size_t level, RangeFn manifolds) const {
   if (planned()) {
     runPlan(1 + level, manifolds);
     return;
@@ -229,6 +233,23 @@ void ContactSolver::forEachStageOfLevel(std::size_t level, RangeFn manifolds) {
   const std::size_t first = level * ContactPartition::kStages;
   for (std::size_t s = first; s < first + ContactPartition::kStages; ++s) {
     runStage(level_runs_.data() + level_stage_start_[s], level_stage_start_[s + 1] - level_stage_start_[s], manifolds);
+  }
+}
+
+void SolverThreadPlan::forEachStageBatches(const std::vector<std::uint32_t>& starts, RangeFn fn) const {
+  forEachStage([&](std::size_t first, std::size_t end) { fn(starts[first], starts[end]); });
+}
+
+void SolverThreadPlan::forEachStageBatchesOfLevel(std::size_t level, const std::vector<std::uint32_t>& starts,
+                                                  RangeFn fn) const {
+  forEachStageOfLevel(level, [&](std::size_t first, std::size_t end) { fn(starts[first], starts[end]); });
+}
+
+void SolverThreadPlan::forEachStageOfRuns(const std::vector<ManifoldRun>& runs, RangeFn fn,
+                                          std::size_t per_manifold) const {
+  for (std::size_t st = 0; st + 1 < pass_stage_start_.size(); ++st) {
+    runStage(runs.data() + pass_stage_start_[st], pass_stage_start_[st + 1] - pass_stage_start_[st], fn,
+             per_manifold * task_manifolds_);
   }
 }
 
