@@ -752,13 +752,14 @@ void ContactSolver::store(std::vector<BodyState>& bodies, std::vector<Contact>& 
     for (std::size_t m = begin; m < end; ++m) {
       WarmStartCache::Manifold manifold;
       manifold.first = manifold_start[m];
-      const std::uint32_t stop = std::min(manifold_start[m + 1], manifold_start[m] + kCachedPointsPerPair);
-      for (std::uint32_t r = manifold_start[m]; r < manifold_start[m + 1]; ++r) {
+      const std::uint32_t last = manifold_start[m + 1];
+      const std::uint32_t stop = std::min(last, manifold.first + kCachedPointsPerPair);
+      for (std::uint32_t r = manifold.first; r < last; ++r) {
         const Row& row = rows_[r];
         Contact& c = contacts[info_[r].contact];
         c.normal_impulse = row.lambda[0] + row.bounce_impulse;
         c.friction_impulse = row.lambda[1] * row.t1 + row.lambda[2] * row.t2;
-        if (r == manifold_start[m]) {
+        if (r == manifold.first) {
           manifold.pair = entityPairKey(c.a, c.b);
           manifold.index_a = row.a;
           manifold.index_b = row.b;
