@@ -204,8 +204,14 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
   stats.manifolds = plan_.manifoldStart().size() - 1;
   prepareRolling(bodies, jacobi);
   wide_ = options.wide_passes && !jacobi;
-  if (wide_) batchManifolds();
-  stats.wide_batches = wide_ ? batches_.size() : 0;
+  if (wide_) {
+    const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
+    wide_batches_.assign(plan_, rows_.size(), motion_.size(), [&](std::uint32_t m) {
+      const std::uint32_t r = manifold_start[m];
+      return WideBatches::ManifoldFacts{info_[r].level, rows_[r].a, rows_[r].b, info_[r].move_a, info_[r].move_b};
+    });
+  }
+  stats.wide_batches = wide_ ? wide_batches_.batches().size() : 0;
 }
 
 // A pair resists rolling with the larger coefficient of its two materials,
@@ -660,7 +666,8 @@ int ContactSolver::solvePositions(const ResponseOptions& options, const Deadline
   };
   int passes = 0;
   if (wide_ && !turns) {
-    plan_.forEachStageBatches(batch_start_, [&](std::size_t first, std::size_t end) { packWidePush(first, end); });
+    plan_.forEachStageBatches(wide_batches_.starts(),
+                              [&](std::size_t first, std::size_t end) { packWidePush(first, end); });
     for (int it = 0; it < options.iterations; ++it, ++passes) {
       if (it > 0 && deadline.passed()) break;
       solvePositionsWide();
@@ -809,7 +816,9 @@ void ContactSolver::iterate(const ResponseOptions& options, const SolveBudget& b
   const Deadline& deadline = budget.deadline;
   ResponseOptions run = options;
   run.iterations = std::max(1, std::min(options.iterations, budget.max_iterations));
-  if (wide_) plan_.forEachStageBatches(batch_start_, [&](std::size_t first, std::size_t end) { packWide(first, end); });
+  if (wide_) {
+    plan_.forEachStageBatches(wide_batches_.starts(), [&](std::size_t first, std::size_t end) { packWide(first, end); });
+  }
   const double t_first = deadline.isSet() ? deadline.now() : 0.0;
   solveVelocities(run, 1);
   const double t_more = deadline.isSet() ? deadline.now() : 0.0;
@@ -820,7 +829,8 @@ void ContactSolver::iterate(const ResponseOptions& options, const SolveBudget& b
   stats.velocity_passes = run.iterations;
   const double t_rest = deadline.isSet() ? deadline.now() : 0.0;
   const auto unpack = [&] {
-    if (wide_) plan_.forEachStageBatches(batch_start_, [&](std::size_t first, std::size_t end) { unpackWide(first, end); });
+    if (!wide_) return;
+    plan_.forEachStageBatches(wide_batches_.starts(), [&](std::size_t first, std::size_t end) { unpackWide(first, end); });
   };
   // Warm-started, shock propagation's impulses would reach the support it
   // held as well: a heavy cube's weight, once a tick, on a light cube under

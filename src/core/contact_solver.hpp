@@ -9,6 +9,7 @@
 #include "contact_partition.hpp"
 #include "solver_thread_plan.hpp"
 #include "warm_start_cache.hpp"
+#include "wide_batches.hpp"
 #include "sphere_tree_collision/body.hpp"
 #include "deadline.hpp"
 #include "sphere_tree_collision/contact.hpp"
@@ -175,38 +176,6 @@ class ContactSolver {
   // `normal`, on the pair's velocities a and b (after its rows, in a pass).
   static void resistRolling(Rolling& roll, double normal, Motion& a, Motion& b);
 
-  // The sequential passes take kLanes manifolds side by side
-  // (contact_solver_wide.cpp; public for its kernels).
-  static constexpr std::uint32_t kLanes = 4;
-  // One row of each lane's manifold (a lane without one here is left alone).
-  // What a velocity pass streams: t2 is n x t1 again (tangentBasis), and
-  // shock propagation's masses are in a WideShockMass of the same place.
-  struct alignas(32) WideRow {
-    double ra[3][kLanes], rb[3][kLanes], n[3][kLanes], t1[3][kLanes];
-    double ang_a[3][3][kLanes], ang_b[3][3][kLanes];  // [direction][axis][lane]
-    double inv_ma[kLanes], inv_mb[kLanes], mass[3][kLanes];
-    double friction[kLanes], speculative[kLanes], bounce_impulse[kLanes];
-    double lambda[3][kLanes];
-  };
-  struct alignas(32) WideShockMass {
-    double mass[3][kLanes];
-  };
-  // The same for the split-impulse passes by translation (RowInfo's push terms).
-  struct alignas(32) WidePush {
-    double n[3][kLanes];
-    double inv_ma[kLanes], inv_mb[kLanes], push[kLanes], mass[kLanes], shock_mass[kLanes], lambda[kLanes];
-    long long pull[kLanes];  // all ones: may pull (bounced across a gap), else clamped at 0
-  };
-  struct WideBatch {
-    std::uint32_t first_row = 0, rows = 0;  // its wide rows: as many as its largest manifold's
-    std::uint32_t lanes = 0;
-    std::uint32_t manifold[kLanes] = {};
-    std::uint32_t manifold_rows[kLanes] = {};
-    std::uint32_t body_a[kLanes] = {}, body_b[kLanes] = {};  // dense indices (a static one is read, never written)
-    bool write_a[kLanes] = {}, write_b[kLanes] = {};
-    bool move_a[kLanes] = {}, move_b[kLanes] = {};  // shock propagation: not held
-  };
-
  private:
   // The rest of a row: the restitution waves, shock propagation and the
   // position pass read it; the velocity iterations do not.
@@ -324,12 +293,8 @@ class ContactSolver {
   bool any_reach_ = false;
 
   // The sequential passes (velocity, shock, position, position shock),
-  // kLanes manifolds side by side (contact_solver_wide.cpp): a block's manifolds in batches that share no
-  // movable body, each manifold in a batch after those of the block's earlier
-  // manifolds on its bodies. Every body so meets its manifolds in the block's
-  // order, and the passes give the one-at-a-time passes' result bit for bit.
-  // After the rows are prepared: batches_, their wide rows' places, batch_start_.
-  void batchManifolds();
+  // kLanes manifolds side by side (contact_solver_wide.cpp) on the batches
+  // of wide_batches_ (wide_batches.hpp), laid out after the rows are prepared.
   // Batches [first, end): rows_ copied in, or their impulses copied back.
   void packWide(std::size_t first, std::size_t end);
   void unpackWide(std::size_t first, std::size_t end);
@@ -344,12 +309,7 @@ class ContactSolver {
   void propagatePositionShockWide();
 
   bool wide_ = false;  // this solve's sequential passes run on the batches
-  std::vector<WideBatch> batches_;
-  std::vector<WideRow> wide_rows_;
-  std::vector<WideShockMass> wide_shock_mass_;
-  std::vector<WidePush> wide_push_;
-  std::vector<std::uint32_t> batch_start_;  // by manifold, where a block or a level's run in it starts
-  std::vector<std::uint32_t> body_batch_;   // batchManifolds: a body's last batch + 1
+  WideBatches wide_batches_;
 
   std::vector<Row> rows_;
   std::vector<RowInfo> info_;

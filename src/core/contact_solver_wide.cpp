@@ -22,7 +22,11 @@ namespace stc {
 
 namespace {
 
-constexpr std::uint32_t kLanes = ContactSolver::kLanes;
+constexpr std::uint32_t kLanes = WideBatches::kLanes;
+using WideRow = WideBatches::Row;
+using WideShockMass = WideBatches::ShockMass;
+using WidePush = WideBatches::Push;
+using WideBatch = WideBatches::Batch;
 static_assert(kLanes == 4, "the lane types below are four doubles wide");
 
 // Four doubles, and a lane mask of the same width (GCC/Clang vector types:
@@ -73,7 +77,7 @@ STC_WIDE Wide3 select(const WideMask& on, const Wide3& yes, const Wide3& no) {
 // propagation moves (the others it holds).
 struct LaneMasks {
   WideMask rows, move_a, move_b;
-  STC_WIDE explicit LaneMasks(const ContactSolver::WideBatch& batch) {
+  STC_WIDE explicit LaneMasks(const WideBatch& batch) {
     for (std::uint32_t l = 0; l < kLanes; ++l) {
       rows[l] = batch.manifold_rows[l];
       move_a[l] = batch.move_a[l] ? -1 : 0;
@@ -89,7 +93,7 @@ struct LaneMasks {
 // relaxRow for the lanes `on`, with the effective masses `mass`: friction,
 // then non-penetration. Body A's velocities change only in the lanes on_a,
 // B's in on_b (shock propagation holds a supporting body still).
-STC_WIDE void relaxWide(ContactSolver::WideRow& row, const double (&mass)[3][kLanes], const WideMask& on,
+STC_WIDE void relaxWide(WideRow& row, const double (&mass)[3][kLanes], const WideMask& on,
                         const WideMask& on_a, const WideMask& on_b, WideMotion& m) {
   const Wide zero = {0.0, 0.0, 0.0, 0.0};
   const Wide one = {1.0, 1.0, 1.0, 1.0};
@@ -170,7 +174,7 @@ STC_WIDE void prefetchMotion(const ContactSolver::Motion& body, bool for_writing
 }
 
 // Asks for the lines of a batch's bodies.
-STC_WIDE void prefetchBodies(const ContactSolver::WideBatch& ahead, const ContactSolver::Motion* motion) {
+STC_WIDE void prefetchBodies(const WideBatch& ahead, const ContactSolver::Motion* motion) {
   for (std::uint32_t l = 0; l < ahead.lanes; ++l) {
     prefetchMotion(motion[ahead.body_a[l]], ahead.write_a[l]);
     prefetchMotion(motion[ahead.body_b[l]], ahead.write_b[l]);
@@ -180,8 +184,8 @@ STC_WIDE void prefetchBodies(const ContactSolver::WideBatch& ahead, const Contac
 // One pass over batches: the velocity iterations' (kShock false) or shock
 // propagation's, with the supporting bodies held (kShock).
 template <bool kShock>
-STC_WIDE void relaxBatchesOf(ContactSolver::WideRow* wide_rows, const ContactSolver::WideShockMass* shock_mass,
-                             ContactSolver::Rolling* rolling, const ContactSolver::WideBatch* batch,
+STC_WIDE void relaxBatchesOf(WideRow* wide_rows, const WideShockMass* shock_mass,
+                             ContactSolver::Rolling* rolling, const WideBatch* batch,
                              std::size_t count, ContactSolver::Motion* motion) {
   for (std::size_t k = 0; k < count; ++k, ++batch) {
     if (k + kBodiesAhead < count) prefetchBodies(batch[kBodiesAhead], motion);
@@ -197,7 +201,7 @@ STC_WIDE void relaxBatchesOf(ContactSolver::WideRow* wide_rows, const ContactSol
     const LaneMasks lanes(*batch);
     for (std::uint32_t s = 0; s < batch->rows; ++s) {
       const WideMask on = lanes.withRow(s);
-      ContactSolver::WideRow& row = wide_rows[batch->first_row + s];
+      WideRow& row = wide_rows[batch->first_row + s];
       if (kShock) {
         relaxWide(row, shock_mass[batch->first_row + s].mass, on, on & lanes.move_a, on & lanes.move_b, m);
       } else {
@@ -210,7 +214,7 @@ STC_WIDE void relaxBatchesOf(ContactSolver::WideRow* wide_rows, const ContactSol
       if (roll.per_normal == 0.0) continue;
       double normal = 0.0;  // as ContactSolver::normalImpulse sums it
       for (std::uint32_t s = 0; s < batch->manifold_rows[l]; ++s) {
-        const ContactSolver::WideRow& row = wide_rows[batch->first_row + s];
+        const WideRow& row = wide_rows[batch->first_row + s];
         normal += row.lambda[0][l] + row.bounce_impulse[l];
       }
       ContactSolver::Motion a, b;
@@ -239,7 +243,7 @@ STC_WIDE void relaxBatchesOf(ContactSolver::WideRow* wide_rows, const ContactSol
 
 // pushStep by translation alone (contact_solver.cpp) for the lanes `on`,
 // with the effective masses `mass`; A moves in the lanes on_a, B in on_b.
-STC_WIDE void pushWide(ContactSolver::WidePush& row, const double (&mass)[kLanes], const WideMask& on,
+STC_WIDE void pushWide(WidePush& row, const double (&mass)[kLanes], const WideMask& on,
                        const WideMask& on_a, const WideMask& on_b, Wide3& va, Wide3& vb) {
   const Wide zero = {0.0, 0.0, 0.0, 0.0};
   const Wide3 n = load3(row.n);
@@ -260,7 +264,7 @@ STC_WIDE void pushWide(ContactSolver::WidePush& row, const double (&mass)[kLanes
 // alone): the position iterations' (kShock false) or the position shock
 // sweep's, with the supporting bodies held (kShock).
 template <bool kShock>
-STC_WIDE void pushBatchesOf(ContactSolver::WidePush* wide_rows, const ContactSolver::WideBatch* batch,
+STC_WIDE void pushBatchesOf(WidePush* wide_rows, const WideBatch* batch,
                             std::size_t count, ContactSolver::Motion* pseudo) {
   for (std::size_t k = 0; k < count; ++k, ++batch) {
     if (k + kBodiesAhead < count) prefetchBodies(batch[kBodiesAhead], pseudo);
@@ -274,7 +278,7 @@ STC_WIDE void pushBatchesOf(ContactSolver::WidePush* wide_rows, const ContactSol
     const LaneMasks lanes(*batch);
     for (std::uint32_t s = 0; s < batch->rows; ++s) {
       const WideMask on = lanes.withRow(s);
-      ContactSolver::WidePush& row = wide_rows[batch->first_row + s];
+      WidePush& row = wide_rows[batch->first_row + s];
       if (kShock) {
         pushWide(row, row.shock_mass, on, on & lanes.move_a, on & lanes.move_b, va, vb);
       } else {
@@ -297,102 +301,40 @@ STC_WIDE void pushBatchesOf(ContactSolver::WidePush* wide_rows, const ContactSol
 #define STC_WIDE_CLONES
 #endif
 
-STC_WIDE_CLONES void relaxBatches(ContactSolver::WideRow* wide_rows, ContactSolver::Rolling* rolling,
-                                  const ContactSolver::WideBatch* batch, std::size_t count,
+STC_WIDE_CLONES void relaxBatches(WideRow* wide_rows, ContactSolver::Rolling* rolling,
+                                  const WideBatch* batch, std::size_t count,
                                   ContactSolver::Motion* motion) {
   relaxBatchesOf<false>(wide_rows, nullptr, rolling, batch, count, motion);
 }
 
-STC_WIDE_CLONES void shockBatches(ContactSolver::WideRow* wide_rows, const ContactSolver::WideShockMass* shock_mass,
-                                  const ContactSolver::WideBatch* batch, std::size_t count,
+STC_WIDE_CLONES void shockBatches(WideRow* wide_rows, const WideShockMass* shock_mass,
+                                  const WideBatch* batch, std::size_t count,
                                   ContactSolver::Motion* motion) {
   relaxBatchesOf<true>(wide_rows, shock_mass, nullptr, batch, count, motion);
 }
 
-STC_WIDE_CLONES void pushBatches(ContactSolver::WidePush* wide_rows, const ContactSolver::WideBatch* batch,
+STC_WIDE_CLONES void pushBatches(WidePush* wide_rows, const WideBatch* batch,
                                  std::size_t count, ContactSolver::Motion* pseudo) {
   pushBatchesOf<false>(wide_rows, batch, count, pseudo);
 }
 
-STC_WIDE_CLONES void shockPushBatches(ContactSolver::WidePush* wide_rows, const ContactSolver::WideBatch* batch,
+STC_WIDE_CLONES void shockPushBatches(WidePush* wide_rows, const WideBatch* batch,
                                       std::size_t count, ContactSolver::Motion* pseudo) {
   pushBatchesOf<true>(wide_rows, batch, count, pseudo);
 }
 
 }  // namespace
 
-void ContactSolver::batchManifolds() {
-  // Sized by the rows, in the tick they grow (no allocation in a later tick
-  // that batches differently with no more rows): a batch holds at least one
-  // manifold, and its wide rows are at most its manifolds' rows. The batches
-  // are cleared first: a growth copies nothing of the last tick's.
-  batches_.clear();
-  growCapacityRewritten(batch_start_, rows_.size() + 1);
-  growCapacityRewritten(batches_, rows_.size());
-  growCapacityRewritten(wide_rows_, rows_.size());
-  growCapacityRewritten(wide_shock_mass_, rows_.size());
-  growCapacityRewritten(wide_push_, rows_.size());
-  const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
-  const std::vector<SolverGroup>& manifolds = plan_.manifolds();
-  batch_start_.assign(manifolds.size() + 1, 0);
-  body_batch_.assign(motion_.size(), 0);
-  // A block's manifolds are in the order from the ground; each level's run
-  // of them (shock propagation's unit, SolverThreadPlan::assign) is batched on its own.
-  const std::uint32_t block_count = plan_.partition().blockCount();
-  for (std::uint32_t block = 0; block < block_count; ++block) {
-    const SolverThreadPlan::ManifoldRun block_manifolds = plan_.block(block);
-    const std::uint32_t end_manifold = block_manifolds.end;
-    std::uint32_t open = 0;  // the run's batches before it are full
-    for (std::uint32_t m = block_manifolds.first; m < end_manifold; ++m) {
-      if (m == block_manifolds.first || info_[manifold_start[m]].level != info_[manifold_start[m - 1]].level) {
-        open = static_cast<std::uint32_t>(batches_.size());
-        batch_start_[m] = open;
-      }
-      const SolverGroup& group = manifolds[m];
-      // After the batches of the run's manifolds so far on either body
-      // (body_batch_ from an earlier run is at most the run's first).
-      std::uint32_t k = open;
-      if (group.a != SolverGroup::kStatic) k = std::max(k, body_batch_[group.a]);
-      if (group.b != SolverGroup::kStatic) k = std::max(k, body_batch_[group.b]);
-      while (k < batches_.size() && batches_[k].lanes == kLanes) ++k;
-      if (k == batches_.size()) batches_.emplace_back();
-      WideBatch& batch = batches_[k];
-      batch.manifold[batch.lanes] = m;
-      batch.manifold_rows[batch.lanes] = manifold_start[m + 1] - manifold_start[m];
-      batch.rows = std::max(batch.rows, batch.manifold_rows[batch.lanes]);
-      ++batch.lanes;
-      if (group.a != SolverGroup::kStatic) body_batch_[group.a] = k + 1;
-      if (group.b != SolverGroup::kStatic) body_batch_[group.b] = k + 1;
-      while (open < batches_.size() && batches_[open].lanes == kLanes) ++open;
-    }
-    batch_start_[end_manifold] = static_cast<std::uint32_t>(batches_.size());
-  }
-  std::uint32_t wide_rows = 0;
-  for (WideBatch& batch : batches_) {
-    batch.first_row = wide_rows;
-    wide_rows += batch.rows;
-    for (std::uint32_t l = 0; l < batch.lanes; ++l) {
-      const std::uint32_t m = batch.manifold[l];
-      batch.body_a[l] = rows_[manifold_start[m]].a;
-      batch.body_b[l] = rows_[manifold_start[m]].b;
-      batch.write_a[l] = manifolds[m].a != SolverGroup::kStatic;
-      batch.write_b[l] = manifolds[m].b != SolverGroup::kStatic;
-      batch.move_a[l] = info_[manifold_start[m]].move_a;
-      batch.move_b[l] = info_[manifold_start[m]].move_b;
-    }
-  }
-  wide_rows_.resize(wide_rows);
-  wide_shock_mass_.resize(wide_rows);
-  wide_push_.resize(wide_rows);
-}
-
 void ContactSolver::packWide(std::size_t first, std::size_t end) {
   const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
+  const std::vector<WideBatch>& batches = wide_batches_.batches();
+  std::vector<WideRow>& wide_rows = wide_batches_.rows();
+  std::vector<WideShockMass>& shock_mass = wide_batches_.shockMass();
   for (std::size_t k = first; k < end; ++k) {
-    const WideBatch& batch = batches_[k];
+    const WideBatch& batch = batches[k];
     for (std::uint32_t s = 0; s < batch.rows; ++s) {
-      WideRow& wide = wide_rows_[batch.first_row + s];
-      WideShockMass& shock = wide_shock_mass_[batch.first_row + s];
+      WideRow& wide = wide_rows[batch.first_row + s];
+      WideShockMass& shock = shock_mass[batch.first_row + s];
       std::memset(&wide, 0, sizeof wide);
       std::memset(&shock, 0, sizeof shock);
       for (std::uint32_t l = 0; l < batch.lanes; ++l) {
@@ -424,10 +366,12 @@ void ContactSolver::packWide(std::size_t first, std::size_t end) {
 
 void ContactSolver::packWidePush(std::size_t first, std::size_t end) {
   const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
+  const std::vector<WideBatch>& batches = wide_batches_.batches();
+  std::vector<WidePush>& push = wide_batches_.push();
   for (std::size_t k = first; k < end; ++k) {
-    const WideBatch& batch = batches_[k];
+    const WideBatch& batch = batches[k];
     for (std::uint32_t s = 0; s < batch.rows; ++s) {
-      WidePush& wide = wide_push_[batch.first_row + s];
+      WidePush& wide = push[batch.first_row + s];
       std::memset(&wide, 0, sizeof wide);
       for (std::uint32_t l = 0; l < batch.lanes; ++l) {
         if (s >= batch.manifold_rows[l]) continue;
@@ -449,11 +393,13 @@ void ContactSolver::packWidePush(std::size_t first, std::size_t end) {
 
 void ContactSolver::unpackWide(std::size_t first, std::size_t end) {
   const std::vector<std::uint32_t>& manifold_start = plan_.manifoldStart();
+  const std::vector<WideBatch>& batches = wide_batches_.batches();
+  const std::vector<WideRow>& wide_rows = wide_batches_.rows();
   for (std::size_t k = first; k < end; ++k) {
-    const WideBatch& batch = batches_[k];
+    const WideBatch& batch = batches[k];
     for (std::uint32_t l = 0; l < batch.lanes; ++l) {
       for (std::uint32_t s = 0; s < batch.manifold_rows[l]; ++s) {
-        const WideRow& wide = wide_rows_[batch.first_row + s];
+        const WideRow& wide = wide_rows[batch.first_row + s];
         Row& row = rows_[manifold_start[batch.manifold[l]] + s];
         for (int i = 0; i < 3; ++i) row.lambda[i] = wide.lambda[i][l];
       }
@@ -462,34 +408,43 @@ void ContactSolver::unpackWide(std::size_t first, std::size_t end) {
 }
 
 void ContactSolver::propagateShockWide(int passes) {
+  WideRow* rows = wide_batches_.rows().data();
+  const WideShockMass* shock_mass = wide_batches_.shockMass().data();
+  const WideBatch* batches = wide_batches_.batches().data();
   for (std::size_t level = 0; level < plan_.shockLevels(); ++level) {
     for (int pass = 0; pass < passes; ++pass) {
-      plan_.forEachStageBatchesOfLevel(level, batch_start_, [&](std::size_t first, std::size_t end) {
-        shockBatches(wide_rows_.data(), wide_shock_mass_.data(), batches_.data() + first, end - first, motion_.data());
+      plan_.forEachStageBatchesOfLevel(level, wide_batches_.starts(), [&](std::size_t first, std::size_t end) {
+        shockBatches(rows, shock_mass, batches + first, end - first, motion_.data());
       });
     }
   }
 }
 
 void ContactSolver::solvePositionsWide() {
-  plan_.forEachStageBatches(batch_start_, [&](std::size_t first, std::size_t end) {
-    pushBatches(wide_push_.data(), batches_.data() + first, end - first, pseudo_.data());
+  WidePush* push = wide_batches_.push().data();
+  const WideBatch* batches = wide_batches_.batches().data();
+  plan_.forEachStageBatches(wide_batches_.starts(), [&](std::size_t first, std::size_t end) {
+    pushBatches(push, batches + first, end - first, pseudo_.data());
   });
 }
 
 void ContactSolver::propagatePositionShockWide() {
+  WidePush* push = wide_batches_.push().data();
+  const WideBatch* batches = wide_batches_.batches().data();
   for (std::size_t level = 0; level < plan_.shockLevels(); ++level) {
-    plan_.forEachStageBatchesOfLevel(level, batch_start_, [&](std::size_t first, std::size_t end) {
-      shockPushBatches(wide_push_.data(), batches_.data() + first, end - first, pseudo_.data());
+    plan_.forEachStageBatchesOfLevel(level, wide_batches_.starts(), [&](std::size_t first, std::size_t end) {
+      shockPushBatches(push, batches + first, end - first, pseudo_.data());
     });
   }
 }
 
 void ContactSolver::solveVelocitiesWide(int passes) {
+  WideRow* rows = wide_batches_.rows().data();
+  Rolling* rolling = any_rolling_ ? rolling_.data() : nullptr;
+  const WideBatch* batches = wide_batches_.batches().data();
   for (int it = 0; it < passes; ++it) {
-    plan_.forEachStageBatches(batch_start_, [&](std::size_t first, std::size_t end) {
-      relaxBatches(wide_rows_.data(), any_rolling_ ? rolling_.data() : nullptr, batches_.data() + first, end - first,
-                   motion_.data());
+    plan_.forEachStageBatches(wide_batches_.starts(), [&](std::size_t first, std::size_t end) {
+      relaxBatches(rows, rolling, batches + first, end - first, motion_.data());
     });
   }
 }
