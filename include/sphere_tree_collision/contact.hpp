@@ -11,6 +11,10 @@ namespace stc {
 // an impact at one instant, not a load the pair carries, so the solver's warm
 // start neither gives it an impulse nor takes one from it.
 constexpr std::int32_t kSweepHitNode = -1;
+// The node of a contact's other side when it was measured against that
+// body's solid (its interior field), not against a sphere of its tree: one
+// body pressed more than a voxel into the other.
+constexpr std::int32_t kInteriorNode = -2;
 
 struct Contact {
   EntityId a = kInvalidEntity;
@@ -35,7 +39,8 @@ struct Contact {
   // least 0 for an accepted unresolved pair, whose overlap is not proven.
   double separation = 0.0;
   std::int32_t node_a = 0;      // sphere pair the contact was built from (tree node indices;
-  std::int32_t node_b = 0;      // kSweepHitNode: the swept test's hit, of no sphere pair)
+  std::int32_t node_b = 0;      // kSweepHitNode: the swept test's hit, of no sphere pair;
+                                // kInteriorNode: the side measured by its solid)
   // Filled in by the solver: impulses applied at the point this tick (N s, world).
   double normal_impulse = 0.0;
   Vec3 friction_impulse = Vec3::Zero();

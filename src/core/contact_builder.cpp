@@ -251,6 +251,90 @@ void PairGeometry::refine(ContactCandidate& c, bool face_normals) const {
   if (face) c.point = faceContactPoint(c);
 }
 
+void PairGeometry::leavesInside(bool from_a, const InteriorField& into, std::vector<std::int32_t>& stack,
+                                std::vector<ContactCandidate>& out) const {
+  const SphereTree& tree = from_a ? tree_a_ : tree_b_;
+  const ShapeBounds* bounds = from_a ? bounds_a_ : bounds_b_;
+  const Mat3& rot_from = from_a ? rot_a_ : rot_b_;
+  const Mat3& rot_into = from_a ? rot_b_ : rot_a_;
+  const Mat3& to_into = from_a ? a_in_b_ : b_in_a_;  // from's axes in into's frame
+  const Vec3 offset = rot_into.transpose() * ((from_a ? pos_a_ : pos_b_) - (from_a ? pos_b_ : pos_a_));
+  const Vec3& pos_from = from_a ? pos_a_ : pos_b_;
+  // A static body's faces that others cover are no way out (a tile's rim, into the next tile).
+  const std::uint8_t* covered = from_a ? covered_b_ : covered_a_;
+  const std::uint8_t root_mask = covered != nullptr ? covered[0] : 0;
+  // The probe's outside distance is of the nearest occupied voxel to the
+  // centre's cell, not to the centre: within a voxel's diagonal.
+  const double slack = std::sqrt(3.0) * into.voxelSize();
+  stack.clear();
+  stack.push_back(0);
+  while (!stack.empty()) {
+    const std::int32_t n = stack.back();
+    stack.pop_back();
+    const SphereNode& node = tree.node(n);
+    const InteriorProbe probe = into.probe(to_into * node.centre + offset);
+    if (!probe.inside && -probe.depth > node.radius + slack) continue;  // wholly outside the solid
+    if (!tree.isLeaf(n)) {
+      for (std::int32_t k = 0; k < node.child_count; ++k) stack.push_back(node.first_child + k);
+      continue;
+    }
+    if (!probe.inside) continue;
+    Vec3 way = probe.out;
+    if (root_mask != 0) {
+      way = clipCovered(root_mask, way);
+      const double length = way.norm();
+      if (!(length > 1e-9)) continue;
+      way /= length;
+    }
+    const Vec3 out_world = rot_into * way;  // the way `from` must move
+    // How far the leaf's voxel box reaches past its centre, deeper in.
+    const Vec3 deeper_from = rot_from.transpose() * (-out_world);
+    const double reach = bounds != nullptr ? bounds->support(n, deeper_from) : node.radius;
+    const Vec3 centre = rot_from * node.centre + pos_from;
+    ContactCandidate c;
+    c.ca = c.cb = centre;
+    c.node_a = from_a ? n : kInteriorNode;
+    c.node_b = from_a ? kInteriorNode : n;
+    c.normal = from_a ? Vec3(-out_world) : out_world;  // a -> b
+    c.overlap = probe.depth + reach;
+    c.separation = -c.overlap;
+    // Halfway between the leaf's deepest point and the way out.
+    c.point = centre + 0.5 * (probe.depth - reach) * out_world;
+    c.refined = true;
+    out.push_back(c);
+  }
+}
+
+void PairGeometry::interiorCandidates(const InteriorField& field_a, const InteriorField& field_b,
+                                      std::vector<std::int32_t>& stack, std::vector<ContactCandidate>& out) const {
+  out.clear();
+  leavesInside(true, field_b, stack, out);
+  leavesInside(false, field_a, stack, out);
+}
+
+bool interiorContacts(const PairGeometry& geometry, const InteriorField& field_a, const InteriorField& field_b,
+                      int limit, std::vector<std::int32_t>& stack, std::vector<ContactCandidate>& candidates,
+                      std::vector<int>& reps, std::vector<Vec3>& normals, std::vector<double>& separations) {
+  geometry.interiorCandidates(field_a, field_b, stack, candidates);
+  if (candidates.empty()) return false;
+  CandidateSpread spread;
+  spread.centroid.setZero();
+  for (const ContactCandidate& c : candidates) spread.centroid += c.point;
+  spread.centroid /= static_cast<double>(candidates.size());
+  spread.scale = std::min(field_a.voxelSize(), field_b.voxelSize());
+  pickRepresentatives(candidates, deepestOverlap(candidates), limit, spread, reps);
+  clusterNormals(candidates, reps, normals);
+  separations.assign(reps.size(), std::numeric_limits<double>::infinity());
+  for (const ContactCandidate& c : candidates) {
+    const std::size_t r = static_cast<std::size_t>(c.cluster);
+    if (c.normal.dot(normals[r]) >= kAlignedCosine) separations[r] = std::min(separations[r], c.separation);
+  }
+  for (std::size_t r = 0; r < reps.size(); ++r) {
+    if (!std::isfinite(separations[r])) separations[r] = candidates[static_cast<std::size_t>(reps[r])].separation;
+  }
+  return true;
+}
+
 void gatherCandidates(const PairTest& test, const PairGeometry& geometry, std::vector<ContactCandidate>& out) {
   out.clear();
   if (test.hasLastPair()) {
@@ -431,7 +515,18 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
                             double priority, const BodySurface& a, const BodySurface& b,
                             const ContactBuildOptions& options, std::vector<Contact>& out) {
   const PairStatus status = test.status();
-  if (status == PairStatus::Separate) return;
+  const bool solids = a.interior != nullptr && b.interior != nullptr && a.interior->built() && b.interior->built();
+  if (status == PairStatus::Separate) {
+    // Surfaces apart, but one body may lie wholly inside the other.
+    if (solids && nested(test, *a.interior, *b.interior)) {
+      const PairGeometry geometry(test, a, b);
+      if (interiorContacts(geometry, *a.interior, *b.interior, options.max_contacts_per_pair, stack_, candidates_,
+                           reps_, normals_, separations_)) {
+        emit(test, true, index_a, index_b, priority, out);  // the field measured it: proven
+      }
+    }
+    return;
+  }
   if (status == PairStatus::Unresolved && !options.accept_unresolved) return;
 
   const PairGeometry geometry(test, a, b);
@@ -446,6 +541,34 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
 
   clusterNormals(candidates_, reps_, normals_);
   clusterSeparations(candidates_, reps_, normals_, geometry, separations_);
+  // Only a pair resolved at the leaves: an unresolved pair's overlap is its
+  // frontier's, not proven of its surfaces (see emit).
+  if (status == PairStatus::Colliding && solids) {
+    const double least = separations_.empty() ? 0.0 : *std::min_element(separations_.begin(), separations_.end());
+    const double voxel = std::min(a.interior->voxelSize(), b.interior->voxelSize());
+    if (least < -kInteriorDepth * voxel &&
+        interiorContacts(geometry, *a.interior, *b.interior, options.max_contacts_per_pair, stack_, inside_, reps_,
+                         normals_, separations_)) {
+      candidates_.swap(inside_);
+    }
+  }
+  emit(test, status == PairStatus::Colliding, index_a, index_b, priority, out);
+}
+
+bool ContactBuilder::nested(const PairTest& test, const InteriorField& field_a, const InteriorField& field_b) {
+  // The root sphere's centre of the smaller body, in the larger one's solid.
+  const PairBody& a = test.bodyA();
+  const PairBody& b = test.bodyB();
+  const bool a_smaller = a.tree->node(0).radius <= b.tree->node(0).radius;
+  const PairBody& inner = a_smaller ? a : b;
+  const PairBody& outer = a_smaller ? b : a;
+  const Vec3 centre = inner.pose->orientation * inner.tree->node(0).centre + inner.pose->position;
+  const Vec3 in_outer = outer.pose->orientation.conjugate() * (centre - outer.pose->position);
+  return (a_smaller ? field_b : field_a).probe(in_outer).inside;
+}
+
+void ContactBuilder::emit(const PairTest& test, bool proven, std::uint32_t index_a, std::uint32_t index_b,
+                          double priority, std::vector<Contact>& out) const {
   for (std::size_t r = 0; r < reps_.size(); ++r) {
     const ContactCandidate& rep = candidates_[reps_[r]];
     Contact contact;
@@ -461,7 +584,7 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
     // bodies from closing in but pushes nothing apart. Pushed out of their
     // root spheres' and node boxes' overlaps, the rocks of a pile under a tick
     // budget flowed and flattened it (docs/error_vs_runtime.md).
-    contact.separation = status == PairStatus::Colliding ? separations_[r] : std::max(0.0, separations_[r]);
+    contact.separation = proven ? separations_[r] : std::max(0.0, separations_[r]);
     // The pair's bound (its deepest sphere pair's h_a + h_b), the same for
     // every point: the solver's slop is a fraction of it, and a slop that
     // differs point by point let position correction lift a rolling link
@@ -469,7 +592,7 @@ void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::ui
     contact.gap_bound = test.gapBound();
     contact.sphere_bound = contact.gap_bound;
     contact.level = std::max(0, test.deepestLevel());
-    contact.resolved = status == PairStatus::Colliding;
+    contact.resolved = proven;
     contact.priority = priority;
     contact.node_a = rep.node_a;
     contact.node_b = rep.node_b;

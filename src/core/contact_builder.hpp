@@ -1,6 +1,7 @@
 // Contacts from the intersecting sphere pairs of a PairTest (paper 3.5, Fig. 4).
 #pragma once
 
+#include "interior_field.hpp"
 #include "pair_test.hpp"
 #include "shape_bounds.hpp"
 #include "sphere_tree_collision/contact.hpp"
@@ -32,11 +33,13 @@ struct ContactCandidate {
 };
 
 // One body's surface as the contact steps see it: its shape's node bounds
-// (nullptr: the surface is the sphere) and, for a static body, the faces of
-// its node boxes other static bodies cover (StaticCover::of; nullptr: none).
+// (nullptr: the surface is the sphere), for a static body the faces of its
+// node boxes other static bodies cover (StaticCover::of; nullptr: none), and
+// its solid (nullptr: no contacts from inside it).
 struct BodySurface {
   const ShapeBounds* bounds = nullptr;
   const std::uint8_t* covered_faces = nullptr;
+  const InteriorField* interior = nullptr;
 };
 
 // The two bodies of a pair as the contact steps see them: trees, surfaces and poses.
@@ -63,6 +66,12 @@ class PairGeometry {
   // normal, and the point moves to the middle of the faces' overlap. A face
   // another static body covers is not a surface: its axis is skipped.
   void refine(ContactCandidate& c, bool face_normals) const;
+  // Bodies inside each other: a candidate for every leaf of either body whose
+  // centre lies in the other's solid (InteriorField), normal the other's way
+  // out (through no covered face), separation minus how deep the leaf's voxel
+  // box reaches in. The other side's node is kInteriorNode. `stack`: scratch.
+  void interiorCandidates(const InteriorField& field_a, const InteriorField& field_b,
+                          std::vector<std::int32_t>& stack, std::vector<ContactCandidate>& out) const;
 
  private:
   // Surface of a node towards a direction in its own body frame.
@@ -83,6 +92,9 @@ class PairGeometry {
   // or -n through one of b's node; and n with those parts removed.
   bool intoCover(std::uint8_t mask_a, std::uint8_t mask_b, const Vec3& n) const;
   Vec3 awayFromCover(std::uint8_t mask_a, std::uint8_t mask_b, const Vec3& n) const;
+  // interiorCandidates one way: the leaves of `from` (a's tree when from_a) in `into`'s solid.
+  void leavesInside(bool from_a, const InteriorField& into, std::vector<std::int32_t>& stack,
+                    std::vector<ContactCandidate>& out) const;
 
   const SphereTree& tree_a_;
   const SphereTree& tree_b_;
@@ -153,6 +165,17 @@ void clusterSeparations(const std::vector<ContactCandidate>& candidates, const s
                         const std::vector<Vec3>& normals, const PairGeometry& geometry,
                         std::vector<double>& separations);
 
+// 6. Bodies inside each other. A pair whose contacts measure a penetration of
+// more than kInteriorDepth of the smaller voxel may be deeper than its shells
+// can measure (a cube pressed through the shell of the one below). Its
+// contacts are then the interior candidates' (PairGeometry::interiorCandidates),
+// picked and clustered as above, each cluster's separation its deepest aligned
+// member's; false (and `candidates` untouched in meaning) when there are none.
+constexpr double kInteriorDepth = 0.5;
+bool interiorContacts(const PairGeometry& geometry, const InteriorField& field_a, const InteriorField& field_b,
+                      int limit, std::vector<std::int32_t>& stack, std::vector<ContactCandidate>& candidates,
+                      std::vector<int>& reps, std::vector<Vec3>& normals, std::vector<double>& separations);
+
 // Builds the contacts of PairTests. Candidates are the test's lastPairs()
 // (leaf pairs when Colliding, the frontier when accepted Unresolved, the roots
 // when no sphere was tested). Per candidate (paper Fig. 4): normal along the
@@ -194,10 +217,19 @@ class alignas(64) ContactBuilder {
   }
 
  private:
+  // Whether the smaller body's root centre lies in the other's solid (a Separate pair nested).
+  static bool nested(const PairTest& test, const InteriorField& field_a, const InteriorField& field_b);
+  // One contact per representative (reps_, normals_, separations_ of
+  // candidates_); not proven (an unresolved pair's): separations at least 0.
+  void emit(const PairTest& test, bool proven, std::uint32_t index_a, std::uint32_t index_b, double priority,
+            std::vector<Contact>& out) const;
+
   std::vector<ContactCandidate> candidates_;  // scratch kept between pairs: no allocation per tick
   std::vector<int> reps_;
   std::vector<Vec3> normals_;
   std::vector<double> separations_;
+  std::vector<std::int32_t> stack_;         // interiorContacts' tree walk
+  std::vector<ContactCandidate> inside_;    // and its candidates
 };
 
 }  // namespace stc

@@ -154,9 +154,12 @@ void Physics::appendContacts(const StepContext& step, std::size_t first, std::si
     const StaticCover* cover = step.static_cover;
     const ShapeBounds& bounds_a = shape_bounds[body_shapes[ia]];
     const ShapeBounds& bounds_b = shape_bounds[body_shapes[ib]];
+    const auto interior = [&](std::uint32_t body) {
+      return step.interior_fields != nullptr ? &(*step.interior_fields)[body_shapes[body]] : nullptr;
+    };
     builder.append(tests[i], ia, ib, priorities[i],
-                   BodySurface{&bounds_a, cover != nullptr ? cover->of(ia) : nullptr},
-                   BodySurface{&bounds_b, cover != nullptr ? cover->of(ib) : nullptr}, build, out);
+                   BodySurface{&bounds_a, cover != nullptr ? cover->of(ia) : nullptr, interior(ia)},
+                   BodySurface{&bounds_b, cover != nullptr ? cover->of(ib) : nullptr, interior(ib)}, build, out);
     const double leaf_radius = std::min(bounds_a.min_leaf_radius, bounds_b.min_leaf_radius);
     if (step.reused != nullptr && status == PairStatus::Colliding && out.size() > before) {
       PairContactCache::record(tests[i], reuseBody(step, ia), reuseBody(step, ib),

@@ -7,6 +7,7 @@
 #include "contact_solver.hpp"
 #include "continuous.hpp"
 #include "pair_contact_cache.hpp"
+#include "interior_field.hpp"
 #include "shape_bounds.hpp"
 #include "sphere_tree_collision/response_options.hpp"
 #include "static_cover.hpp"
@@ -28,11 +29,12 @@ struct StepContext {
   double dt = 0.0;
   Vec3 gravity = Vec3::Zero();
   const ResponseOptions* options = nullptr;
-  // Bodies by dense index, their shape ids, and the bounds of each shape id
-  // (built once per shape: World::addShape).
+  // Bodies by dense index, their shape ids, and the bounds and interior of
+  // each shape id (built once per shape: World::addShape).
   std::vector<BodyState>* bodies = nullptr;
   const std::vector<std::uint32_t>* body_shapes = nullptr;
   const std::deque<ShapeBounds>* shape_bounds = nullptr;
+  const std::deque<InteriorField>* interior_fields = nullptr;  // nullptr: no contacts from inside
   // The narrow phase's pairs: tests[0..*pair_count) (the count read when a
   // phase runs: the broad phase sets it), the dense indices of each test's
   // bodies, and their perceptual priorities (sweep: pair_bodies only).

@@ -76,12 +76,14 @@ ShapeId ShapeLibrary::addShape(const std::string& key, VoxelShape voxels, const 
 
   // Bounds of every node, once per shape (contacts and sweeps read them each tick).
   ShapeBounds bounds = makeShapeBounds(info.tree, &voxels, info.body_origin);
+  InteriorField interior(voxels, info.body_origin);
   info.voxels = std::move(voxels);
 
   const auto id = static_cast<ShapeId>(shapes_.size());
   shapes_.push_back(std::move(info));  // deque: earlier shapes (and trees) stay put
   bounds.tree = &shapes_.back().tree;  // the tree moved into the deque
   shape_bounds_.push_back(std::move(bounds));
+  interior_fields_.push_back(std::move(interior));
   cover_shapes_.push_back(CoverShape{&shapes_.back().voxels, shapes_.back().body_origin, &shape_bounds_.back()});
   shape_by_key_.emplace(key, id);
   return id;

@@ -1,11 +1,13 @@
 // ShapeLibrary: the shapes entities are made of, one per key, each built
 // once: its voxels, exact mass properties, sphere-tree, and the bounds the
-// tick reads of every node (shape_bounds.hpp, static_cover.hpp). Every
+// tick reads of every node (shape_bounds.hpp, static_cover.hpp), and its
+// interior (interior_field.hpp). Every
 // entity of a shape shares them (EntitySpec::shape); the body frame is the
 // shape's centre of mass. World::Parts holds the library (world_parts.hpp);
 // the tick reads its arrays through the inline calls below.
 #pragma once
 
+#include "interior_field.hpp"
 #include "shape_bounds.hpp"
 #include "sphere_tree_collision/shape_info.hpp"
 #include "sphere_tree_collision/sphere_tree.hpp"
@@ -40,6 +42,7 @@ class ShapeLibrary {
   // shape, the bounds of its nodes, and what StaticCover reads of each shape.
   const ShapeInfo& shapeAt(ShapeId id) const { return shapes_[id]; }
   const std::deque<ShapeBounds>& shapeBounds() const { return shape_bounds_; }
+  const std::deque<InteriorField>& interiorFields() const { return interior_fields_; }
   const std::vector<CoverShape>& coverShapes() const { return cover_shapes_; }
 
  private:
@@ -47,6 +50,7 @@ class ShapeLibrary {
   // are added, so the bounds can point at the trees and the cover shapes at both.
   std::deque<ShapeInfo> shapes_;
   std::deque<ShapeBounds> shape_bounds_;
+  std::deque<InteriorField> interior_fields_;
   std::vector<CoverShape> cover_shapes_;  // what StaticCover reads of each
   std::unordered_map<std::string, ShapeId> shape_by_key_;
 };

@@ -379,6 +379,7 @@ TickContext World::Parts::beginTick(double dt, const Budget& budget, TickReport&
   step.bodies = &rows_.bodies();
   step.body_shapes = &rows_.bodyShapes();
   step.shape_bounds = &shapes_.shapeBounds();
+  step.interior_fields = &shapes_.interiorFields();
   step.tests = &pair_tests_;
   step.pair_count = &pair_count_;
   step.pair_bodies = &pair_bodies_;
