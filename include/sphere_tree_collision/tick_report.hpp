@@ -100,6 +100,9 @@ struct TickResponse {
   // Of the accepted unresolved pairs, those that kept a deeper frontier's
   // contacts (Physics::kFrontierTolerance).
   std::size_t frontier_kept = 0;
+  // Of the contacts, those measured against the other body's solid (node
+  // kInteriorNode): a pair pressed deeper than its shells, or nested.
+  std::size_t interior_contacts = 0;
   int velocity_passes = 0;             // solver iterations run (>= 1 with contacts)
   int position_passes = 0;             // split-impulse iterations run (>= 1 with penetration)
   double response_refinement_s = 0.0;  // of TickPhases::response_s: iterations the deadline could have cut

@@ -360,6 +360,10 @@ void Physics::buildContacts(const StepContext& step) {
   // Unlimited ticks keep the frontier entries as they are: they stay valid
   // while their bodies stay put, and a limited tick finds them again.
   report_.frontier_kept = 0;
+  // Built or carried over, every contact measured against a solid.
+  report_.interior_contacts = static_cast<std::size_t>(std::count_if(
+      contacts.begin(), contacts.end(),
+      [](const Contact& c) { return c.node_a == kInteriorNode || c.node_b == kInteriorNode; }));
   if (step.steady_frontier) {
     reuse_pending_.clear();
     for (std::size_t k = 0; k < chunks; ++k) {

@@ -72,6 +72,8 @@ struct PhysicsReport {
   // Accepted unresolved pairs that kept a deeper frontier's contacts this tick
   // (steady_frontier; Physics::kFrontierTolerance).
   std::size_t frontier_kept = 0;
+  // Contacts measured against the other body's solid (kInteriorNode).
+  std::size_t interior_contacts = 0;
 };
 
 class Physics {

@@ -627,6 +627,7 @@ void World::Parts::response(TickContext& tick) {
     physics_.buildContacts(tick.physics);
   }
   report.response.frontier_kept = physics_.lastReport().frontier_kept;
+  report.response.interior_contacts = physics_.lastReport().interior_contacts;
   physics_.solve(tick.physics);
   const SolveStats& stats = physics_.lastReport().solve;
   report.response.velocity_passes = stats.velocity_passes;

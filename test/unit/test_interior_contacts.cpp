@@ -139,6 +139,7 @@ WorldConfig noGravity() {
 struct Seen {
   double least = 0.0;
   bool interior = false;
+  std::size_t interior_count = 0;
   Vec3 normal = Vec3::Zero();
 };
 Seen contactsOf(const World& world) {
@@ -148,8 +149,9 @@ Seen contactsOf(const World& world) {
       seen.least = c.separation;
       seen.normal = c.normal;
     }
-    seen.interior = seen.interior || c.node_a == kInteriorNode || c.node_b == kInteriorNode;
+    if (c.node_a == kInteriorNode || c.node_b == kInteriorNode) ++seen.interior_count;
   }
+  seen.interior = seen.interior_count > 0;
   return seen;
 }
 
@@ -167,9 +169,10 @@ void expectPushedOut(double depth, double tilt) {
   Pair p{World(noGravity())};
   pressed(p, depth, tilt);
   const double dt = 1.0 / 60.0;
-  p.world.step(dt, Budget::unlimited());
+  const TickReport report = p.world.step(dt, Budget::unlimited());
   const Seen first = contactsOf(p.world);
   EXPECT_TRUE(first.interior) << depth;
+  EXPECT_EQ(report.response.interior_contacts, first.interior_count);
   // The lower one is a (index 0): the normal a -> b points up, out of it.
   EXPECT_GT(std::abs(first.normal.z()), 0.9);
   EXPECT_LT(first.least, -0.5 * depth) << "measured as deep as it is";
@@ -217,8 +220,10 @@ TEST(InteriorContacts, CubesRestingFaceToFaceKeepTheirSurfaceContacts) {
   Pair p{World(noGravity())};
   pressed(p, 0.1 * kVoxel, 0.0);
   for (int tick = 0; tick < 10; ++tick) {
-    p.world.step(1.0 / 60.0, Budget::unlimited());
+    const TickReport report = p.world.step(1.0 / 60.0, Budget::unlimited());
     EXPECT_FALSE(contactsOf(p.world).interior);
+    EXPECT_GT(report.response.contacts, 0u);
+    EXPECT_EQ(report.response.interior_contacts, 0u);
   }
 }
 

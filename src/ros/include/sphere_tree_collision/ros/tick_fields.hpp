@@ -36,6 +36,7 @@
   X(geometric_bound, r.accuracy.geometric_bound)                                                                   \
   X(perceived_inaccuracy, r.accuracy.perceived_inaccuracy)                                                         \
   X(contacts, r.response.contacts)                                                                                 \
+  X(interior_contacts, r.response.interior_contacts)                                                               \
   X(tick_budget_ms, r.budget.tick_budget_s * 1e3)                                                                  \
   X(narrow_budget_ms, r.budget.narrow_budget_s * 1e3)                                                              \
   X(response_budget_ms, r.budget.response_budget_s * 1e3)                                                          \
