@@ -258,8 +258,9 @@ void PairGeometry::leavesInside(bool from_a, const InteriorField& into, std::vec
   const Mat3& rot_from = from_a ? rot_a_ : rot_b_;
   const Mat3& rot_into = from_a ? rot_b_ : rot_a_;
   const Mat3& to_into = from_a ? a_in_b_ : b_in_a_;  // from's axes in into's frame
-  const Vec3 offset = rot_into.transpose() * ((from_a ? pos_a_ : pos_b_) - (from_a ? pos_b_ : pos_a_));
   const Vec3& pos_from = from_a ? pos_a_ : pos_b_;
+  const Vec3& pos_into = from_a ? pos_b_ : pos_a_;
+  const Vec3 offset = rot_into.transpose() * (pos_from - pos_into);
   // A static body's faces that others cover are no way out (a tile's rim, into the next tile).
   const std::uint8_t* covered = from_a ? covered_b_ : covered_a_;
   const std::uint8_t root_mask = covered != nullptr ? covered[0] : 0;

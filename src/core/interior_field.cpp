@@ -186,7 +186,7 @@ InteriorProbe InteriorField::probe(const Vec3& point_body) const {
   // may be nearer. Of these seven, the nearest box.
   double best = kFar;
   Vec3 best_to = Vec3::Zero();
-  std::int32_t best_site = -1;
+  Eigen::Vector3i best_at(-1, -1, -1);  // the nearest site's cell
   const auto consider = [&](std::int32_t site) {
     if (site < 0) return;
     const Eigen::Vector3i at(site % px_, (site / px_) % py_, site / (px_ * py_));
@@ -195,7 +195,7 @@ InteriorProbe InteriorField::probe(const Vec3& point_body) const {
     if (d < best) {
       best = d;
       best_to = to;
-      best_site = site;
+      best_at = at;
     }
   };
   consider(nearest_[c]);
@@ -208,7 +208,7 @@ InteriorProbe InteriorField::probe(const Vec3& point_body) const {
       consider((solid_[n] != 0) == solid ? nearest_[n] : static_cast<std::int32_t>(n));
     }
   }
-  if (best_site < 0) return result;
+  if (best_at.x() < 0) return result;
   const double length = std::sqrt(best);
   if (!solid) {
     result.depth = -length * voxel_;
@@ -217,9 +217,8 @@ InteriorProbe InteriorField::probe(const Vec3& point_body) const {
   result.inside = true;
   result.depth = length * voxel_;
   // On the face itself: towards the empty cell's centre.
-  const Eigen::Vector3i at(best_site % px_, (best_site / px_) % py_, best_site / (px_ * py_));
   result.out = length > 1e-9 ? Vec3(best_to / length)
-                             : Vec3((at.cast<double>() + Vec3::Constant(0.5) - g).normalized());
+                             : Vec3((best_at.cast<double>() + Vec3::Constant(0.5) - g).normalized());
   return result;
 }
 
