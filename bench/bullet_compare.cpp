@@ -41,7 +41,7 @@
 //   --bullet-only  skip this package's run (to run the engines apart, in parallel)
 //   --smoke     every scene at 100 bodies at most, 0.05 s, no settling: that the bench runs, scripts/bench_smoke.sh
 //   --iterations N  this package's velocity and position iterations per tick
-//               (ResponseOptions::iterations; default: the World's, 20). Bullet
+//               (ResponseOptions::iterations; default: the World's). Bullet
 //               runs its default 10 always: --iterations 10 compares the two
 //               at the same solver effort. The SUMMARY lines say which was used.
 //   --solver NAME  this package's solver (ResponseOptions::solver: sequential, jacobi,

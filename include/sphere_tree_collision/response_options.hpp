@@ -22,7 +22,7 @@ const char* toString(SolverKind kind);
 
 struct ResponseOptions {
   bool enabled = true;
-  int iterations = 20;                  // velocity (and position) iterations per tick, >= 1
+  int iterations = 15;                  // velocity (and position) iterations per tick, >= 1
   // m/s: slower approach is treated as resting. The World raises it to at
   // least 4 |g| dt: a body resting under gravity falls that fast within a
   // speculative gap in one or two ticks, and bouncing on that would never settle.

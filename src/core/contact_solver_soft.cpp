@@ -22,6 +22,11 @@ constexpr std::size_t kRowsPerTask = 256;
 // sphere bound, about a voxel): see substepCount.
 constexpr double kSubstepPerScale = 0.07;
 constexpr int kMaxSubsteps = 64;
+// The restitution waves before the substeps, and the passes of each: a count
+// of the soft step's own, so that ResponseOptions::iterations (the default
+// solver's) is not used by it (a ball's bounce then depends on the other
+// solver's setting).
+constexpr int kSoftCollisionPasses = 20;
 constexpr double kPi = 3.14159265358979323846;
 
 // A soft contact as a damped spring of `hertz` and `damping_ratio`, solved
@@ -341,6 +346,7 @@ SolveStats ContactSolver::solveSoft(std::vector<BodyState>& bodies, std::vector<
   });
   ResponseOptions sequential = options;
   sequential.wide_passes = false;  // the soft passes take one manifold at a time
+  sequential.iterations = kSoftCollisionPasses;
   prepare(bodies, contacts, sequential, dt, stats);
   // The poses back to the tick's start: the moves since the contacts' poses.
   forEachIndex(workers_, body_count, kBodiesPerTask, [&](std::size_t begin, std::size_t end) {

@@ -173,7 +173,7 @@ TEST(Stability, ZeroDetectionBudgetStaysFiniteAndBounded) {
 // way, the scene blew up (energy gain 0.7 of its scale, 42 m/s) and the heavy
 // cube ended 27 cm from where it rested. With it the gain stays under 1e-2 (7.8e-3: position
 // correction lifting bodies out with fewer passes to spread it); the suite's
-// 1e-3 holds at the default 20 iterations.
+// 1e-3 holds at the default 15 iterations.
 TEST(Stability, HeavyCubeOnLightCubesHoldsWithTenIterations) {
   ResponseOptions ten;
   ten.iterations = 10;
