@@ -78,7 +78,9 @@ demoTicks() {
     echo "rospack find sphere_tree_collision: $found"
     case "$found" in "$expected" | "$expected"/*) ;; *) echo "the package was not found in $expected"; exit 1 ;; esac
     export ROS_MASTER_URI="http://localhost:$port"
-    exec roslaunch -p "$port" sphere_tree_collision demo.launch rviz:=false
+    # Line-buffered: the nodes' log lines reach the log as they are printed
+    # (block-buffered into a file, the first ones came about 20 s late).
+    exec stdbuf -oL roslaunch -p "$port" sphere_tree_collision demo.launch rviz:=false
   ) >"$log" 2>&1 &
   launcher=$!
   for _ in $(seq 1 240); do  # liveness bound: 120 s
