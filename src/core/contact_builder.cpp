@@ -24,6 +24,23 @@ constexpr double kAlignedCosine = 0.95;
 // deepest give the cluster's normal.
 constexpr double kDeepBand = 0.1;
 
+// Each cluster's separation: the least of `along(candidate, cluster)` over
+// the members whose own normal is within kAlignedCosine of the cluster's; a
+// cluster with none keeps its representative's separation.
+template <typename Along>
+void leastAlignedSeparations(const std::vector<ContactCandidate>& candidates, const std::vector<int>& reps,
+                             const std::vector<Vec3>& normals, const Along& along, std::vector<double>& separations) {
+  separations.assign(reps.size(), std::numeric_limits<double>::infinity());
+  for (const ContactCandidate& c : candidates) {
+    const std::size_t r = static_cast<std::size_t>(c.cluster);
+    if (c.normal.dot(normals[r]) < kAlignedCosine) continue;
+    separations[r] = std::min(separations[r], along(c, r));
+  }
+  for (std::size_t r = 0; r < reps.size(); ++r) {
+    if (!std::isfinite(separations[r])) separations[r] = candidates[static_cast<std::size_t>(reps[r])].separation;
+  }
+}
+
 // Unit direction a -> b: the line of centres, else the body centres, else +Z.
 Vec3 directionOf(const Vec3& delta, const Vec3& body_a, const Vec3& body_b) {
   const double length = delta.norm();
@@ -325,14 +342,9 @@ bool interiorContacts(const PairGeometry& geometry, const InteriorField& field_a
   spread.scale = std::min(field_a.voxelSize(), field_b.voxelSize());
   pickRepresentatives(candidates, deepestOverlap(candidates), limit, spread, reps);
   clusterNormals(candidates, reps, normals);
-  separations.assign(reps.size(), std::numeric_limits<double>::infinity());
-  for (const ContactCandidate& c : candidates) {
-    const std::size_t r = static_cast<std::size_t>(c.cluster);
-    if (c.normal.dot(normals[r]) >= kAlignedCosine) separations[r] = std::min(separations[r], c.separation);
-  }
-  for (std::size_t r = 0; r < reps.size(); ++r) {
-    if (!std::isfinite(separations[r])) separations[r] = candidates[static_cast<std::size_t>(reps[r])].separation;
-  }
+  // A member's separation is already its depth along its own way out.
+  leastAlignedSeparations(candidates, reps, normals,
+                          [](const ContactCandidate& c, std::size_t) { return c.separation; }, separations);
   return true;
 }
 
@@ -498,18 +510,11 @@ void clusterNormals(const std::vector<ContactCandidate>& candidates, const std::
 void clusterSeparations(const std::vector<ContactCandidate>& candidates, const std::vector<int>& reps,
                         const std::vector<Vec3>& normals, const PairGeometry& geometry,
                         std::vector<double>& separations) {
-  const std::size_t count = reps.size();
-  separations.assign(count, std::numeric_limits<double>::infinity());
   PairGeometry::Axis axes[kMaxRepresentatives];
-  for (std::size_t r = 0; r < count; ++r) axes[r] = geometry.axis(normals[r]);
-  for (const ContactCandidate& c : candidates) {
-    const std::size_t r = static_cast<std::size_t>(c.cluster);
-    if (c.normal.dot(normals[r]) < kAlignedCosine) continue;
-    separations[r] = std::min(separations[r], geometry.gapAlong(c, axes[r]));
-  }
-  for (std::size_t r = 0; r < count; ++r) {
-    if (!std::isfinite(separations[r])) separations[r] = candidates[static_cast<std::size_t>(reps[r])].separation;
-  }
+  for (std::size_t r = 0; r < reps.size(); ++r) axes[r] = geometry.axis(normals[r]);
+  leastAlignedSeparations(candidates, reps, normals,
+                          [&](const ContactCandidate& c, std::size_t r) { return geometry.gapAlong(c, axes[r]); },
+                          separations);
 }
 
 void ContactBuilder::append(const PairTest& test, std::uint32_t index_a, std::uint32_t index_b,
