@@ -33,6 +33,7 @@
 //   --rolling C  every body's Material::rolling_resistance set to C after the
 //              scene is built (default: the scene's own)
 //   --solver NAME  ResponseOptions::solver: sequential (default), jacobi or soft
+//   --iterations N  ResponseOptions::iterations (default: the World's)
 #include "sphere_tree_collision/scenes.hpp"
 #include "sphere_tree_collision/world.hpp"
 #include "tick_clock.hpp"
@@ -57,6 +58,7 @@ struct Options {
   bool sleep_off = false;
   double rolling = -1.0;  // < 0: the scene's
   SolverKind solver = ResponseOptions{}.solver;
+  int iterations = ResponseOptions{}.iterations;
 };
 
 Options parse(int argc, char** argv) {
@@ -75,6 +77,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--sleep-off") o.sleep_off = true;
     else if (a == "--rolling") o.rolling = std::stod(next());
     else if (a == "--solver") o.solver = parseSolverKind(next());
+    else if (a == "--iterations") o.iterations = std::stoi(next());
     else if (a == "--smoke") o.bodies = 200, o.settle = 0.1, o.seconds = 0.05, o.every = 0.05;
     else throw InputError(a, "unknown option");
   }
@@ -248,6 +251,7 @@ int main(int argc, char** argv) {
     WorldConfig config;
     config.sleeping.enabled = !opt.sleep_off;
     config.response.solver = opt.solver;
+    config.response.iterations = opt.iterations;
     SceneParams params;
     params.entities = opt.bodies;
     SceneWorld scene = makeSceneWorld(opt.scene, params, config);
@@ -259,9 +263,9 @@ int main(int argc, char** argv) {
     const double dt = spec.dt;
     double rolling = 0.0;
     for (const BodyState& b : world.bodies()) rolling = std::max(rolling, b.material.rolling_resistance);
-    std::printf("scene=%s bodies=%d dt=%.5f solver=%s sleeping=%s (linear_speed %.3g m/s for %.3g s) "
+    std::printf("scene=%s bodies=%d dt=%.5f solver=%s iterations=%d sleeping=%s (linear_speed %.3g m/s for %.3g s) "
                 "rolling_resistance=%.3g\n",
-                toString(opt.scene), opt.bodies, dt, toString(opt.solver), opt.sleep_off ? "off" : "on",
+                toString(opt.scene), opt.bodies, dt, toString(opt.solver), opt.iterations, opt.sleep_off ? "off" : "on",
                 config.sleeping.linear_speed, config.sleeping.time_to_sleep, rolling);
     Diagnosis diagnosis(world, spec);
     const int every = std::max(1, static_cast<int>(std::lround(opt.every / dt)));

@@ -52,6 +52,7 @@ World::Parts::Parts(World& owner, const WorldConfig& config)
   validateGravity(config_.gravity, config_.limits);
   validateFractureOptions(config_.fracture);
   validateSleepOptions(config_.sleeping);
+  validateResponseOptions(config_.response);
 }
 World::Parts::~Parts() = default;
 

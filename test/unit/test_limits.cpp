@@ -69,7 +69,7 @@ TEST(Limits, FiniteButAbsurdInputIsRejectedNamingFieldAndLimit) {
   expectRejected(f.world, s, "material.restitution", "[0, 1]");
 }
 
-TEST(Limits, LimitsAndGravityAreCheckedWhenTheWorldIsMade) {
+TEST(Limits, LimitsGravityAndResponseAreCheckedWhenTheWorldIsMade) {
   WorldConfig config;
   config.gravity = Vec3(0, 0, -1e308);
   EXPECT_THROW(
@@ -88,6 +88,18 @@ TEST(Limits, LimitsAndGravityAreCheckedWhenTheWorldIsMade) {
   config = WorldConfig{};
   config.limits.min_density = 10.0;
   config.limits.max_density = 1.0;
+  EXPECT_THROW(World{config}, InputError);
+  // The response's options too, as World::setResponse checks them.
+  config = WorldConfig{};
+  config.response.iterations = 0;
+  try {
+    World w(config);
+    ADD_FAILURE() << "a World was made with 0 solver iterations";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "response.iterations");
+  }
+  config.response.iterations = 15;
+  config.response.max_push_speed = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(World{config}, InputError);
 }
 
