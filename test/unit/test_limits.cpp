@@ -3,6 +3,8 @@
 // its end, named, and the rest of the world goes on exactly as without it.
 #include "sphere_tree_collision/world.hpp"
 
+#include "world_refuses.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cfloat>
@@ -72,35 +74,21 @@ TEST(Limits, FiniteButAbsurdInputIsRejectedNamingFieldAndLimit) {
 TEST(Limits, LimitsGravityAndResponseAreCheckedWhenTheWorldIsMade) {
   WorldConfig config;
   config.gravity = Vec3(0, 0, -1e308);
-  EXPECT_THROW(
-      {
-        try {
-          World w(config);
-        } catch (const InputError& e) {
-          EXPECT_EQ(e.field(), "gravity");
-          throw;
-        }
-      },
-      InputError);
+  EXPECT_TRUE(worldRefuses(config, "gravity"));
   config = WorldConfig{};
   config.limits.max_speed = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(World{config}, InputError);
+  EXPECT_TRUE(worldRefuses(config, "max_speed"));
   config = WorldConfig{};
   config.limits.min_density = 10.0;
   config.limits.max_density = 1.0;
-  EXPECT_THROW(World{config}, InputError);
+  EXPECT_TRUE(worldRefuses(config, "min_density"));
   // The response's options too, as World::setResponse checks them.
   config = WorldConfig{};
   config.response.iterations = 0;
-  try {
-    World w(config);
-    ADD_FAILURE() << "a World was made with 0 solver iterations";
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.field(), "response.iterations");
-  }
+  EXPECT_TRUE(worldRefuses(config, "response.iterations"));
   config.response.iterations = 15;
   config.response.max_push_speed = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(World{config}, InputError);
+  EXPECT_TRUE(worldRefuses(config, "response.max_push_speed"));
 }
 
 TEST(Limits, ARunawayBodyIsQuarantinedByNameAndTheRestGoesOnUntouched) {
