@@ -27,6 +27,7 @@ using WideRow = WideBatches::Row;
 using WideShockMass = WideBatches::ShockMass;
 using WidePush = WideBatches::Push;
 using WideBatch = WideBatches::Batch;
+using WideRolling = WideBatches::Rolling;
 static_assert(kLanes == 4, "the lane types below are four doubles wide");
 
 // Four doubles, and a lane mask of the same width (GCC/Clang vector types:
@@ -156,6 +157,39 @@ STC_WIDE void relaxWide(WideRow& row, const double (&mass)[3][kLanes], const Wid
   store(row.lambda[2], lambda2);
 }
 
+// A lane's 3x3 matrix times a vector, in the order of Eigen's Matrix3d *
+// Vector3d (SSE2): rows 0 and 1 as one packet, column by column, so
+// (m0 v.x + m1 v.y) + m2 v.z; row 2 as a reduction split in halves,
+// m0 v.x + (m1 v.y + m2 v.z). test_wide_passes holds this to the bit.
+STC_WIDE Wide3 times(const double (&m)[3][3][kLanes], const Wide3& v) {
+  const auto mul = [&](int i, int j, const Wide& x) __attribute__((always_inline)) { return load(m[i][j]) * x; };
+  return {(mul(0, 0, v.x) + mul(0, 1, v.y)) + mul(0, 2, v.z), (mul(1, 0, v.x) + mul(1, 1, v.y)) + mul(1, 2, v.z),
+          mul(2, 0, v.x) + (mul(2, 1, v.y) + mul(2, 2, v.z))};
+}
+
+// rollingStep (contact_rows.hpp) for the lanes `on`, the pair's normal
+// impulse so far `normal`.
+STC_WIDE void rollWide(WideRolling& roll, const Wide& normal, const WideMask& on, WideMotion& m) {
+  const Wide zero = {0.0, 0.0, 0.0, 0.0};
+  const Wide one = {1.0, 1.0, 1.0, 1.0};
+  const Wide limit = load(roll.per_normal) * normal;
+  const Wide3 old = load3(roll.lambda);
+  const Wide3 spin = times(roll.mass, Wide3{m.wb.x - m.wa.x, m.wb.y - m.wa.y, m.wb.z - m.wa.z});
+  Wide3 lambda = {old.x - spin.x, old.y - spin.y, old.z - spin.z};
+  const Wide squared = dot(lambda, lambda);
+  Wide norm = squared;
+  for (std::uint32_t l = 0; l < kLanes; ++l) norm[l] = std::sqrt(squared[l]);
+  const Wide scale = norm > limit ? (norm > zero ? limit / norm : zero) : one;
+  lambda = {lambda.x * scale, lambda.y * scale, lambda.z * scale};
+  const Wide3 delta = {lambda.x - old.x, lambda.y - old.y, lambda.z - old.z};
+  const Wide3 da = times(roll.inv_ia, delta), db = times(roll.inv_ib, delta);
+  m.wa = select(on, Wide3{m.wa.x - da.x, m.wa.y - da.y, m.wa.z - da.z}, m.wa);
+  m.wb = select(on, Wide3{m.wb.x + db.x, m.wb.y + db.y, m.wb.z + db.z}, m.wb);
+  store(roll.lambda[0], select(on, lambda.x, old.x));
+  store(roll.lambda[1], select(on, lambda.y, old.y));
+  store(roll.lambda[2], select(on, lambda.z, old.z));
+}
+
 // How many batches ahead a pass asks for the bodies it will read. A body's
 // velocity is a line of its own that the other thread may have written last
 // stage (cores far apart: a few hundred ns each) and, on a large pile, out of
@@ -185,7 +219,7 @@ STC_WIDE void prefetchBodies(const WideBatch& ahead, const ContactSolver::Motion
 // propagation's, with the supporting bodies held (kShock).
 template <bool kShock>
 STC_WIDE void relaxBatchesOf(WideRow* wide_rows, const WideShockMass* shock_mass,
-                             ContactSolver::Rolling* rolling, const WideBatch* batch,
+                             WideRolling* rolling, const WideBatch* batch,
                              std::size_t count, ContactSolver::Motion* motion) {
   for (std::size_t k = 0; k < count; ++k, ++batch) {
     if (k + kBodiesAhead < count) prefetchBodies(batch[kBodiesAhead], motion);
@@ -208,23 +242,17 @@ STC_WIDE void relaxBatchesOf(WideRow* wide_rows, const WideShockMass* shock_mass
         relaxWide(row, row.mass, on, on, on, m);
       }
     }
-    // Each pair's rolling resistance after its rows, one lane at a time.
-    for (std::uint32_t l = 0; rolling != nullptr && l < batch->lanes; ++l) {
-      ContactSolver::Rolling& roll = rolling[batch->manifold[l]];
-      if (roll.per_normal == 0.0) continue;
-      double normal = 0.0;  // as ContactSolver::normalImpulse sums it
-      for (std::uint32_t s = 0; s < batch->manifold_rows[l]; ++s) {
+    // Each pair's rolling resistance after its rows, its normal impulse
+    // summed over its rows as ContactSolver::normalImpulse sums it.
+    if (rolling != nullptr) {
+      const Wide zero = {0.0, 0.0, 0.0, 0.0};
+      Wide normal = zero;
+      for (std::uint32_t s = 0; s < batch->rows; ++s) {
         const WideRow& row = wide_rows[batch->first_row + s];
-        normal += row.lambda[0][l] + row.bounce_impulse[l];
+        normal = select(lanes.withRow(s), normal + (load(row.lambda[0]) + load(row.bounce_impulse)), normal);
       }
-      ContactSolver::Motion a, b;
-      a.v = Vec3(m.va.x[l], m.va.y[l], m.va.z[l]);
-      a.w = Vec3(m.wa.x[l], m.wa.y[l], m.wa.z[l]);
-      b.v = Vec3(m.vb.x[l], m.vb.y[l], m.vb.z[l]);
-      b.w = Vec3(m.wb.x[l], m.wb.y[l], m.wb.z[l]);
-      ContactSolver::resistRolling(roll, normal, a, b);
-      m.wa.x[l] = a.w.x(), m.wa.y[l] = a.w.y(), m.wa.z[l] = a.w.z();
-      m.wb.x[l] = b.w.x(), m.wb.y[l] = b.w.y(), m.wb.z[l] = b.w.z();
+      WideRolling& roll = rolling[k];
+      rollWide(roll, normal, load(roll.per_normal) != zero, m);
     }
     for (std::uint32_t l = 0; l < batch->lanes; ++l) {
       if (batch->write_a[l]) {
@@ -301,7 +329,7 @@ STC_WIDE void pushBatchesOf(WidePush* wide_rows, const WideBatch* batch,
 #define STC_WIDE_CLONES
 #endif
 
-STC_WIDE_CLONES void relaxBatches(WideRow* wide_rows, ContactSolver::Rolling* rolling,
+STC_WIDE_CLONES void relaxBatches(WideRow* wide_rows, WideRolling* rolling,
                                   const WideBatch* batch, std::size_t count,
                                   ContactSolver::Motion* motion) {
   relaxBatchesOf<false>(wide_rows, nullptr, rolling, batch, count, motion);
@@ -361,6 +389,21 @@ void ContactSolver::packWide(std::size_t first, std::size_t end) {
         wide.bounce_impulse[l] = row.bounce_impulse;
       }
     }
+    if (!any_rolling_) continue;
+    WideRolling& wide = wide_batches_.rolling()[k];
+    std::memset(&wide, 0, sizeof wide);
+    for (std::uint32_t l = 0; l < batch.lanes; ++l) {
+      const Rolling& roll = rolling_[batch.manifold[l]];
+      wide.per_normal[l] = roll.per_normal;
+      for (int i = 0; i < 3; ++i) {
+        wide.lambda[i][l] = roll.lambda[i];
+        for (int j = 0; j < 3; ++j) {
+          wide.mass[i][j][l] = roll.mass(i, j);
+          wide.inv_ia[i][j][l] = roll.inv_ia(i, j);
+          wide.inv_ib[i][j][l] = roll.inv_ib(i, j);
+        }
+      }
+    }
   }
 }
 
@@ -404,6 +447,12 @@ void ContactSolver::unpackWide(std::size_t first, std::size_t end) {
         for (int i = 0; i < 3; ++i) row.lambda[i] = wide.lambda[i][l];
       }
     }
+    if (!any_rolling_) continue;
+    const WideRolling& wide = wide_batches_.rolling()[k];
+    for (std::uint32_t l = 0; l < batch.lanes; ++l) {
+      Rolling& roll = rolling_[batch.manifold[l]];
+      if (roll.per_normal != 0.0) roll.lambda = Vec3(wide.lambda[0][l], wide.lambda[1][l], wide.lambda[2][l]);
+    }
   }
 }
 
@@ -440,11 +489,11 @@ void ContactSolver::propagatePositionShockWide() {
 
 void ContactSolver::solveVelocitiesWide(int passes) {
   WideRow* rows = wide_batches_.rows().data();
-  Rolling* rolling = any_rolling_ ? rolling_.data() : nullptr;
+  WideRolling* rolling = any_rolling_ ? wide_batches_.rolling().data() : nullptr;
   const WideBatch* batches = wide_batches_.batches().data();
   for (int it = 0; it < passes; ++it) {
     plan_.forEachStageBatches(wide_batches_.starts(), [&](std::size_t first, std::size_t end) {
-      relaxBatches(rows, rolling, batches + first, end - first, motion_.data());
+      relaxBatches(rows, rolling != nullptr ? rolling + first : nullptr, batches + first, end - first, motion_.data());
     });
   }
 }

@@ -41,6 +41,13 @@ class WideBatches {
     double inv_ma[kLanes], inv_mb[kLanes], push[kLanes], mass[kLanes], shock_mass[kLanes], lambda[kLanes];
     long long pull[kLanes];  // all ones: may pull (bounced across a gap), else clamped at 0
   };
+  // Each lane's rolling resistance (ContactSolver::Rolling), one a batch:
+  // matrices [row][column][lane]; per_normal 0 in a lane without it.
+  struct alignas(32) Rolling {
+    double mass[3][3][kLanes], inv_ia[3][3][kLanes], inv_ib[3][3][kLanes];
+    double per_normal[kLanes];
+    double lambda[3][kLanes];
+  };
   struct Batch {
     std::uint32_t first_row = 0, rows = 0;  // its wide rows: as many as its largest manifold's
     std::uint32_t lanes = 0;
@@ -70,12 +77,14 @@ class WideBatches {
   std::vector<Row>& rows() { return rows_; }
   std::vector<ShockMass>& shockMass() { return shock_mass_; }
   std::vector<Push>& push() { return push_; }
+  std::vector<Rolling>& rolling() { return rolling_; }  // by batch
 
  private:
   std::vector<Batch> batches_;
   std::vector<Row> rows_;
   std::vector<ShockMass> shock_mass_;
   std::vector<Push> push_;
+  std::vector<Rolling> rolling_;
   std::vector<std::uint32_t> batch_start_;
   std::vector<std::uint32_t> body_batch_;  // assign: a body's last batch + 1
 };
@@ -91,6 +100,7 @@ void WideBatches::assign(const SolverThreadPlan& plan, std::size_t rows, std::si
   growCapacityRewritten(rows_, rows);
   growCapacityRewritten(shock_mass_, rows);
   growCapacityRewritten(push_, rows);
+  growCapacityRewritten(rolling_, rows);
   const std::vector<std::uint32_t>& manifold_start = plan.manifoldStart();
   const std::vector<SolverGroup>& manifolds = plan.manifolds();
   batch_start_.assign(manifolds.size() + 1, 0);
@@ -144,6 +154,7 @@ void WideBatches::assign(const SolverThreadPlan& plan, std::size_t rows, std::si
   rows_.resize(wide_rows);
   shock_mass_.resize(wide_rows);
   push_.resize(wide_rows);
+  rolling_.resize(batches_.size());
 }
 
 }  // namespace stc
