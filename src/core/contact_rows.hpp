@@ -56,19 +56,29 @@ STC_HOT_INLINE void applyNormal(const ContactSolver::Row& row, double impulse, C
   b.w += impulse * row.ang_b[0];
 }
 
+// m v with its sums in a fixed order, the one Eigen's Matrix3d * Vector3d
+// takes with SSE2 (rows 0 and 1 as a packet, column by column; row 2 as a
+// reduction split in halves), written out so that the four-wide passes
+// (contact_solver_wide.cpp, `times`) can follow it whatever Eigen does on
+// another target.
+STC_HOT_INLINE Vec3 timesInOrder(const Mat3& m, const Vec3& v) {
+  return Vec3((m(0, 0) * v.x() + m(0, 1) * v.y()) + m(0, 2) * v.z(), (m(1, 0) * v.x() + m(1, 1) * v.y()) + m(1, 2) * v.z(),
+              m(2, 0) * v.x() + (m(2, 1) * v.y() + m(2, 2) * v.z()));
+}
+
 // One step of a pair's rolling resistance: the angular impulse that stops
 // the bodies' relative spin, its sum held within per_normal times the
 // pair's normal impulse so far (a ball of the cone, as friction's).
 STC_HOT_INLINE void rollingStep(ContactSolver::Rolling& roll, double normal, const Vec3& wa, const Vec3& wb,
                                 ContactSolver::Motion& out_a, ContactSolver::Motion& out_b) {
   const double limit = roll.per_normal * normal;
-  Vec3 lambda = roll.lambda - roll.mass * (wb - wa);
-  const double norm = lambda.norm();
+  Vec3 lambda = roll.lambda - timesInOrder(roll.mass, wb - wa);
+  const double norm = std::sqrt((lambda.x() * lambda.x() + lambda.y() * lambda.y()) + lambda.z() * lambda.z());
   if (norm > limit) lambda *= norm > 0.0 ? limit / norm : 0.0;
   const Vec3 delta = lambda - roll.lambda;
   roll.lambda = lambda;
-  out_a.w -= roll.inv_ia * delta;
-  out_b.w += roll.inv_ib * delta;
+  out_a.w -= timesInOrder(roll.inv_ia, delta);
+  out_b.w += timesInOrder(roll.inv_ib, delta);
 }
 
 }  // namespace contact_rows

@@ -157,10 +157,7 @@ STC_WIDE void relaxWide(WideRow& row, const double (&mass)[3][kLanes], const Wid
   store(row.lambda[2], lambda2);
 }
 
-// A lane's 3x3 matrix times a vector, in the order of Eigen's Matrix3d *
-// Vector3d (SSE2): rows 0 and 1 as one packet, column by column, so
-// (m0 v.x + m1 v.y) + m2 v.z; row 2 as a reduction split in halves,
-// m0 v.x + (m1 v.y + m2 v.z). test_wide_passes holds this to the bit.
+// A lane's 3x3 matrix times a vector, in timesInOrder's order (contact_rows.hpp).
 STC_WIDE Wide3 times(const double (&m)[3][3][kLanes], const Wide3& v) {
   const auto mul = [&](int i, int j, const Wide& x) __attribute__((always_inline)) { return load(m[i][j]) * x; };
   return {(mul(0, 0, v.x) + mul(0, 1, v.y)) + mul(0, 2, v.z), (mul(1, 0, v.x) + mul(1, 1, v.y)) + mul(1, 2, v.z),
