@@ -25,6 +25,8 @@ void tangentBasis(const Vec3& n, Vec3& t1, Vec3& t2) {
 namespace {
 
 constexpr int kUnreached = std::numeric_limits<int>::max();
+// How many rows ahead preparing them asks for their contacts and bodies.
+constexpr std::size_t kRowsAhead = 8;
 constexpr std::size_t kRowsPerTask = 256;       // rows prepared by one task, at least
 constexpr std::size_t kManifoldsPerTask = 128;  // manifolds' rolling resistance or cache, at least
 // A restitution wave's stage goes to the team from this many rows per
@@ -196,8 +198,26 @@ void ContactSolver::prepare(const std::vector<BodyState>& bodies,
     wave_flag_[r] = info.bounced ? 1 : 0;
     row_bodies_[r] = {row.a, row.b};
   };
+  // A row reads its contact and both bodies at random places (the rows are in
+  // block order): each contact is asked for 2 kRowsAhead rows before its row,
+  // and its bodies kRowsAhead rows before, so the reads overlap.
+  const auto prefetchBodies = [&](std::size_t r) {
+    const Contact& c = contacts[order_[r]];
+    for (const std::uint32_t i : {c.index_a, c.index_b}) {
+      const BodyState& b = bodies[i];
+      __builtin_prefetch(&b.pose);
+      __builtin_prefetch(&b.inv_mass);
+      __builtin_prefetch(&b.inv_inertia_world);
+      __builtin_prefetch(&b.material);
+      __builtin_prefetch(&motion_[i]);
+    }
+  };
   forEachIndex(workers_, order_.size(), kRowsPerTask, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t r = begin; r < end; ++r) prepareRow(r);
+    for (std::size_t r = begin; r < end; ++r) {
+      if (r + 2 * kRowsAhead < end) __builtin_prefetch(&contacts[order_[r + 2 * kRowsAhead]]);
+      if (r + kRowsAhead < end) prefetchBodies(r + kRowsAhead);
+      prepareRow(r);
+    }
   });
   for (const std::uint32_t ci : order_) stats.max_penetration = std::max(stats.max_penetration, -contacts[ci].separation);
   stats.contacts = rows_.size();
