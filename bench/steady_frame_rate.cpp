@@ -38,6 +38,10 @@
 //     every tick; default: the World's), to measure contact recycling off and on
 //   --trace-ticks FILE: a CSV line a tick of every run (its cost, contacts, the island levels)
 //   --smoke: every scene at 100 entities for 0.05 s: that the bench runs, scripts/bench_smoke.sh
+//   A budgeted tick's contacts without its clock: `--tick-budget-ms 1e9 --sphere-tests 0
+//   --no-reference` (every pair cut at its root spheres, as a starved budget leaves it, but
+//   nothing timed, so two builds give the same ticks): how solver changes were weighed for
+//   the budgeted case (budgeted runs follow the clock and part after a few ticks).
 #include "bench_args.hpp"
 #include "plausibility.hpp"
 #include "scene_cases.hpp"
