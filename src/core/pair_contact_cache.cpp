@@ -36,14 +36,21 @@ std::uint32_t PairContactCache::find(const ReuseBody& a, const ReuseBody& b, dou
   const std::uint32_t index = index_->find(entityPairKey(a.id, b.id));
   if (index == detail::FlatHashMap::kMissing) return kNone;
   const Entry& e = entries_[index];
+  const Pose& pa = *a.pose;
+  const Pose& pb = *b.pose;
+  // First, without a rotation: the centres' distance changed by at most what
+  // either origin moved in the other's frame (rotations keep lengths), so a
+  // change beyond the tolerance leaves both measures below beyond it too. A
+  // pair that moves (most, while a pile forms) costs a norm; the margin keeps
+  // rounding from turning away a pair the measures below would take.
+  const double distance_change = std::abs((pb.position - pa.position).norm() - e.b_in_a.norm());
+  if (distance_change > e.tolerance * (1.0 + 1e-9) + 1e-12) return kNone;
   // How far the relative pose moved since the entry was made: a point of B at
   // distance r from its origin moved, in A's frame, by at most the shift of
   // B's origin there plus the chord of the relative turn at r (2 r sin(angle/2),
   // sin(angle/2) being the turn's quaternion's vector part). The same seen
   // from B; either bound holds, so the smaller is taken (a big static plate
   // barely turns against the small body on it).
-  const Pose& pa = *a.pose;
-  const Pose& pb = *b.pose;
   const Quat turn = e.a_to_b.conjugate() * (pa.orientation.conjugate() * pb.orientation);
   const double chord = 2.0 * turn.vec().norm();
   // Their speed now the same way: a point of B at distance r from its origin
