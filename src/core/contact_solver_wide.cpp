@@ -91,13 +91,22 @@ struct LaneMasks {
   }
 };
 
+// What an impulse of squared length `squared` is scaled by to stay within
+// `limit` (a cone's, friction's and rolling's): 1 inside, limit / length beyond.
+STC_WIDE Wide coneScale(const Wide& squared, const Wide& limit) {
+  const Wide zero = {0.0, 0.0, 0.0, 0.0};
+  const Wide one = {1.0, 1.0, 1.0, 1.0};
+  Wide length = squared;
+  for (std::uint32_t l = 0; l < kLanes; ++l) length[l] = std::sqrt(squared[l]);
+  return length > limit ? (length > zero ? limit / length : zero) : one;
+}
+
 // relaxRow for the lanes `on`, with the effective masses `mass`: friction,
 // then non-penetration. Body A's velocities change only in the lanes on_a,
 // B's in on_b (shock propagation holds a supporting body still).
 STC_WIDE void relaxWide(WideRow& row, const double (&mass)[3][kLanes], const WideMask& on,
                         const WideMask& on_a, const WideMask& on_b, WideMotion& m) {
   const Wide zero = {0.0, 0.0, 0.0, 0.0};
-  const Wide one = {1.0, 1.0, 1.0, 1.0};
   const Wide3 ra = load3(row.ra), rb = load3(row.rb);
   const Wide3 n = load3(row.n), t1 = load3(row.t1);
   const Wide3 t2 = cross(n, t1);  // as tangentBasis made it
@@ -109,10 +118,7 @@ STC_WIDE void relaxWide(WideRow& row, const double (&mass)[3][kLanes], const Wid
   const Wide limit = load(row.friction) * (lambda0 + load(row.bounce_impulse));
   const Wide f1 = lambda1 - load(mass[1]) * dot(vrel, t1);
   const Wide f2 = lambda2 - load(mass[2]) * dot(vrel, t2);
-  const Wide squared = f1 * f1 + f2 * f2;
-  Wide tn = squared;
-  for (std::uint32_t l = 0; l < kLanes; ++l) tn[l] = std::sqrt(squared[l]);
-  const Wide scale = tn > limit ? (tn > zero ? limit / tn : zero) : one;
+  const Wide scale = coneScale(f1 * f1 + f2 * f2, limit);
   const Wide d1 = select(on, f1 * scale - lambda1, zero);
   const Wide d2 = select(on, f2 * scale - lambda2, zero);
   lambda1 = lambda1 + d1;
@@ -167,16 +173,11 @@ STC_WIDE Wide3 times(const double (&m)[3][3][kLanes], const Wide3& v) {
 // rollingStep (contact_rows.hpp) for the lanes `on`, the pair's normal
 // impulse so far `normal`.
 STC_WIDE void rollWide(WideRolling& roll, const Wide& normal, const WideMask& on, WideMotion& m) {
-  const Wide zero = {0.0, 0.0, 0.0, 0.0};
-  const Wide one = {1.0, 1.0, 1.0, 1.0};
   const Wide limit = load(roll.per_normal) * normal;
   const Wide3 old = load3(roll.lambda);
   const Wide3 spin = times(roll.mass, Wide3{m.wb.x - m.wa.x, m.wb.y - m.wa.y, m.wb.z - m.wa.z});
   Wide3 lambda = {old.x - spin.x, old.y - spin.y, old.z - spin.z};
-  const Wide squared = dot(lambda, lambda);
-  Wide norm = squared;
-  for (std::uint32_t l = 0; l < kLanes; ++l) norm[l] = std::sqrt(squared[l]);
-  const Wide scale = norm > limit ? (norm > zero ? limit / norm : zero) : one;
+  const Wide scale = coneScale(dot(lambda, lambda), limit);
   lambda = {lambda.x * scale, lambda.y * scale, lambda.z * scale};
   const Wide3 delta = {lambda.x - old.x, lambda.y - old.y, lambda.z - old.z};
   const Wide3 da = times(roll.inv_ia, delta), db = times(roll.inv_ib, delta);
@@ -448,7 +449,7 @@ void ContactSolver::unpackWide(std::size_t first, std::size_t end) {
     const WideRolling& wide = wide_batches_.rolling()[k];
     for (std::uint32_t l = 0; l < batch.lanes; ++l) {
       Rolling& roll = rolling_[batch.manifold[l]];
-      if (roll.per_normal != 0.0) roll.lambda = Vec3(wide.lambda[0][l], wide.lambda[1][l], wide.lambda[2][l]);
+      roll.lambda = Vec3(wide.lambda[0][l], wide.lambda[1][l], wide.lambda[2][l]);  // unchanged in a lane without it
     }
   }
 }
